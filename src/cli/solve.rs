@@ -1,0 +1,290 @@
+//! `info`, `validate`, `solve`, `eval`, `solvers`, `generate`.
+
+use anyhow::{bail, Context as _, Result};
+use cellseq::formats::json::{self, SolutionFile, SOLUTION_FORMAT};
+use cellseq::formats::{self, best_known};
+use cellseq::model::{Instance, Objective};
+use cellseq::solvers::{self, parse_kv, Budget, NoObserver, ParamKind, RunResult};
+use clap::Args;
+use serde_json::json;
+use std::path::{Path, PathBuf};
+use std::time::Duration;
+
+#[derive(Args, Debug)]
+pub struct InfoArgs {
+    /// Instance file (.json, .sop, .pcglns).
+    file: PathBuf,
+}
+
+#[derive(Args, Debug)]
+pub struct ValidateArgs {
+    /// Instance file.
+    file: PathBuf,
+}
+
+#[derive(Args, Debug)]
+pub struct SolveArgs {
+    /// Instance file.
+    pub file: PathBuf,
+    /// Solver name (see `cellseq solvers`).
+    #[arg(long, default_value = solvers::DEFAULT_SOLVER)]
+    pub solver: String,
+    /// Solver parameter KEY=VALUE (repeatable).
+    #[arg(long = "param", value_name = "KEY=VALUE")]
+    pub params: Vec<String>,
+    /// Random seed.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Wall-clock limit in seconds.
+    #[arg(long, value_name = "SECONDS")]
+    pub time_limit: Option<f64>,
+    /// Evaluation budget (deterministic runs).
+    #[arg(long, value_name = "N")]
+    pub max_evals: Option<u64>,
+    /// Objective: time (default), air, or matrix.
+    #[arg(long)]
+    pub objective: Option<String>,
+    /// Write the solution here (cellseq-solution/1 JSON).
+    #[arg(long, value_name = "SOLUTION.json")]
+    pub out: Option<PathBuf>,
+    /// Print one JSON object instead of the human-readable report.
+    #[arg(long)]
+    pub json: bool,
+}
+
+#[derive(Args, Debug)]
+pub struct EvalArgs {
+    /// Instance file.
+    file: PathBuf,
+    /// Solution file (cellseq-solution/1 JSON).
+    solution: PathBuf,
+    /// Objective: time (default), air, or matrix.
+    #[arg(long)]
+    objective: Option<String>,
+    /// Print JSON.
+    #[arg(long)]
+    json: bool,
+}
+
+#[derive(Args, Debug)]
+pub struct GenerateArgs {
+    /// Generator kind (see the list in the error for unknown kinds).
+    kind: String,
+    /// Generator parameter KEY=VALUE (repeatable).
+    #[arg(long = "param", value_name = "KEY=VALUE")]
+    params: Vec<String>,
+    /// Seed.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Output instance file.
+    #[arg(short, long)]
+    out: PathBuf,
+}
+
+/// Loads an instance, with the file named in any error.
+pub fn load(path: &Path) -> Result<Instance> {
+    Ok(formats::load_instance(path)?)
+}
+
+/// Parses an objective name, or the instance's default.
+pub fn objective_of(inst: &Instance, name: Option<&str>) -> Result<Objective> {
+    match name {
+        None => Ok(inst.default_objective()),
+        Some(s) => match Objective::parse(s) {
+            Some(Objective::Matrix) if !inst.is_matrix() => {
+                bail!("objective 'matrix' needs a matrix instance (TSPLIB SOP or PCGTSP)")
+            }
+            Some(o) if inst.is_matrix() && o != Objective::Matrix => {
+                bail!("matrix instances are scored by their matrix; objective '{s}' does not apply")
+            }
+            Some(o) => Ok(o),
+            None => bail!("unknown objective '{s}' (known: time, air, matrix)"),
+        },
+    }
+}
+
+pub fn info(a: InfoArgs) -> Result<()> {
+    let inst = load(&a.file)?;
+    println!("instance        {}", inst.name);
+    println!("kind            {}", if inst.is_matrix() { "matrix" } else { "geometric" });
+    println!("cells           {}", inst.n());
+    println!("modes           {}", inst.total_modes());
+    println!("tools           {}", inst.used_tools().len());
+    println!("precedence      {} edges", inst.precedence.len());
+    println!("density         {:.4}", inst.precedence_density());
+    if let Some(g) = &inst.meta.generator {
+        println!("source          {g}");
+    }
+    println!("as-programmed   {}", if inst.as_given.is_some() { "yes" } else { "no" });
+    if let Some((bk, proven)) = best_known(&a.file) {
+        println!("best known      {bk}{}", if proven { " (optimal)" } else { "" });
+    }
+    Ok(())
+}
+
+pub fn validate(a: ValidateArgs) -> Result<()> {
+    load(&a.file)?;
+    println!("ok");
+    Ok(())
+}
+
+pub fn solve(a: SolveArgs) -> Result<()> {
+    let inst = load(&a.file)?;
+    let objective = objective_of(&inst, a.objective.as_deref())?;
+    let params = parse_kv(&a.params)?;
+    if let Some(t) = a.time_limit {
+        if !(t.is_finite() && t > 0.0) {
+            bail!("--time-limit must be a positive number of seconds, got {t}");
+        }
+    }
+    let budget = Budget {
+        time_limit: a.time_limit.map(Duration::from_secs_f64),
+        max_evals: a.max_evals,
+    };
+    let r = solvers::run(&a.solver, &inst, objective, &params, a.seed, budget, &mut NoObserver)?;
+    let bk = best_known(&a.file).map(|b| b.0);
+    if let Some(out) = &a.out {
+        let sol = solution_file(&inst, &a.solver, a.seed, &r);
+        formats::write_atomic(out, json::solution_to_json(&sol).as_bytes())
+            .with_context(|| format!("writing {}", out.display()))?;
+    }
+    if a.json {
+        println!("{}", serde_json::to_string(&result_json(&inst, &a.solver, a.seed, &r, bk))?);
+    } else {
+        print_report(&inst, &a.solver, &r, bk);
+    }
+    Ok(())
+}
+
+/// The solution file of a run.
+pub fn solution_file(inst: &Instance, solver: &str, seed: u64, r: &RunResult) -> SolutionFile {
+    SolutionFile {
+        format: SOLUTION_FORMAT.into(),
+        instance: inst.name.clone(),
+        solver: solver.into(),
+        seed,
+        objective: r.objective.name().into(),
+        sequence: json::to_refs(inst, &r.outcome.sequence),
+        report: Some(r.report),
+    }
+}
+
+fn gap(cost: f64, bk: Option<f64>) -> Option<f64> {
+    bk.filter(|&b| b > 0.0).map(|b| 100.0 * (cost - b) / b)
+}
+
+/// The `--json` object of a run.
+pub fn result_json(inst: &Instance, solver: &str, seed: u64, r: &RunResult, bk: Option<f64>) -> serde_json::Value {
+    let rep = &r.report;
+    json!({
+        "instance": inst.name,
+        "solver": solver,
+        "seed": seed,
+        "objective": r.objective.name(),
+        "feasible": true,
+        "cost": rep.cost,
+        "air_length": rep.air_length,
+        "cut_length": rep.cut_length,
+        "path_length": rep.path_length,
+        "lifts": rep.lifts,
+        "tool_changes": rep.tool_changes,
+        "machining_time": rep.machining_time,
+        "best_known": bk,
+        "gap_percent": gap(rep.cost, bk),
+        "proven_optimal": r.outcome.proven_optimal,
+        "lower_bound": r.outcome.lower_bound,
+        "evaluations": r.evaluations,
+        "elapsed_s": r.elapsed_s,
+        "sequence": json::to_refs(inst, &r.outcome.sequence),
+    })
+}
+
+fn print_report(inst: &Instance, solver: &str, r: &RunResult, bk: Option<f64>) {
+    let rep = &r.report;
+    println!("instance        {} ({} cells)", inst.name, inst.n());
+    println!("solver          {solver}");
+    println!("objective       {}", r.objective.name());
+    println!("cost            {}", fmt_num(rep.cost));
+    if !inst.is_matrix() {
+        println!("cut length      {:.3} mm", rep.cut_length);
+        println!("air length      {:.3} mm", rep.air_length);
+        println!("path length     {:.3} mm", rep.path_length);
+        println!("lifts           {}", rep.lifts);
+        println!("tool changes    {}", rep.tool_changes);
+        println!("machining time  {:.3} s", rep.machining_time);
+    }
+    if let Some(b) = bk {
+        println!("best known      {}  (gap {:.3} %)", fmt_num(b), gap(rep.cost, Some(b)).unwrap_or(0.0));
+    }
+    if r.outcome.proven_optimal {
+        println!("proven optimal  yes");
+    }
+    println!("feasible        yes (independent checker)");
+    println!("evaluations     {}", r.evaluations);
+    println!("elapsed         {:.3} s", r.elapsed_s);
+}
+
+fn fmt_num(x: f64) -> String {
+    if x.fract() == 0.0 && x.abs() < 1e15 {
+        format!("{x:.0}")
+    } else {
+        format!("{x:.3}")
+    }
+}
+
+pub fn eval(a: EvalArgs) -> Result<()> {
+    let inst = load(&a.file)?;
+    let objective = objective_of(&inst, a.objective.as_deref())?;
+    let spath = a.solution.display().to_string();
+    let text = formats::read_text(&a.solution)?;
+    let sol = json::parse_solution(&spath, &text)?;
+    let seq = json::from_refs(&inst, &sol.sequence, &spath)?;
+    let rep = cellseq::check(&inst, &seq, objective)
+        .map_err(|v| anyhow::anyhow!("{spath}: infeasible: {v}"))?;
+    let bk = best_known(&a.file).map(|b| b.0);
+    if a.json {
+        println!(
+            "{}",
+            json!({"instance": inst.name, "feasible": true, "objective": objective.name(),
+                   "report": rep, "best_known": bk, "gap_percent": gap(rep.cost, bk)})
+        );
+    } else {
+        println!("feasible        yes");
+        println!("cost            {}", fmt_num(rep.cost));
+        if !inst.is_matrix() {
+            println!("air length      {:.3} mm", rep.air_length);
+            println!("lifts           {}", rep.lifts);
+            println!("tool changes    {}", rep.tool_changes);
+            println!("machining time  {:.3} s", rep.machining_time);
+        }
+        if let Some(b) = bk {
+            println!("best known      {}  (gap {:.3} %)", fmt_num(b), gap(rep.cost, Some(b)).unwrap_or(0.0));
+        }
+    }
+    Ok(())
+}
+
+pub fn solvers() -> Result<()> {
+    for s in solvers::registry() {
+        let default = if s.name == solvers::DEFAULT_SOLVER { "  (default)" } else { "" };
+        println!("{}{default}\n    {}", s.name, s.summary);
+        for p in s.params {
+            let kind = match p.kind {
+                ParamKind::Int => "int".to_string(),
+                ParamKind::Float => "float".to_string(),
+                ParamKind::Bool => "bool".to_string(),
+                ParamKind::Choice(c) => c.join("|"),
+            };
+            println!("    --param {}={}  [{kind}]  {}", p.name, p.default, p.help);
+        }
+    }
+    Ok(())
+}
+
+pub fn generate(a: GenerateArgs) -> Result<()> {
+    let params = parse_kv(&a.params)?;
+    let inst = cellseq::generate::generate(&a.kind, &params, a.seed)?;
+    formats::save_instance(&a.out, &inst)?;
+    println!("wrote {} ({} cells)", a.out.display(), inst.n());
+    Ok(())
+}

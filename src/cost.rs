@@ -1,0 +1,360 @@
+//! The solvers' view of an instance: O(1) arc costs between (cell, mode) pairs.
+//!
+//! [`CostModel`] flattens the modes of all cells into *nodes* and answers `start`, `arc` and
+//! `finish` costs for the chosen [`Objective`], for geometric and matrix instances alike.
+//! It is the solvers' incremental evaluator; the independent checker in [`crate::check`]
+//! recomputes everything from the raw instance without using this module.
+
+use crate::geom::Point3;
+use crate::model::{CostMatrix, Instance, Objective, Sequence};
+use crate::precedence::Dag;
+
+/// Geometry and machine data flattened for fast arc evaluation.
+#[derive(Debug, Clone)]
+struct Geo {
+    entry: Vec<Point3>,
+    exit: Vec<Point3>,
+    clearance: f64,
+    /// seconds per mm at rapid feed
+    rapid_rate: f64,
+    lift_time: f64,
+    change_time: f64,
+    link_distance: f64,
+    tool_change: Point3,
+    home: Point3,
+    return_home: bool,
+    initial_tool: Option<u32>,
+}
+
+/// Arc costs, mode layout, tools and precedence of an instance, ready for search.
+#[derive(Debug, Clone)]
+pub struct CostModel {
+    objective: Objective,
+    /// node offset of each cell; `offsets[n]` = number of nodes
+    offsets: Vec<u32>,
+    /// cell of each node
+    node_cell: Vec<u32>,
+    /// tool index of each cell
+    tools: Vec<u32>,
+    /// seconds per mm of cutting, per cell
+    cut_rate: Vec<f64>,
+    /// the mode that cuts the same cell in the opposite direction, per node (itself if none)
+    flip: Vec<u32>,
+    reversible: Vec<bool>,
+    constant: f64,
+    matrix: Option<CostMatrix>,
+    geo: Option<Geo>,
+    /// precedence (transitive reduction where affordable)
+    pub dag: Dag,
+}
+
+impl CostModel {
+    /// Builds the model of a validated instance for the given objective. A geometric
+    /// objective on a matrix instance falls back to the matrix cost.
+    pub fn new(inst: &Instance, objective: Objective) -> CostModel {
+        let n = inst.n();
+        let mut offsets = Vec::with_capacity(n + 1);
+        let mut node_cell = Vec::with_capacity(inst.total_modes());
+        let mut acc = 0u32;
+        for (i, c) in inst.cells.iter().enumerate() {
+            offsets.push(acc);
+            acc += c.modes.len() as u32;
+            node_cell.extend(std::iter::repeat_n(i as u32, c.modes.len()));
+        }
+        offsets.push(acc);
+        let tool_ids = inst.used_tools();
+        let tools: Vec<u32> = inst
+            .cells
+            .iter()
+            .map(|c| tool_ids.iter().position(|t| *t == c.tool).unwrap_or(0) as u32)
+            .collect();
+        let m = &inst.machine;
+        let cut_rate: Vec<f64> = inst
+            .cells
+            .iter()
+            .map(|c| {
+                let feed = c
+                    .feed
+                    .or_else(|| inst.tool(&c.tool).and_then(|t| t.feed))
+                    .unwrap_or(m.cut_feed);
+                60.0 / feed
+            })
+            .collect();
+        let reversible: Vec<bool> = inst.cells.iter().map(|c| c.reversible).collect();
+        let mut flip: Vec<u32> = (0..acc).collect();
+        let objective = if inst.is_matrix() {
+            Objective::Matrix
+        } else if objective == Objective::Matrix {
+            Objective::Time
+        } else {
+            objective
+        };
+        let (matrix, geo, constant) = if let Some(mx) = &inst.matrix {
+            (Some(mx.clone()), None, 0.0)
+        } else {
+            let mut entry = Vec::with_capacity(acc as usize);
+            let mut exit = Vec::with_capacity(acc as usize);
+            for (i, c) in inst.cells.iter().enumerate() {
+                for (k, md) in c.modes.iter().enumerate() {
+                    entry.push(md.entry);
+                    exit.push(md.exit);
+                    if c.reversible {
+                        if let Some(j) = c.modes.iter().position(|o| *o == md.reversed()) {
+                            flip[offsets[i] as usize + k] = offsets[i] + j as u32;
+                        }
+                    }
+                }
+            }
+            let constant = if objective == Objective::Time {
+                inst.cells
+                    .iter()
+                    .zip(&cut_rate)
+                    .map(|(c, r)| c.cut_length * r)
+                    .sum()
+            } else {
+                0.0
+            };
+            let geo = Geo {
+                entry,
+                exit,
+                clearance: m.clearance,
+                rapid_rate: 60.0 / m.rapid_feed,
+                lift_time: m.lift_time,
+                change_time: m.tool_change_time,
+                link_distance: m.link_distance,
+                tool_change: m.tool_change,
+                home: m.home,
+                return_home: m.return_home,
+                initial_tool: m
+                    .initial_tool
+                    .as_ref()
+                    .map(|t| tool_ids.iter().position(|x| x == t).unwrap_or(u32::MAX as usize) as u32),
+            };
+            (None, Some(geo), constant)
+        };
+        let mut edges = inst.precedence.clone();
+        if let Some(f) = inst.first {
+            edges.extend((0..n).filter(|&c| c != f).map(|c| (f, c)));
+        }
+        if let Some(l) = inst.last {
+            edges.extend((0..n).filter(|&c| c != l).map(|c| (c, l)));
+        }
+        let dag = Dag::new(n, &edges).reduced(20_000);
+        CostModel {
+            objective,
+            offsets,
+            node_cell,
+            tools,
+            cut_rate,
+            flip,
+            reversible,
+            constant,
+            matrix,
+            geo,
+            dag,
+        }
+    }
+
+    /// The objective costs are expressed in.
+    pub fn objective(&self) -> Objective {
+        self.objective
+    }
+    /// Number of cells.
+    #[inline]
+    pub fn n(&self) -> usize {
+        self.offsets.len() - 1
+    }
+    /// Number of nodes ((cell, mode) pairs).
+    #[inline]
+    pub fn nodes(&self) -> usize {
+        *self.offsets.last().unwrap_or(&0) as usize
+    }
+    /// Number of modes of a cell.
+    #[inline]
+    pub fn modes(&self, cell: usize) -> usize {
+        (self.offsets[cell + 1] - self.offsets[cell]) as usize
+    }
+    /// Node index of (cell, mode).
+    #[inline]
+    pub fn node(&self, cell: usize, mode: usize) -> usize {
+        self.offsets[cell] as usize + mode
+    }
+    /// Cell and mode of a node.
+    #[inline]
+    pub fn cell_mode(&self, node: usize) -> (usize, usize) {
+        let c = self.node_cell[node] as usize;
+        (c, node - self.offsets[c] as usize)
+    }
+    /// Tool index (into the instance's used tools) of a cell.
+    #[inline]
+    pub fn tool(&self, cell: usize) -> u32 {
+        self.tools[cell]
+    }
+    /// Whether the cell may be reversed.
+    #[inline]
+    pub fn reversible(&self, cell: usize) -> bool {
+        self.reversible[cell]
+    }
+    /// The mode that cuts `cell` the other way round, if the cell is reversible and has one.
+    #[inline]
+    pub fn flipped(&self, cell: usize, mode: usize) -> Option<usize> {
+        let nd = self.node(cell, mode);
+        let f = self.flip[nd] as usize;
+        (f != nd).then(|| f - self.offsets[cell] as usize)
+    }
+    /// True for geometric instances.
+    pub fn is_geometric(&self) -> bool {
+        self.geo.is_some()
+    }
+    /// Entry point of a node (geometric instances; origin otherwise).
+    #[inline]
+    pub fn entry(&self, node: usize) -> Point3 {
+        self.geo.as_ref().map(|g| g.entry[node]).unwrap_or_default()
+    }
+    /// Exit point of a node (geometric instances; origin otherwise).
+    #[inline]
+    pub fn exit(&self, node: usize) -> Point3 {
+        self.geo.as_ref().map(|g| g.exit[node]).unwrap_or_default()
+    }
+    /// Cost independent of the order (cutting time for the time objective).
+    pub fn constant(&self) -> f64 {
+        self.constant
+    }
+    /// Seconds per mm of cutting in a cell.
+    #[inline]
+    pub fn cut_rate(&self, cell: usize) -> f64 {
+        self.cut_rate[cell]
+    }
+    /// The tool-change point (geometric; origin otherwise).
+    pub fn tool_change_point(&self) -> Point3 {
+        self.geo.as_ref().map(|g| g.tool_change).unwrap_or_default()
+    }
+    /// The home point (geometric; origin otherwise).
+    pub fn home_point(&self) -> Point3 {
+        self.geo.as_ref().map(|g| g.home).unwrap_or_default()
+    }
+    /// The part of any tool-changing move out of (cell, mode) that does not depend on the
+    /// target: retract, travel to the tool-change point, change and lift time.
+    pub fn change_offset(&self, cell: usize, mode: usize) -> f64 {
+        match &self.geo {
+            None => 0.0,
+            Some(g) => {
+                let ex = g.exit[self.node(cell, mode)];
+                let air = (g.clearance - ex.z) + ex.at_z(g.clearance).dist(&g.tool_change);
+                self.scale(g, air, 1, 1, 0.0)
+            }
+        }
+    }
+    /// Seconds per mm at rapid (geometric), used by lower bounds on moves.
+    pub fn rapid_rate(&self) -> f64 {
+        self.geo.as_ref().map(|g| g.rapid_rate).unwrap_or(1.0)
+    }
+
+    /// Cost of starting the path with (cell, mode).
+    #[inline]
+    pub fn start(&self, cell: usize, mode: usize) -> f64 {
+        let b = self.node(cell, mode);
+        match &self.geo {
+            None => 0.0,
+            Some(g) => {
+                let en = g.entry[b];
+                let above = en.at_z(g.clearance);
+                let down = g.clearance - en.z;
+                let change = matches!(g.initial_tool, Some(t) if t != self.tools[cell]);
+                let air = if change {
+                    g.home.dist(&g.tool_change) + g.tool_change.dist(&above) + down
+                } else {
+                    g.home.dist(&above) + down
+                };
+                self.scale(g, air, 0, change as u32, 0.0)
+            }
+        }
+    }
+
+    /// Cost of going from (a, ma) to (b, mb).
+    #[inline]
+    pub fn arc(&self, a: usize, ma: usize, b: usize, mb: usize) -> f64 {
+        let na = self.node(a, ma);
+        let nb = self.node(b, mb);
+        match &self.geo {
+            None => match &self.matrix {
+                Some(m) => m.get(na, nb),
+                None => 0.0,
+            },
+            Some(g) => {
+                let ex = g.exit[na];
+                let en = g.entry[nb];
+                if self.tools[a] == self.tools[b] {
+                    let dxy = ex.dist_xy(&en);
+                    if (ex.z - en.z).abs() <= 1e-9 && dxy <= g.link_distance + 1e-9 {
+                        // linked at cutting feed, no lift
+                        return match self.objective {
+                            Objective::Time => dxy * self.cut_rate[b],
+                            _ => dxy,
+                        };
+                    }
+                    let air = (g.clearance - ex.z) + dxy + (g.clearance - en.z);
+                    self.scale(g, air, 1, 0, 0.0)
+                } else {
+                    let air = (g.clearance - ex.z)
+                        + ex.at_z(g.clearance).dist(&g.tool_change)
+                        + g.tool_change.dist(&en.at_z(g.clearance))
+                        + (g.clearance - en.z);
+                    self.scale(g, air, 1, 1, 0.0)
+                }
+            }
+        }
+    }
+
+    /// Cost of ending the path with (cell, mode).
+    #[inline]
+    pub fn finish(&self, cell: usize, mode: usize) -> f64 {
+        match &self.geo {
+            Some(g) if g.return_home => {
+                let ex = g.exit[self.node(cell, mode)];
+                let air = (g.clearance - ex.z) + ex.at_z(g.clearance).dist(&g.home);
+                self.scale(g, air, 0, 0, 0.0)
+            }
+            _ => 0.0,
+        }
+    }
+
+    #[inline]
+    fn scale(&self, g: &Geo, air: f64, lifts: u32, changes: u32, extra: f64) -> f64 {
+        match self.objective {
+            Objective::Time => {
+                air * g.rapid_rate
+                    + lifts as f64 * g.lift_time
+                    + changes as f64 * g.change_time
+                    + extra
+            }
+            _ => air,
+        }
+    }
+
+    /// Full cost of a sequence (solver-side evaluation; no feasibility check).
+    pub fn evaluate(&self, seq: &Sequence) -> f64 {
+        let Some(first) = seq.first() else {
+            return self.constant;
+        };
+        let mut total = self.constant + self.start(first.cell, first.mode);
+        for w in seq.windows(2) {
+            total += self.arc(w[0].cell, w[0].mode, w[1].cell, w[1].mode);
+        }
+        let last = seq[seq.len() - 1];
+        total + self.finish(last.cell, last.mode)
+    }
+
+    /// The cheapest arc cost from (a, ma) into any mode of b, and that mode.
+    #[inline]
+    pub fn best_arc_into(&self, a: usize, ma: usize, b: usize) -> (f64, usize) {
+        let mut best = (f64::INFINITY, 0);
+        for mb in 0..self.modes(b) {
+            let c = self.arc(a, ma, b, mb);
+            if c < best.0 {
+                best = (c, mb);
+            }
+        }
+        best
+    }
+}

@@ -1,0 +1,395 @@
+//! Readers for TSPLIB-style text: TSPLIB SOP (`TYPE: SOP`) and PCGLNS/PCGTSP (`TYPE: PCGLNS`).
+
+use crate::error::{Error, Result};
+use crate::model::{Cell, CostMatrix, Instance, Machine, Metadata, Mode};
+use std::collections::BTreeSet;
+
+/// Cost stored for arcs that precedence forbids (the files mark them −1).
+pub const FORBIDDEN_ARC: f64 = 1.0e9;
+
+/// A whitespace token with its 1-based line number.
+struct Tokens<'a> {
+    file: &'a str,
+    toks: Vec<(usize, &'a str)>,
+    pos: usize,
+    last_line: usize,
+}
+
+impl<'a> Tokens<'a> {
+    fn new(file: &'a str, lines: &[(usize, &'a str)]) -> Self {
+        let toks = lines
+            .iter()
+            .flat_map(|&(ln, l)| l.split_whitespace().map(move |t| (ln, t)))
+            .collect();
+        let last_line = lines.last().map(|l| l.0).unwrap_or(1);
+        Tokens {
+            file,
+            toks,
+            pos: 0,
+            last_line,
+        }
+    }
+    fn peek(&self) -> Option<(usize, &'a str)> {
+        self.toks.get(self.pos).copied()
+    }
+    fn next_num(&mut self, what: &str) -> Result<(usize, f64)> {
+        let Some((ln, t)) = self.peek() else {
+            return Err(Error::parse(
+                self.file,
+                self.last_line,
+                format!("file ends early: expected {what}"),
+            ));
+        };
+        self.pos += 1;
+        match t.parse::<f64>() {
+            Ok(v) if v.is_finite() => Ok((ln, v)),
+            _ => Err(Error::parse(
+                self.file,
+                ln,
+                format!("expected a number for {what}, found '{t}'"),
+            )),
+        }
+    }
+    fn next_int(&mut self, what: &str) -> Result<(usize, i64)> {
+        let (ln, v) = self.next_num(what)?;
+        if v.fract() != 0.0 {
+            return Err(Error::parse(
+                self.file,
+                ln,
+                format!("expected an integer for {what}, found {v}"),
+            ));
+        }
+        Ok((ln, v as i64))
+    }
+}
+
+struct Header<'a> {
+    pairs: Vec<(usize, String, &'a str)>,
+}
+
+impl Header<'_> {
+    fn get(&self, key: &str) -> Option<(usize, &str)> {
+        self.pairs
+            .iter()
+            .find(|(_, k, _)| k == key)
+            .map(|(l, _, v)| (*l, *v))
+    }
+}
+
+/// Splits a TSPLIB text into header `KEY: VALUE` pairs and named sections of lines.
+fn split_sections<'a>(
+    file: &str,
+    text: &'a str,
+    section_names: &[&str],
+) -> Result<(Header<'a>, Vec<(String, Vec<(usize, &'a str)>)>)> {
+    let mut header = Header { pairs: Vec::new() };
+    let mut sections: Vec<(String, Vec<(usize, &'a str)>)> = Vec::new();
+    for (i, raw) in text.lines().enumerate() {
+        let ln = i + 1;
+        let line = raw.trim();
+        if line.is_empty() {
+            continue;
+        }
+        if line == "EOF" {
+            break;
+        }
+        let key = line.split([':', ' ', '\t']).next().unwrap_or("");
+        if section_names.contains(&key) {
+            sections.push((key.to_string(), Vec::new()));
+            continue;
+        }
+        if let Some((_, lines)) = sections.last_mut() {
+            lines.push((ln, line));
+        } else if let Some((k, v)) = line.split_once(':') {
+            header.pairs.push((ln, k.trim().to_ascii_uppercase(), v.trim()));
+        } else {
+            return Err(Error::parse(
+                file,
+                ln,
+                format!("expected 'KEY: VALUE' or a section name, found '{line}'"),
+            ));
+        }
+    }
+    Ok((header, sections))
+}
+
+fn header_usize(file: &str, h: &Header, key: &str) -> Result<usize> {
+    let (ln, v) = h.get(key).ok_or_else(|| {
+        Error::parse(file, 1, format!("missing header field {key}"))
+    })?;
+    v.parse::<usize>()
+        .ok()
+        .filter(|&d| d > 0)
+        .ok_or_else(|| Error::parse(file, ln, format!("{key} must be a positive integer, found '{v}'")))
+}
+
+fn check_explicit(file: &str, h: &Header) -> Result<()> {
+    if let Some((ln, v)) = h.get("EDGE_WEIGHT_TYPE") {
+        if v != "EXPLICIT" {
+            return Err(Error::parse(file, ln, format!("EDGE_WEIGHT_TYPE {v} is not supported (EXPLICIT only)")));
+        }
+    }
+    if let Some((ln, v)) = h.get("EDGE_WEIGHT_FORMAT") {
+        if v != "FULL_MATRIX" {
+            return Err(Error::parse(file, ln, format!("EDGE_WEIGHT_FORMAT {v} is not supported (FULL_MATRIX only)")));
+        }
+    }
+    Ok(())
+}
+
+fn instance_name(h: &Header, file: &str) -> String {
+    let stem = std::path::Path::new(file)
+        .file_name()
+        .and_then(|s| s.to_str())
+        .unwrap_or(file);
+    let stem = stem
+        .strip_suffix(".sop")
+        .or_else(|| stem.strip_suffix(".pcglns"))
+        .unwrap_or(stem);
+    if stem.is_empty() {
+        h.get("NAME").map(|(_, v)| v.to_string()).unwrap_or_default()
+    } else {
+        stem.to_string()
+    }
+}
+
+/// Parses a TSPLIB SOP file. Node i (1-based) becomes cell `"i"` with one mode.
+pub fn parse_sop(file: &str, text: &str) -> Result<Instance> {
+    let (h, sections) = split_sections(file, text, &["EDGE_WEIGHT_SECTION"])?;
+    if let Some((ln, t)) = h.get("TYPE") {
+        if t != "SOP" {
+            return Err(Error::parse(file, ln, format!("TYPE is '{t}', expected SOP")));
+        }
+    }
+    check_explicit(file, &h)?;
+    let dim = header_usize(file, &h, "DIMENSION")?;
+    let Some((_, lines)) = sections.into_iter().find(|(k, _)| k == "EDGE_WEIGHT_SECTION") else {
+        return Err(Error::parse(file, text.lines().count().max(1), "missing EDGE_WEIGHT_SECTION"));
+    };
+    let mut tok = Tokens::new(file, &lines);
+    let (ln, d2) = tok.next_int("the dimension after EDGE_WEIGHT_SECTION")?;
+    if d2 != dim as i64 {
+        return Err(Error::parse(
+            file,
+            ln,
+            format!("dimension after EDGE_WEIGHT_SECTION is {d2}, header says DIMENSION {dim}"),
+        ));
+    }
+    let mut costs = vec![0.0; dim * dim];
+    let mut edges = Vec::new();
+    for i in 0..dim {
+        for j in 0..dim {
+            let (ln, v) = tok.next_num(&format!("matrix entry ({}, {})", i + 1, j + 1))?;
+            if v == -1.0 {
+                if i == j {
+                    return Err(Error::parse(file, ln, format!("node {} must precede itself", i + 1)));
+                }
+                edges.push((j, i));
+                costs[i * dim + j] = FORBIDDEN_ARC;
+            } else if v < 0.0 {
+                return Err(Error::parse(file, ln, format!("negative cost {v} (only -1 marks precedence)")));
+            } else {
+                costs[i * dim + j] = v;
+            }
+        }
+    }
+    if let Some((ln, t)) = tok.peek() {
+        return Err(Error::parse(
+            file,
+            ln,
+            format!("unexpected token '{t}' after the {dim}x{dim} matrix (wrong DIMENSION?)"),
+        ));
+    }
+    let cells = (0..dim)
+        .map(|i| Cell::new((i + 1).to_string(), "", vec![Mode::default()]))
+        .collect();
+    Ok(Instance {
+        name: instance_name(&h, file),
+        meta: Metadata {
+            generator: Some("tsplib-sop".into()),
+            comment: h.get("COMMENT").map(|(_, v)| v.to_string()),
+            ..Default::default()
+        },
+        machine: Machine::default(),
+        tools: Vec::new(),
+        cells,
+        precedence: edges,
+        as_given: None,
+        matrix: Some(CostMatrix { size: dim, costs }),
+        first: Some(0),
+        last: Some(dim - 1),
+    })
+}
+
+/// Parses a PCGLNS (PCGTSP) file. Group g becomes cell `"g"` whose modes are the group's
+/// nodes in file order.
+pub fn parse_pcglns(file: &str, text: &str) -> Result<Instance> {
+    let (h, sections) = split_sections(
+        file,
+        text,
+        &[
+            "EDGE_WEIGHT_SECTION",
+            "GTSP_SET_SECTION",
+            "GTSP_SET_ORDERING",
+            "START_GROUP_SECTION",
+        ],
+    )?;
+    if let Some((ln, t)) = h.get("TYPE") {
+        if t != "PCGLNS" && t != "PCGTSP" {
+            return Err(Error::parse(file, ln, format!("TYPE is '{t}', expected PCGLNS")));
+        }
+    }
+    check_explicit(file, &h)?;
+    let dim = header_usize(file, &h, "DIMENSION")?;
+    let ngroups = header_usize(file, &h, "GTSP_SETS")?;
+    let section = |name: &str| -> Result<Vec<(usize, &str)>> {
+        sections
+            .iter()
+            .find(|(k, _)| k == name)
+            .map(|(_, l)| l.clone())
+            .ok_or_else(|| Error::parse(file, text.lines().count().max(1), format!("missing {name}")))
+    };
+    // groups
+    let mut group_of = vec![usize::MAX; dim];
+    let mut groups: Vec<Vec<usize>> = vec![Vec::new(); ngroups];
+    let mut seen_group = vec![false; ngroups];
+    for (ln, line) in section("GTSP_SET_SECTION")? {
+        let nums = parse_list(file, ln, line)?;
+        let g = group_number(file, ln, nums[0], ngroups)?;
+        if seen_group[g] {
+            return Err(Error::parse(file, ln, format!("group {} listed twice", g + 1)));
+        }
+        seen_group[g] = true;
+        for &v in &nums[1..] {
+            if v < 1 || v as usize > dim {
+                return Err(Error::parse(file, ln, format!("node {v} out of range 1..{dim}")));
+            }
+            let v = v as usize - 1;
+            if group_of[v] != usize::MAX {
+                return Err(Error::parse(file, ln, format!("node {} is in two groups", v + 1)));
+            }
+            group_of[v] = g;
+            groups[g].push(v);
+        }
+    }
+    if let Some(g) = groups.iter().position(|g| g.is_empty()) {
+        return Err(Error::invalid(file, format!("group {} has no nodes", g + 1)));
+    }
+    if let Some(v) = group_of.iter().position(|&g| g == usize::MAX) {
+        return Err(Error::invalid(file, format!("node {} belongs to no group", v + 1)));
+    }
+    // our node numbering: group by group, file order within
+    let mut new_index = vec![0usize; dim];
+    let mut k = 0;
+    for g in &groups {
+        for &v in g {
+            new_index[v] = k;
+            k += 1;
+        }
+    }
+    let lines = section("EDGE_WEIGHT_SECTION")?;
+    let mut tok = Tokens::new(file, &lines);
+    let mut costs = vec![0.0; dim * dim];
+    let mut edges: BTreeSet<(usize, usize)> = BTreeSet::new();
+    for i in 0..dim {
+        for j in 0..dim {
+            let (ln, v) = tok.next_num(&format!("matrix entry ({}, {})", i + 1, j + 1))?;
+            let (gi, gj) = (group_of[i], group_of[j]);
+            let slot = new_index[i] * dim + new_index[j];
+            if v == -1.0 {
+                if gi == gj {
+                    return Err(Error::parse(file, ln, format!("group {} must precede itself", gi + 1)));
+                }
+                edges.insert((gj, gi));
+                costs[slot] = FORBIDDEN_ARC;
+            } else if v < 0.0 {
+                return Err(Error::parse(file, ln, format!("negative cost {v} (only -1 marks precedence)")));
+            } else {
+                costs[slot] = v;
+            }
+        }
+    }
+    if let Some((ln, t)) = tok.peek() {
+        return Err(Error::parse(
+            file,
+            ln,
+            format!("unexpected token '{t}' after the {dim}x{dim} matrix (wrong DIMENSION?)"),
+        ));
+    }
+    if let Ok(order) = section("GTSP_SET_ORDERING") {
+        for (ln, line) in order {
+            let nums = parse_list(file, ln, line)?;
+            let g = group_number(file, ln, nums[0], ngroups)?;
+            for &x in &nums[1..] {
+                let hgrp = group_number(file, ln, x, ngroups)?;
+                if hgrp == g {
+                    return Err(Error::parse(file, ln, format!("group {} must precede itself", g + 1)));
+                }
+                edges.insert((g, hgrp));
+            }
+        }
+    }
+    let start_lines = section("START_GROUP_SECTION")?;
+    let mut tok = Tokens::new(file, &start_lines);
+    let (ln, s) = tok.next_int("the start group")?;
+    let start = group_number(file, ln, s, ngroups)?;
+    for g in 0..ngroups {
+        if g != start {
+            edges.insert((start, g));
+        }
+    }
+    let cells = groups
+        .iter()
+        .enumerate()
+        .map(|(g, nodes)| Cell::new((g + 1).to_string(), "", vec![Mode::default(); nodes.len()]))
+        .collect();
+    Ok(Instance {
+        name: instance_name(&h, file),
+        meta: Metadata {
+            generator: Some("pcglns".into()),
+            comment: h.get("COMMENT").map(|(_, v)| v.to_string()),
+            ..Default::default()
+        },
+        machine: Machine::default(),
+        tools: Vec::new(),
+        cells,
+        precedence: edges.into_iter().collect(),
+        as_given: None,
+        matrix: Some(CostMatrix { size: dim, costs }),
+        first: Some(start),
+        last: None,
+    })
+}
+
+/// Parses "a b c ... -1" into the numbers before the terminating -1.
+fn parse_list(file: &str, ln: usize, line: &str) -> Result<Vec<i64>> {
+    let mut out = Vec::new();
+    let mut ended = false;
+    for t in line.split_whitespace() {
+        if ended {
+            return Err(Error::parse(file, ln, format!("token '{t}' after the terminating -1")));
+        }
+        let v: i64 = t
+            .parse()
+            .map_err(|_| Error::parse(file, ln, format!("expected an integer, found '{t}'")))?;
+        if v == -1 {
+            ended = true;
+        } else {
+            out.push(v);
+        }
+    }
+    if !ended {
+        return Err(Error::parse(file, ln, "list is not terminated by -1"));
+    }
+    if out.is_empty() {
+        return Err(Error::parse(file, ln, "empty list"));
+    }
+    Ok(out)
+}
+
+fn group_number(file: &str, ln: usize, g: i64, ngroups: usize) -> Result<usize> {
+    if g < 1 || g as usize > ngroups {
+        return Err(Error::parse(file, ln, format!("group {g} out of range 1..{ngroups}")));
+    }
+    Ok(g as usize - 1)
+}

@@ -1,0 +1,51 @@
+//! Small 3-D point type used by every geometric part of the model.
+
+use serde::{Deserialize, Serialize};
+
+/// A point in machine coordinates (mm). Serialized as `[x, y, z]`.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+#[serde(from = "[f64; 3]", into = "[f64; 3]")]
+pub struct Point3 {
+    /// X coordinate.
+    pub x: f64,
+    /// Y coordinate.
+    pub y: f64,
+    /// Z coordinate (depth is negative below the part's top surface by convention).
+    pub z: f64,
+}
+
+impl Point3 {
+    /// Builds a point.
+    pub const fn new(x: f64, y: f64, z: f64) -> Self {
+        Self { x, y, z }
+    }
+    /// True when every coordinate is finite (no NaN, no infinity).
+    pub fn is_finite(&self) -> bool {
+        self.x.is_finite() && self.y.is_finite() && self.z.is_finite()
+    }
+    /// Planar (XY) distance.
+    pub fn dist_xy(&self, o: &Point3) -> f64 {
+        (self.x - o.x).hypot(self.y - o.y)
+    }
+    /// Euclidean 3-D distance.
+    pub fn dist(&self, o: &Point3) -> f64 {
+        let (dx, dy, dz) = (self.x - o.x, self.y - o.y, self.z - o.z);
+        (dx * dx + dy * dy + dz * dz).sqrt()
+    }
+    /// The same XY position at height `z`.
+    pub fn at_z(&self, z: f64) -> Point3 {
+        Point3::new(self.x, self.y, z)
+    }
+}
+
+impl From<[f64; 3]> for Point3 {
+    fn from(a: [f64; 3]) -> Self {
+        Point3::new(a[0], a[1], a[2])
+    }
+}
+
+impl From<Point3> for [f64; 3] {
+    fn from(p: Point3) -> Self {
+        [p.x, p.y, p.z]
+    }
+}

@@ -1,0 +1,122 @@
+//! Named, typed, documented parameters (`--param KEY=VALUE`) shared by solvers and generators.
+
+use crate::error::{Error, Result};
+use std::collections::BTreeMap;
+
+/// The type of a parameter.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum ParamKind {
+    /// A non-negative integer.
+    Int,
+    /// A finite number.
+    Float,
+    /// `true` or `false`.
+    Bool,
+    /// One of the listed words.
+    Choice(&'static [&'static str]),
+}
+
+/// One documented solver parameter.
+#[derive(Debug, Clone, Copy)]
+pub struct ParamSpec {
+    /// Name used in `--param NAME=VALUE`.
+    pub name: &'static str,
+    /// Default value, as text.
+    pub default: &'static str,
+    /// Type.
+    pub kind: ParamKind,
+    /// One-line description.
+    pub help: &'static str,
+}
+
+/// Validated parameter values (defaults filled in).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Params {
+    values: BTreeMap<String, String>,
+}
+
+impl Params {
+    /// Validates `given` against `specs`: unknown names and malformed values are errors.
+    pub fn new(owner: &str, specs: &[ParamSpec], given: &BTreeMap<String, String>) -> Result<Params> {
+        let mut values = BTreeMap::new();
+        for (k, v) in given {
+            let Some(spec) = specs.iter().find(|s| s.name == k) else {
+                let known: Vec<&str> = specs.iter().map(|s| s.name).collect();
+                return Err(Error::Param(format!(
+                    "'{owner}' has no parameter '{k}' (known: {})",
+                    if known.is_empty() { "none".to_string() } else { known.join(", ") }
+                )));
+            };
+            check_value(owner, spec, v)?;
+            values.insert(k.clone(), v.clone());
+        }
+        for s in specs {
+            values.entry(s.name.to_string()).or_insert_with(|| s.default.to_string());
+        }
+        Ok(Params { values })
+    }
+    /// All values, defaults included.
+    pub fn values(&self) -> &BTreeMap<String, String> {
+        &self.values
+    }
+    fn raw(&self, name: &str) -> &str {
+        self.values.get(name).map(|s| s.as_str()).unwrap_or_else(|| {
+            panic!("parameter '{name}' is not declared by this solver")
+        })
+    }
+    /// An integer parameter.
+    pub fn int(&self, name: &str) -> u64 {
+        self.raw(name).parse().unwrap_or(0)
+    }
+    /// A numeric parameter.
+    pub fn float(&self, name: &str) -> f64 {
+        self.raw(name).parse().unwrap_or(0.0)
+    }
+    /// A boolean parameter.
+    pub fn bool(&self, name: &str) -> bool {
+        self.raw(name) == "true"
+    }
+    /// A word parameter.
+    pub fn word(&self, name: &str) -> &str {
+        self.raw(name)
+    }
+}
+
+fn check_value(owner: &str, spec: &ParamSpec, v: &str) -> Result<()> {
+    let ok = match spec.kind {
+        ParamKind::Int => v.parse::<u64>().is_ok(),
+        ParamKind::Float => v.parse::<f64>().is_ok_and(|x| x.is_finite()),
+        ParamKind::Bool => v == "true" || v == "false",
+        ParamKind::Choice(c) => c.contains(&v),
+    };
+    if ok {
+        Ok(())
+    } else {
+        let want = match spec.kind {
+            ParamKind::Int => "a non-negative integer".to_string(),
+            ParamKind::Float => "a finite number".to_string(),
+            ParamKind::Bool => "true or false".to_string(),
+            ParamKind::Choice(c) => format!("one of {}", c.join(", ")),
+        };
+        Err(Error::Param(format!(
+            "'{owner}': parameter '{}' must be {want}, got '{v}'",
+            spec.name
+        )))
+    }
+}
+
+/// Parses `KEY=VALUE` strings into a map.
+pub fn parse_kv(pairs: &[String]) -> Result<BTreeMap<String, String>> {
+    let mut m = BTreeMap::new();
+    for p in pairs {
+        let Some((k, v)) = p.split_once('=') else {
+            return Err(Error::Param(format!("malformed parameter '{p}': expected KEY=VALUE")));
+        };
+        if k.trim().is_empty() {
+            return Err(Error::Param(format!("malformed parameter '{p}': empty key")));
+        }
+        m.insert(k.trim().to_string(), v.trim().to_string());
+    }
+    Ok(m)
+}
+

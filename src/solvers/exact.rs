@@ -1,0 +1,193 @@
+//! `exact`: dynamic programming over precedence-closed subsets (Held–Karp over order ideals)
+//! with the mode in the state.
+//!
+//! A state is (ideal S, last node u) with the cheapest cost of a path that visits exactly the
+//! cells of S and ends in u. Only order ideals (predecessor-closed sets) are reachable, so dense
+//! precedence shrinks the state space from 2ⁿ to far less. Levels are processed by |S|; the
+//! memory in use is tracked and the solver refuses once it would pass `memory_mb`.
+
+use super::{Context, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo};
+use crate::error::{Error, Result};
+use crate::model::Visit;
+use rustc_hash::FxHashMap;
+
+/// Registry entry.
+pub static INFO: SolverInfo = SolverInfo {
+    name: "exact",
+    summary: "Held-Karp DP over precedence-closed subsets with modes; proves optimality",
+    params: &[
+        ParamSpec {
+            name: "memory_mb",
+            default: "4096",
+            kind: ParamKind::Int,
+            help: "refuse when the DP tables would need more than this many MiB",
+        },
+        ParamSpec {
+            name: "max_cells",
+            default: "128",
+            kind: ParamKind::Int,
+            help: "refuse instances with more cells (the subset bitset holds at most 128)",
+        },
+    ],
+    make: |p: &Params| {
+        Box::new(Exact {
+            memory_mb: p.int("memory_mb"),
+            max_cells: p.int("max_cells").min(128) as usize,
+        })
+    },
+};
+
+/// The exact DP solver.
+pub struct Exact {
+    /// Memory limit (MiB).
+    pub memory_mb: u64,
+    /// Largest instance accepted.
+    pub max_cells: usize,
+}
+
+type Level = FxHashMap<u128, Vec<(u32, f64)>>;
+
+const BYTES_PER_IDEAL: u64 = 80;
+const BYTES_PER_ENTRY: u64 = 16;
+
+impl Solver for Exact {
+    fn solve(&self, ctx: &mut Context) -> Result<Outcome> {
+        let m = ctx.model;
+        let n = m.n();
+        let err = |msg: String| Error::Solver {
+            solver: "exact".into(),
+            msg,
+        };
+        if n > self.max_cells {
+            return Err(err(format!(
+                "instance has {n} cells; the exact DP accepts at most {} (use another solver)",
+                self.max_cells
+            )));
+        }
+        let pred_mask: Vec<u128> = (0..n)
+            .map(|c| m.dag.preds[c].iter().fold(0u128, |a, &p| a | 1u128 << p))
+            .collect();
+        let limit = self.memory_mb.saturating_mul(1 << 20);
+        let mut used: u64 = 0;
+        let mut levels: Vec<Level> = Vec::with_capacity(n);
+        let mut first = Level::default();
+        for v in 0..n {
+            if pred_mask[v] == 0 {
+                let e: Vec<(u32, f64)> = (0..m.modes(v))
+                    .map(|md| (m.node(v, md) as u32, m.start(v, md)))
+                    .collect();
+                used += BYTES_PER_IDEAL + BYTES_PER_ENTRY * e.len() as u64;
+                first.insert(1u128 << v, e);
+            }
+        }
+        ctx.count(first.len() as u64);
+        levels.push(first);
+        for k in 1..n {
+            let prev = &levels[k - 1];
+            let mut next = Level::default();
+            let mut evals = 0u64;
+            // deterministic iteration: sort the ideals of the previous level
+            let mut keys: Vec<&u128> = prev.keys().collect();
+            keys.sort_unstable();
+            for &s in keys {
+                let entries = &prev[&s];
+                for v in 0..n {
+                    if s >> v & 1 == 1 || pred_mask[v] & !s != 0 {
+                        continue;
+                    }
+                    let t = s | 1u128 << v;
+                    let slot = next.entry(t).or_insert_with(|| {
+                        used += BYTES_PER_IDEAL;
+                        Vec::new()
+                    });
+                    for mv in 0..m.modes(v) {
+                        let nv = m.node(v, mv) as u32;
+                        let mut best = f64::INFINITY;
+                        for &(u, cu) in entries {
+                            let (cu_cell, cu_mode) = m.cell_mode(u as usize);
+                            let c = cu + m.arc(cu_cell, cu_mode, v, mv);
+                            if c < best {
+                                best = c;
+                            }
+                        }
+                        evals += entries.len() as u64;
+                        match slot.iter_mut().find(|(x, _)| *x == nv) {
+                            Some(e) => {
+                                if best < e.1 {
+                                    e.1 = best;
+                                }
+                            }
+                            None => {
+                                used += BYTES_PER_ENTRY;
+                                slot.push((nv, best));
+                            }
+                        }
+                    }
+                }
+                if used > limit {
+                    return Err(err(format!(
+                        "memory estimate passed the limit of {} MiB at subset size {} of {n} \
+                         ({} subsets so far); raise memory_mb or use another solver",
+                        self.memory_mb,
+                        k + 1,
+                        next.len()
+                    )));
+                }
+            }
+            ctx.count(evals);
+            if ctx.exhausted() {
+                return Err(err(format!(
+                    "budget exhausted at subset size {} of {n} before optimality was proven",
+                    k + 1
+                )));
+            }
+            levels.push(next);
+        }
+        // close the path
+        let full = &levels[n - 1];
+        let (&all, entries) = full.iter().next().ok_or_else(|| err("no feasible order".into()))?;
+        let mut best = (f64::INFINITY, u32::MAX);
+        for &(u, cu) in entries {
+            let (c, md) = m.cell_mode(u as usize);
+            let total = cu + m.finish(c, md);
+            if total < best.0 || (total == best.0 && u < best.1) {
+                best = (total, u);
+            }
+        }
+        // walk back
+        let mut seq = Vec::with_capacity(n);
+        let mut s = all;
+        let mut u = best.1;
+        let mut cu = entries.iter().find(|e| e.0 == u).map(|e| e.1).unwrap_or(0.0);
+        for k in (0..n).rev() {
+            let (c, md) = m.cell_mode(u as usize);
+            seq.push(Visit::new(c, md));
+            if k == 0 {
+                break;
+            }
+            s &= !(1u128 << c);
+            let prev = &levels[k - 1][&s];
+            let tol = 1e-7 * cu.abs().max(1.0);
+            let mut found = None;
+            for &(p, cp) in prev {
+                let (pc, pm) = m.cell_mode(p as usize);
+                if (cp + m.arc(pc, pm, c, md) - cu).abs() <= tol {
+                    found = Some((p, cp));
+                    break;
+                }
+            }
+            let (p, cp) = found.ok_or_else(|| err("internal error: broken DP back-pointer".into()))?;
+            u = p;
+            cu = cp;
+        }
+        seq.reverse();
+        let cost = m.evaluate(&seq);
+        ctx.report(cost);
+        Ok(Outcome {
+            sequence: seq,
+            cost,
+            proven_optimal: true,
+            lower_bound: Some(cost),
+        })
+    }
+}
