@@ -118,21 +118,21 @@ pub fn check(inst: &Instance, seq: &Sequence, objective: Objective) -> Result<Re
             cell: inst.cells[i].id.clone(),
         });
     }
-    if let Some(f) = inst.first {
-        if position[f] != 0 {
-            return Err(Violation::Fixed {
-                cell: inst.cells[f].id.clone(),
-                which: "first",
-            });
-        }
+    if let Some(f) = inst.first
+        && position[f] != 0
+    {
+        return Err(Violation::Fixed {
+            cell: inst.cells[f].id.clone(),
+            which: "first",
+        });
     }
-    if let Some(l) = inst.last {
-        if position[l] != n - 1 {
-            return Err(Violation::Fixed {
-                cell: inst.cells[l].id.clone(),
-                which: "last",
-            });
-        }
+    if let Some(l) = inst.last
+        && position[l] != n - 1
+    {
+        return Err(Violation::Fixed {
+            cell: inst.cells[l].id.clone(),
+            which: "last",
+        });
     }
     // first broken pair in sequence order: the earliest cell placed before one of its predecessors
     let mut broken: Option<(usize, usize)> = None;
@@ -162,6 +162,11 @@ pub fn check(inst: &Instance, seq: &Sequence, objective: Objective) -> Result<Re
             let mut total = 0.0;
             for w in seq.windows(2) {
                 total += m.costs[node(w[0].cell, w[0].mode) * m.size + node(w[1].cell, w[1].mode)];
+            }
+            if inst.closed {
+                if let (Some(a), Some(b)) = (seq.last(), seq.first()) {
+                    total += m.costs[node(a.cell, a.mode) * m.size + node(b.cell, b.mode)];
+                }
             }
             Report {
                 cost: total,
@@ -230,7 +235,8 @@ fn geometric_report(inst: &Instance, seq: &Sequence, objective: Objective) -> Re
                         + dist3(tc, above_entry)
                         + (h - entry[2]);
                 } else {
-                    let planar = ((pexit[0] - entry[0]).powi(2) + (pexit[1] - entry[1]).powi(2)).sqrt();
+                    let planar =
+                        ((pexit[0] - entry[0]).powi(2) + (pexit[1] - entry[1]).powi(2)).sqrt();
                     let same_depth = (pexit[2] - entry[2]).abs() <= 1e-9;
                     if same_depth && planar <= m.link_distance + 1e-9 {
                         r.air_length += planar;
@@ -246,10 +252,10 @@ fn geometric_report(inst: &Instance, seq: &Sequence, objective: Objective) -> Re
         cut_time += cell.cut_length * 60.0 / feed;
         prev = Some((exit, cell.tool.as_str()));
     }
-    if m.return_home {
-        if let Some((pexit, _)) = prev {
-            rapid += (h - pexit[2]) + dist3([pexit[0], pexit[1], h], home);
-        }
+    if m.return_home
+        && let Some((pexit, _)) = prev
+    {
+        rapid += (h - pexit[2]) + dist3([pexit[0], pexit[1], h], home);
     }
     r.air_length += rapid;
     r.path_length = r.cut_length + r.air_length;

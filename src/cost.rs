@@ -24,6 +24,8 @@ struct Geo {
     home: Point3,
     return_home: bool,
     initial_tool: Option<u32>,
+    /// highest entry point of any node
+    max_entry_z: f64,
 }
 
 /// Arc costs, mode layout, tools and precedence of an instance, ready for search.
@@ -43,6 +45,8 @@ pub struct CostModel {
     reversible: Vec<bool>,
     constant: f64,
     matrix: Option<CostMatrix>,
+    /// closed matrix tours return to this node
+    return_node: Option<usize>,
     geo: Option<Geo>,
     /// precedence (transitive reduction where affordable)
     pub dag: Dag,
@@ -98,10 +102,10 @@ impl CostModel {
                 for (k, md) in c.modes.iter().enumerate() {
                     entry.push(md.entry);
                     exit.push(md.exit);
-                    if c.reversible {
-                        if let Some(j) = c.modes.iter().position(|o| *o == md.reversed()) {
-                            flip[offsets[i] as usize + k] = offsets[i] + j as u32;
-                        }
+                    if c.reversible
+                        && let Some(j) = c.modes.iter().position(|o| *o == md.reversed())
+                    {
+                        flip[offsets[i] as usize + k] = offsets[i] + j as u32;
                     }
                 }
             }
@@ -114,7 +118,9 @@ impl CostModel {
             } else {
                 0.0
             };
+            let max_entry_z = entry.iter().map(|p| p.z).fold(f64::NEG_INFINITY, f64::max);
             let geo = Geo {
+                max_entry_z,
                 entry,
                 exit,
                 clearance: m.clearance,
@@ -125,10 +131,12 @@ impl CostModel {
                 tool_change: m.tool_change,
                 home: m.home,
                 return_home: m.return_home,
-                initial_tool: m
-                    .initial_tool
-                    .as_ref()
-                    .map(|t| tool_ids.iter().position(|x| x == t).unwrap_or(u32::MAX as usize) as u32),
+                initial_tool: m.initial_tool.as_ref().map(|t| {
+                    tool_ids
+                        .iter()
+                        .position(|x| x == t)
+                        .unwrap_or(u32::MAX as usize) as u32
+                }),
             };
             (None, Some(geo), constant)
         };
@@ -140,8 +148,14 @@ impl CostModel {
             edges.extend((0..n).filter(|&c| c != l).map(|c| (c, l)));
         }
         let dag = Dag::new(n, &edges).reduced(20_000);
+        let return_node = if inst.closed && inst.is_matrix() {
+            inst.first.map(|f| offsets[f] as usize)
+        } else {
+            None
+        };
         CostModel {
             objective,
+            return_node,
             offsets,
             node_cell,
             tools,
@@ -233,6 +247,22 @@ impl CostModel {
     pub fn home_point(&self) -> Point3 {
         self.geo.as_ref().map(|g| g.home).unwrap_or_default()
     }
+    /// Planar distance within which same-depth, same-tool moves are linked without a lift.
+    pub fn link_distance(&self) -> f64 {
+        self.geo.as_ref().map(|g| g.link_distance).unwrap_or(0.0)
+    }
+    /// A lower bound on the part of any lifting same-tool move out of (cell, mode) that does
+    /// not depend on the planar distance: retract, plunge to the highest entry, lift time.
+    pub fn lift_floor(&self, cell: usize, mode: usize) -> f64 {
+        match &self.geo {
+            None => 0.0,
+            Some(g) => {
+                let ex = g.exit[self.node(cell, mode)];
+                let air = (g.clearance - ex.z) + (g.clearance - g.max_entry_z);
+                self.scale(g, air, 1, 0, 0.0)
+            }
+        }
+    }
     /// The part of any tool-changing move out of (cell, mode) that does not depend on the
     /// target: retract, travel to the tool-change point, change and lift time.
     pub fn change_offset(&self, cell: usize, mode: usize) -> f64 {
@@ -315,7 +345,11 @@ impl CostModel {
                 let air = (g.clearance - ex.z) + ex.at_z(g.clearance).dist(&g.home);
                 self.scale(g, air, 0, 0, 0.0)
             }
-            _ => 0.0,
+            Some(_) => 0.0,
+            None => match (&self.matrix, self.return_node) {
+                (Some(m), Some(r)) => m.get(self.node(cell, mode), r),
+                _ => 0.0,
+            },
         }
     }
 

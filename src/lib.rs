@@ -5,6 +5,9 @@
 //! for search; a [`solvers::Solver`] returns a [`model::Sequence`]; [`check::check`] verifies it
 //! and recomputes the [`check::Report`] from scratch.
 
+// Index loops are the clearest form for the graph and DP code here.
+#![allow(clippy::needless_range_loop)]
+
 pub mod check;
 pub mod cost;
 pub mod error;
@@ -17,6 +20,6 @@ pub mod precedence;
 pub mod solvers;
 pub mod validate;
 
-pub use check::{check, Report, Violation};
+pub use check::{Report, Violation, check};
 pub use error::{Error, Result};
 pub use model::{Cell, Instance, Machine, Mode, Objective, Sequence, StepKind, Tool, Visit};

@@ -13,6 +13,7 @@ use std::collections::HashMap;
 /// The kind of machining step a cell belongs to.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
+#[derive(Default)]
 pub enum StepKind {
     /// Facing the top surface.
     Face,
@@ -33,13 +34,8 @@ pub enum StepKind {
     /// Engraving, marking, plotting.
     Engrave,
     /// Anything else.
+    #[default]
     Other,
-}
-
-impl Default for StepKind {
-    fn default() -> Self {
-        StepKind::Other
-    }
 }
 
 impl StepKind {
@@ -333,6 +329,9 @@ pub struct Instance {
     pub first: Option<usize>,
     /// Cell that must come last, if any.
     pub last: Option<usize>,
+    /// Matrix instances scored as a closed tour: the cost of returning from the last cell to
+    /// the (fixed, single-mode) first cell is added (PCGLNS/PCGTSP convention).
+    pub closed: bool,
 }
 
 impl Instance {

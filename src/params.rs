@@ -37,21 +37,31 @@ pub struct Params {
 
 impl Params {
     /// Validates `given` against `specs`: unknown names and malformed values are errors.
-    pub fn new(owner: &str, specs: &[ParamSpec], given: &BTreeMap<String, String>) -> Result<Params> {
+    pub fn new(
+        owner: &str,
+        specs: &[ParamSpec],
+        given: &BTreeMap<String, String>,
+    ) -> Result<Params> {
         let mut values = BTreeMap::new();
         for (k, v) in given {
             let Some(spec) = specs.iter().find(|s| s.name == k) else {
                 let known: Vec<&str> = specs.iter().map(|s| s.name).collect();
                 return Err(Error::Param(format!(
                     "'{owner}' has no parameter '{k}' (known: {})",
-                    if known.is_empty() { "none".to_string() } else { known.join(", ") }
+                    if known.is_empty() {
+                        "none".to_string()
+                    } else {
+                        known.join(", ")
+                    }
                 )));
             };
             check_value(owner, spec, v)?;
             values.insert(k.clone(), v.clone());
         }
         for s in specs {
-            values.entry(s.name.to_string()).or_insert_with(|| s.default.to_string());
+            values
+                .entry(s.name.to_string())
+                .or_insert_with(|| s.default.to_string());
         }
         Ok(Params { values })
     }
@@ -60,9 +70,10 @@ impl Params {
         &self.values
     }
     fn raw(&self, name: &str) -> &str {
-        self.values.get(name).map(|s| s.as_str()).unwrap_or_else(|| {
-            panic!("parameter '{name}' is not declared by this solver")
-        })
+        self.values
+            .get(name)
+            .map(|s| s.as_str())
+            .unwrap_or_else(|| panic!("parameter '{name}' is not declared by this solver"))
     }
     /// An integer parameter.
     pub fn int(&self, name: &str) -> u64 {
@@ -110,13 +121,16 @@ pub fn parse_kv(pairs: &[String]) -> Result<BTreeMap<String, String>> {
     let mut m = BTreeMap::new();
     for p in pairs {
         let Some((k, v)) = p.split_once('=') else {
-            return Err(Error::Param(format!("malformed parameter '{p}': expected KEY=VALUE")));
+            return Err(Error::Param(format!(
+                "malformed parameter '{p}': expected KEY=VALUE"
+            )));
         };
         if k.trim().is_empty() {
-            return Err(Error::Param(format!("malformed parameter '{p}': empty key")));
+            return Err(Error::Param(format!(
+                "malformed parameter '{p}': empty key"
+            )));
         }
         m.insert(k.trim().to_string(), v.trim().to_string());
     }
     Ok(m)
 }
-

@@ -1,7 +1,7 @@
 //! The precedence DAG: adjacency, cycle detection, closure and reduction, topological orders.
 
-use std::collections::BinaryHeap;
 use std::cmp::Reverse;
+use std::collections::BinaryHeap;
 
 /// Predecessor and successor lists of a precedence DAG over `n` cells.
 #[derive(Debug, Clone, Default)]

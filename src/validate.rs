@@ -2,7 +2,7 @@
 
 use crate::error::{Error, Result};
 use crate::model::Instance;
-use crate::precedence::{topological_order, Dag};
+use crate::precedence::{Dag, topological_order};
 use std::collections::HashMap;
 
 /// Validates `inst`; `file` names the source in error messages.
@@ -34,15 +34,18 @@ pub fn validate(inst: &Instance, file: &str) -> Result<()> {
             return bad(format!("cell '{}' has no modes", c.id));
         }
         if !c.cut_length.is_finite() || c.cut_length < 0.0 {
-            return bad(format!("cell '{}' has an invalid cut_length {}", c.id, c.cut_length));
+            return bad(format!(
+                "cell '{}' has an invalid cut_length {}",
+                c.id, c.cut_length
+            ));
         }
         if !c.z.is_finite() {
             return bad(format!("cell '{}' has a non-finite z", c.id));
         }
-        if let Some(f) = c.feed {
-            if !(f.is_finite() && f > 0.0) {
-                return bad(format!("cell '{}' has an invalid feed {f}", c.id));
-            }
+        if let Some(f) = c.feed
+            && !(f.is_finite() && f > 0.0)
+        {
+            return bad(format!("cell '{}' has an invalid feed {f}", c.id));
         }
         if !inst.is_matrix() {
             if inst.tool(&c.tool).is_none() {
@@ -67,10 +70,7 @@ pub fn validate(inst: &Instance, file: &str) -> Result<()> {
     }
     if !inst.is_matrix() {
         let m = &inst.machine;
-        for (name, v) in [
-            ("rapid_feed", m.rapid_feed),
-            ("cut_feed", m.cut_feed),
-        ] {
+        for (name, v) in [("rapid_feed", m.rapid_feed), ("cut_feed", m.cut_feed)] {
             if !(v.is_finite() && v > 0.0) {
                 return bad(format!("machine {name} must be a positive number, got {v}"));
             }
@@ -93,21 +93,29 @@ pub fn validate(inst: &Instance, file: &str) -> Result<()> {
         }
         for t in &inst.tools {
             if !(t.diameter.is_finite() && t.diameter > 0.0) {
-                return bad(format!("tool '{}' has an invalid diameter {}", t.id, t.diameter));
+                return bad(format!(
+                    "tool '{}' has an invalid diameter {}",
+                    t.id, t.diameter
+                ));
             }
-            if let Some(f) = t.feed {
-                if !(f.is_finite() && f > 0.0) {
-                    return bad(format!("tool '{}' has an invalid feed {f}", t.id));
-                }
+            if let Some(f) = t.feed
+                && !(f.is_finite() && f > 0.0)
+            {
+                return bad(format!("tool '{}' has an invalid feed {f}", t.id));
             }
         }
     }
     for &(a, b) in &inst.precedence {
         if a >= n || b >= n {
-            return bad(format!("precedence edge ({a}, {b}) refers to a cell that does not exist"));
+            return bad(format!(
+                "precedence edge ({a}, {b}) refers to a cell that does not exist"
+            ));
         }
         if a == b {
-            return bad(format!("cell '{}' is required to precede itself", inst.cells[a].id));
+            return bad(format!(
+                "cell '{}' is required to precede itself",
+                inst.cells[a].id
+            ));
         }
     }
     let dag = Dag::new(n, &inst.precedence);
@@ -120,10 +128,16 @@ pub fn validate(inst: &Instance, file: &str) -> Result<()> {
         ));
     }
     for (which, v) in [("first", inst.first), ("last", inst.last)] {
-        if let Some(c) = v {
-            if c >= n {
-                return bad(format!("fixed {which} cell index {c} does not exist"));
-            }
+        if let Some(c) = v
+            && c >= n
+        {
+            return bad(format!("fixed {which} cell index {c} does not exist"));
+        }
+    }
+    if inst.closed {
+        match inst.first {
+            Some(f) if inst.cells[f].modes.len() == 1 => {}
+            _ => return bad("a closed tour needs a fixed first cell with exactly one mode".into()),
         }
     }
     if let Some(order) = &inst.as_given {

@@ -1,10 +1,10 @@
 //! `info`, `validate`, `solve`, `eval`, `solvers`, `generate`.
 
-use anyhow::{bail, Context as _, Result};
-use cellseq::formats::json::{self, SolutionFile, SOLUTION_FORMAT};
+use anyhow::{Context as _, Result, bail};
+use cellseq::formats::json::{self, SOLUTION_FORMAT, SolutionFile};
 use cellseq::formats::{self, best_known};
 use cellseq::model::{Instance, Objective};
-use cellseq::solvers::{self, parse_kv, Budget, NoObserver, ParamKind, RunResult};
+use cellseq::solvers::{self, Budget, NoObserver, ParamKind, RunResult, parse_kv};
 use clap::Args;
 use serde_json::json;
 use std::path::{Path, PathBuf};
@@ -106,7 +106,14 @@ pub fn objective_of(inst: &Instance, name: Option<&str>) -> Result<Objective> {
 pub fn info(a: InfoArgs) -> Result<()> {
     let inst = load(&a.file)?;
     println!("instance        {}", inst.name);
-    println!("kind            {}", if inst.is_matrix() { "matrix" } else { "geometric" });
+    println!(
+        "kind            {}",
+        if inst.is_matrix() {
+            "matrix"
+        } else {
+            "geometric"
+        }
+    );
     println!("cells           {}", inst.n());
     println!("modes           {}", inst.total_modes());
     println!("tools           {}", inst.used_tools().len());
@@ -115,9 +122,15 @@ pub fn info(a: InfoArgs) -> Result<()> {
     if let Some(g) = &inst.meta.generator {
         println!("source          {g}");
     }
-    println!("as-programmed   {}", if inst.as_given.is_some() { "yes" } else { "no" });
+    println!(
+        "as-programmed   {}",
+        if inst.as_given.is_some() { "yes" } else { "no" }
+    );
     if let Some((bk, proven)) = best_known(&a.file) {
-        println!("best known      {bk}{}", if proven { " (optimal)" } else { "" });
+        println!(
+            "best known      {bk}{}",
+            if proven { " (optimal)" } else { "" }
+        );
     }
     Ok(())
 }
@@ -132,16 +145,24 @@ pub fn solve(a: SolveArgs) -> Result<()> {
     let inst = load(&a.file)?;
     let objective = objective_of(&inst, a.objective.as_deref())?;
     let params = parse_kv(&a.params)?;
-    if let Some(t) = a.time_limit {
-        if !(t.is_finite() && t > 0.0) {
-            bail!("--time-limit must be a positive number of seconds, got {t}");
-        }
+    if let Some(t) = a.time_limit
+        && !(t.is_finite() && t > 0.0)
+    {
+        bail!("--time-limit must be a positive number of seconds, got {t}");
     }
     let budget = Budget {
         time_limit: a.time_limit.map(Duration::from_secs_f64),
         max_evals: a.max_evals,
     };
-    let r = solvers::run(&a.solver, &inst, objective, &params, a.seed, budget, &mut NoObserver)?;
+    let r = solvers::run(
+        &a.solver,
+        &inst,
+        objective,
+        &params,
+        a.seed,
+        budget,
+        &mut NoObserver,
+    )?;
     let bk = best_known(&a.file).map(|b| b.0);
     if let Some(out) = &a.out {
         let sol = solution_file(&inst, &a.solver, a.seed, &r);
@@ -149,7 +170,10 @@ pub fn solve(a: SolveArgs) -> Result<()> {
             .with_context(|| format!("writing {}", out.display()))?;
     }
     if a.json {
-        println!("{}", serde_json::to_string(&result_json(&inst, &a.solver, a.seed, &r, bk))?);
+        println!(
+            "{}",
+            serde_json::to_string(&result_json(&inst, &a.solver, a.seed, &r, bk))?
+        );
     } else {
         print_report(&inst, &a.solver, &r, bk);
     }
@@ -174,7 +198,13 @@ fn gap(cost: f64, bk: Option<f64>) -> Option<f64> {
 }
 
 /// The `--json` object of a run.
-pub fn result_json(inst: &Instance, solver: &str, seed: u64, r: &RunResult, bk: Option<f64>) -> serde_json::Value {
+pub fn result_json(
+    inst: &Instance,
+    solver: &str,
+    seed: u64,
+    r: &RunResult,
+    bk: Option<f64>,
+) -> serde_json::Value {
     let rep = &r.report;
     json!({
         "instance": inst.name,
@@ -214,7 +244,11 @@ fn print_report(inst: &Instance, solver: &str, r: &RunResult, bk: Option<f64>) {
         println!("machining time  {:.3} s", rep.machining_time);
     }
     if let Some(b) = bk {
-        println!("best known      {}  (gap {:.3} %)", fmt_num(b), gap(rep.cost, Some(b)).unwrap_or(0.0));
+        println!(
+            "best known      {}  (gap {:.3} %)",
+            fmt_num(b),
+            gap(rep.cost, Some(b)).unwrap_or(0.0)
+        );
     }
     if r.outcome.proven_optimal {
         println!("proven optimal  yes");
@@ -258,7 +292,11 @@ pub fn eval(a: EvalArgs) -> Result<()> {
             println!("machining time  {:.3} s", rep.machining_time);
         }
         if let Some(b) = bk {
-            println!("best known      {}  (gap {:.3} %)", fmt_num(b), gap(rep.cost, Some(b)).unwrap_or(0.0));
+            println!(
+                "best known      {}  (gap {:.3} %)",
+                fmt_num(b),
+                gap(rep.cost, Some(b)).unwrap_or(0.0)
+            );
         }
     }
     Ok(())
@@ -266,7 +304,11 @@ pub fn eval(a: EvalArgs) -> Result<()> {
 
 pub fn solvers() -> Result<()> {
     for s in solvers::registry() {
-        let default = if s.name == solvers::DEFAULT_SOLVER { "  (default)" } else { "" };
+        let default = if s.name == solvers::DEFAULT_SOLVER {
+            "  (default)"
+        } else {
+            ""
+        };
         println!("{}{default}\n    {}", s.name, s.summary);
         for p in s.params {
             let kind = match p.kind {

@@ -42,6 +42,8 @@ struct InstanceFile {
     first: Option<String>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     last: Option<String>,
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    closed: bool,
 }
 
 /// A solution file.
@@ -67,13 +69,27 @@ pub struct SolutionFile {
     pub report: Option<Report>,
 }
 
-fn json_error(file: &str, e: serde_json::Error) -> Error {
-    Error::parse(file, e.line().max(1), e.to_string())
+fn json_error(file: &str, text: &str, e: serde_json::Error) -> Error {
+    let line = e.line().max(1);
+    let at = text
+        .lines()
+        .nth(line - 1)
+        .and_then(|l| l.get(e.column().saturating_sub(1)..))
+        .unwrap_or("");
+    let non_finite = ["NaN", "nan", "Infinity", "-Infinity", "inf", "-inf"]
+        .iter()
+        .any(|w| at.starts_with(w));
+    let msg = if non_finite {
+        format!("non-finite number (NaN or infinity) is not allowed: {e}")
+    } else {
+        e.to_string()
+    };
+    Error::parse(file, line, msg)
 }
 
 /// Parses an instance from JSON text.
 pub fn parse_instance(file: &str, text: &str) -> Result<Instance> {
-    let f: InstanceFile = serde_json::from_str(text).map_err(|e| json_error(file, e))?;
+    let f: InstanceFile = serde_json::from_str(text).map_err(|e| json_error(file, text, e))?;
     if f.format != INSTANCE_FORMAT {
         return Err(Error::invalid(
             file,
@@ -83,7 +99,10 @@ pub fn parse_instance(file: &str, text: &str) -> Result<Instance> {
     let mut index: HashMap<&str, usize> = HashMap::new();
     for (i, c) in f.cells.iter().enumerate() {
         if index.insert(c.id.as_str(), i).is_some() {
-            return Err(Error::invalid(file, format!("duplicate cell id '{}'", c.id)));
+            return Err(Error::invalid(
+                file,
+                format!("duplicate cell id '{}'", c.id),
+            ));
         }
     }
     let look = |id: &str, what: &str| -> Result<usize> {
@@ -112,7 +131,11 @@ pub fn parse_instance(file: &str, text: &str) -> Result<Instance> {
             if let Some(r) = rows.iter().position(|r| r.len() != size) {
                 return Err(Error::invalid(
                     file,
-                    format!("matrix row {} has {} entries, expected {size}", r + 1, rows[r].len()),
+                    format!(
+                        "matrix row {} has {} entries, expected {size}",
+                        r + 1,
+                        rows[r].len()
+                    ),
                 ));
             }
             Some(CostMatrix {
@@ -133,6 +156,7 @@ pub fn parse_instance(file: &str, text: &str) -> Result<Instance> {
         matrix,
         first,
         last,
+        closed: f.closed,
     })
 }
 
@@ -146,7 +170,11 @@ pub fn instance_to_json(inst: &Instance) -> String {
         machine: inst.machine.clone(),
         tools: inst.tools.clone(),
         cells: inst.cells.clone(),
-        precedence: inst.precedence.iter().map(|&(a, b)| (id(a), id(b))).collect(),
+        precedence: inst
+            .precedence
+            .iter()
+            .map(|&(a, b)| (id(a), id(b)))
+            .collect(),
         as_given: inst.as_given.as_ref().map(|s| to_refs(inst, s)),
         matrix: inst
             .matrix
@@ -154,6 +182,7 @@ pub fn instance_to_json(inst: &Instance) -> String {
             .map(|m| m.costs.chunks(m.size).map(|r| r.to_vec()).collect()),
         first: inst.first.map(id),
         last: inst.last.map(id),
+        closed: inst.closed,
     };
     let mut s = serde_json::to_string_pretty(&f).expect("instance serializes");
     s.push('\n');
@@ -178,14 +207,16 @@ pub fn from_refs(inst: &Instance, refs: &[VisitRef], file: &str) -> Result<Seque
             index
                 .get(r.cell.as_str())
                 .map(|&c| Visit::new(c, r.mode))
-                .ok_or_else(|| Error::invalid(file, format!("solution names unknown cell '{}'", r.cell)))
+                .ok_or_else(|| {
+                    Error::invalid(file, format!("solution names unknown cell '{}'", r.cell))
+                })
         })
         .collect()
 }
 
 /// Parses a solution file's text.
 pub fn parse_solution(file: &str, text: &str) -> Result<SolutionFile> {
-    let s: SolutionFile = serde_json::from_str(text).map_err(|e| json_error(file, e))?;
+    let s: SolutionFile = serde_json::from_str(text).map_err(|e| json_error(file, text, e))?;
     if s.format != SOLUTION_FORMAT {
         return Err(Error::invalid(
             file,

@@ -23,7 +23,11 @@ pub enum Format {
 
 /// Guesses the format from the file name, then from the content.
 pub fn detect(path: &Path, text: &str) -> Option<Format> {
-    match path.extension().and_then(|e| e.to_str()).map(|e| e.to_ascii_lowercase()) {
+    match path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(|e| e.to_ascii_lowercase())
+    {
         Some(e) if e == "json" => return Some(Format::Json),
         Some(e) if e == "sop" => return Some(Format::Sop),
         Some(e) if e == "pcglns" || e == "pcgtsp" => return Some(Format::Pcglns),
@@ -34,13 +38,13 @@ pub fn detect(path: &Path, text: &str) -> Option<Format> {
         return Some(Format::Json);
     }
     for line in text.lines().take(20) {
-        if let Some((k, v)) = line.split_once(':') {
-            if k.trim().eq_ignore_ascii_case("TYPE") {
-                match v.trim() {
-                    "SOP" => return Some(Format::Sop),
-                    "PCGLNS" | "PCGTSP" => return Some(Format::Pcglns),
-                    _ => {}
-                }
+        if let Some((k, v)) = line.split_once(':')
+            && k.trim().eq_ignore_ascii_case("TYPE")
+        {
+            match v.trim() {
+                "SOP" => return Some(Format::Sop),
+                "PCGLNS" | "PCGTSP" => return Some(Format::Pcglns),
+                _ => {}
             }
         }
     }
@@ -52,7 +56,10 @@ pub fn read_text(path: &Path) -> Result<String> {
     let file = path.display().to_string();
     let bytes = std::fs::read(path).map_err(|e| Error::io(&file, e))?;
     String::from_utf8(bytes).map_err(|e| {
-        Error::invalid(&file, format!("not UTF-8 text (byte {})", e.utf8_error().valid_up_to()))
+        Error::invalid(
+            &file,
+            format!("not UTF-8 text (byte {})", e.utf8_error().valid_up_to()),
+        )
     })
 }
 
@@ -73,7 +80,10 @@ pub fn load_instance(path: &Path) -> Result<Instance> {
     let file = path.display().to_string();
     let text = read_text(path)?;
     let format = detect(path, &text).ok_or_else(|| {
-        Error::invalid(&file, "unknown instance format (expected .json, .sop or .pcglns)")
+        Error::invalid(
+            &file,
+            "unknown instance format (expected .json, .sop or .pcglns)",
+        )
     })?;
     let inst = parse_instance(&file, &text, format)?;
     crate::validate::validate(&inst, &file)?;
@@ -88,7 +98,10 @@ pub fn save_instance(path: &Path, inst: &Instance) -> Result<()> {
 /// Writes a file through a temporary sibling and a rename, so readers never see half a file.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
     let file = path.display().to_string();
-    let dir = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    let dir = path
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
     let name = path.file_name().and_then(|s| s.to_str()).unwrap_or("out");
     let tmp = dir.join(format!(".{name}.tmp{}", std::process::id()));
     std::fs::write(&tmp, bytes).map_err(|e| Error::io(&file, e))?;

@@ -76,12 +76,15 @@ impl Header<'_> {
     }
 }
 
+/// Named sections, each with its numbered lines.
+type Sections<'a> = Vec<(String, Vec<(usize, &'a str)>)>;
+
 /// Splits a TSPLIB text into header `KEY: VALUE` pairs and named sections of lines.
 fn split_sections<'a>(
     file: &str,
     text: &'a str,
     section_names: &[&str],
-) -> Result<(Header<'a>, Vec<(String, Vec<(usize, &'a str)>)>)> {
+) -> Result<(Header<'a>, Sections<'a>)> {
     let mut header = Header { pairs: Vec::new() };
     let mut sections: Vec<(String, Vec<(usize, &'a str)>)> = Vec::new();
     for (i, raw) in text.lines().enumerate() {
@@ -101,7 +104,9 @@ fn split_sections<'a>(
         if let Some((_, lines)) = sections.last_mut() {
             lines.push((ln, line));
         } else if let Some((k, v)) = line.split_once(':') {
-            header.pairs.push((ln, k.trim().to_ascii_uppercase(), v.trim()));
+            header
+                .pairs
+                .push((ln, k.trim().to_ascii_uppercase(), v.trim()));
         } else {
             return Err(Error::parse(
                 file,
@@ -114,25 +119,36 @@ fn split_sections<'a>(
 }
 
 fn header_usize(file: &str, h: &Header, key: &str) -> Result<usize> {
-    let (ln, v) = h.get(key).ok_or_else(|| {
-        Error::parse(file, 1, format!("missing header field {key}"))
-    })?;
-    v.parse::<usize>()
-        .ok()
-        .filter(|&d| d > 0)
-        .ok_or_else(|| Error::parse(file, ln, format!("{key} must be a positive integer, found '{v}'")))
+    let (ln, v) = h
+        .get(key)
+        .ok_or_else(|| Error::parse(file, 1, format!("missing header field {key}")))?;
+    v.parse::<usize>().ok().filter(|&d| d > 0).ok_or_else(|| {
+        Error::parse(
+            file,
+            ln,
+            format!("{key} must be a positive integer, found '{v}'"),
+        )
+    })
 }
 
 fn check_explicit(file: &str, h: &Header) -> Result<()> {
-    if let Some((ln, v)) = h.get("EDGE_WEIGHT_TYPE") {
-        if v != "EXPLICIT" {
-            return Err(Error::parse(file, ln, format!("EDGE_WEIGHT_TYPE {v} is not supported (EXPLICIT only)")));
-        }
+    if let Some((ln, v)) = h.get("EDGE_WEIGHT_TYPE")
+        && v != "EXPLICIT"
+    {
+        return Err(Error::parse(
+            file,
+            ln,
+            format!("EDGE_WEIGHT_TYPE {v} is not supported (EXPLICIT only)"),
+        ));
     }
-    if let Some((ln, v)) = h.get("EDGE_WEIGHT_FORMAT") {
-        if v != "FULL_MATRIX" {
-            return Err(Error::parse(file, ln, format!("EDGE_WEIGHT_FORMAT {v} is not supported (FULL_MATRIX only)")));
-        }
+    if let Some((ln, v)) = h.get("EDGE_WEIGHT_FORMAT")
+        && v != "FULL_MATRIX"
+    {
+        return Err(Error::parse(
+            file,
+            ln,
+            format!("EDGE_WEIGHT_FORMAT {v} is not supported (FULL_MATRIX only)"),
+        ));
     }
     Ok(())
 }
@@ -147,7 +163,9 @@ fn instance_name(h: &Header, file: &str) -> String {
         .or_else(|| stem.strip_suffix(".pcglns"))
         .unwrap_or(stem);
     if stem.is_empty() {
-        h.get("NAME").map(|(_, v)| v.to_string()).unwrap_or_default()
+        h.get("NAME")
+            .map(|(_, v)| v.to_string())
+            .unwrap_or_default()
     } else {
         stem.to_string()
     }
@@ -156,15 +174,26 @@ fn instance_name(h: &Header, file: &str) -> String {
 /// Parses a TSPLIB SOP file. Node i (1-based) becomes cell `"i"` with one mode.
 pub fn parse_sop(file: &str, text: &str) -> Result<Instance> {
     let (h, sections) = split_sections(file, text, &["EDGE_WEIGHT_SECTION"])?;
-    if let Some((ln, t)) = h.get("TYPE") {
-        if t != "SOP" {
-            return Err(Error::parse(file, ln, format!("TYPE is '{t}', expected SOP")));
-        }
+    if let Some((ln, t)) = h.get("TYPE")
+        && t != "SOP"
+    {
+        return Err(Error::parse(
+            file,
+            ln,
+            format!("TYPE is '{t}', expected SOP"),
+        ));
     }
     check_explicit(file, &h)?;
     let dim = header_usize(file, &h, "DIMENSION")?;
-    let Some((_, lines)) = sections.into_iter().find(|(k, _)| k == "EDGE_WEIGHT_SECTION") else {
-        return Err(Error::parse(file, text.lines().count().max(1), "missing EDGE_WEIGHT_SECTION"));
+    let Some((_, lines)) = sections
+        .into_iter()
+        .find(|(k, _)| k == "EDGE_WEIGHT_SECTION")
+    else {
+        return Err(Error::parse(
+            file,
+            text.lines().count().max(1),
+            "missing EDGE_WEIGHT_SECTION",
+        ));
     };
     let mut tok = Tokens::new(file, &lines);
     let (ln, d2) = tok.next_int("the dimension after EDGE_WEIGHT_SECTION")?;
@@ -182,12 +211,20 @@ pub fn parse_sop(file: &str, text: &str) -> Result<Instance> {
             let (ln, v) = tok.next_num(&format!("matrix entry ({}, {})", i + 1, j + 1))?;
             if v == -1.0 {
                 if i == j {
-                    return Err(Error::parse(file, ln, format!("node {} must precede itself", i + 1)));
+                    return Err(Error::parse(
+                        file,
+                        ln,
+                        format!("node {} must precede itself", i + 1),
+                    ));
                 }
                 edges.push((j, i));
                 costs[i * dim + j] = FORBIDDEN_ARC;
             } else if v < 0.0 {
-                return Err(Error::parse(file, ln, format!("negative cost {v} (only -1 marks precedence)")));
+                return Err(Error::parse(
+                    file,
+                    ln,
+                    format!("negative cost {v} (only -1 marks precedence)"),
+                ));
             } else {
                 costs[i * dim + j] = v;
             }
@@ -218,6 +255,7 @@ pub fn parse_sop(file: &str, text: &str) -> Result<Instance> {
         matrix: Some(CostMatrix { size: dim, costs }),
         first: Some(0),
         last: Some(dim - 1),
+        closed: false,
     })
 }
 
@@ -234,10 +272,15 @@ pub fn parse_pcglns(file: &str, text: &str) -> Result<Instance> {
             "START_GROUP_SECTION",
         ],
     )?;
-    if let Some((ln, t)) = h.get("TYPE") {
-        if t != "PCGLNS" && t != "PCGTSP" {
-            return Err(Error::parse(file, ln, format!("TYPE is '{t}', expected PCGLNS")));
-        }
+    if let Some((ln, t)) = h.get("TYPE")
+        && t != "PCGLNS"
+        && t != "PCGTSP"
+    {
+        return Err(Error::parse(
+            file,
+            ln,
+            format!("TYPE is '{t}', expected PCGLNS"),
+        ));
     }
     check_explicit(file, &h)?;
     let dim = header_usize(file, &h, "DIMENSION")?;
@@ -247,7 +290,9 @@ pub fn parse_pcglns(file: &str, text: &str) -> Result<Instance> {
             .iter()
             .find(|(k, _)| k == name)
             .map(|(_, l)| l.clone())
-            .ok_or_else(|| Error::parse(file, text.lines().count().max(1), format!("missing {name}")))
+            .ok_or_else(|| {
+                Error::parse(file, text.lines().count().max(1), format!("missing {name}"))
+            })
     };
     // groups
     let mut group_of = vec![usize::MAX; dim];
@@ -257,26 +302,44 @@ pub fn parse_pcglns(file: &str, text: &str) -> Result<Instance> {
         let nums = parse_list(file, ln, line)?;
         let g = group_number(file, ln, nums[0], ngroups)?;
         if seen_group[g] {
-            return Err(Error::parse(file, ln, format!("group {} listed twice", g + 1)));
+            return Err(Error::parse(
+                file,
+                ln,
+                format!("group {} listed twice", g + 1),
+            ));
         }
         seen_group[g] = true;
         for &v in &nums[1..] {
             if v < 1 || v as usize > dim {
-                return Err(Error::parse(file, ln, format!("node {v} out of range 1..{dim}")));
+                return Err(Error::parse(
+                    file,
+                    ln,
+                    format!("node {v} out of range 1..{dim}"),
+                ));
             }
             let v = v as usize - 1;
             if group_of[v] != usize::MAX {
-                return Err(Error::parse(file, ln, format!("node {} is in two groups", v + 1)));
+                return Err(Error::parse(
+                    file,
+                    ln,
+                    format!("node {} is in two groups", v + 1),
+                ));
             }
             group_of[v] = g;
             groups[g].push(v);
         }
     }
     if let Some(g) = groups.iter().position(|g| g.is_empty()) {
-        return Err(Error::invalid(file, format!("group {} has no nodes", g + 1)));
+        return Err(Error::invalid(
+            file,
+            format!("group {} has no nodes", g + 1),
+        ));
     }
     if let Some(v) = group_of.iter().position(|&g| g == usize::MAX) {
-        return Err(Error::invalid(file, format!("node {} belongs to no group", v + 1)));
+        return Err(Error::invalid(
+            file,
+            format!("node {} belongs to no group", v + 1),
+        ));
     }
     // our node numbering: group by group, file order within
     let mut new_index = vec![0usize; dim];
@@ -298,12 +361,20 @@ pub fn parse_pcglns(file: &str, text: &str) -> Result<Instance> {
             let slot = new_index[i] * dim + new_index[j];
             if v == -1.0 {
                 if gi == gj {
-                    return Err(Error::parse(file, ln, format!("group {} must precede itself", gi + 1)));
+                    return Err(Error::parse(
+                        file,
+                        ln,
+                        format!("group {} must precede itself", gi + 1),
+                    ));
                 }
                 edges.insert((gj, gi));
                 costs[slot] = FORBIDDEN_ARC;
             } else if v < 0.0 {
-                return Err(Error::parse(file, ln, format!("negative cost {v} (only -1 marks precedence)")));
+                return Err(Error::parse(
+                    file,
+                    ln,
+                    format!("negative cost {v} (only -1 marks precedence)"),
+                ));
             } else {
                 costs[slot] = v;
             }
@@ -323,7 +394,11 @@ pub fn parse_pcglns(file: &str, text: &str) -> Result<Instance> {
             for &x in &nums[1..] {
                 let hgrp = group_number(file, ln, x, ngroups)?;
                 if hgrp == g {
-                    return Err(Error::parse(file, ln, format!("group {} must precede itself", g + 1)));
+                    return Err(Error::parse(
+                        file,
+                        ln,
+                        format!("group {} must precede itself", g + 1),
+                    ));
                 }
                 edges.insert((g, hgrp));
             }
@@ -358,6 +433,7 @@ pub fn parse_pcglns(file: &str, text: &str) -> Result<Instance> {
         matrix: Some(CostMatrix { size: dim, costs }),
         first: Some(start),
         last: None,
+        closed: true,
     })
 }
 
@@ -367,7 +443,11 @@ fn parse_list(file: &str, ln: usize, line: &str) -> Result<Vec<i64>> {
     let mut ended = false;
     for t in line.split_whitespace() {
         if ended {
-            return Err(Error::parse(file, ln, format!("token '{t}' after the terminating -1")));
+            return Err(Error::parse(
+                file,
+                ln,
+                format!("token '{t}' after the terminating -1"),
+            ));
         }
         let v: i64 = t
             .parse()
@@ -389,7 +469,11 @@ fn parse_list(file: &str, ln: usize, line: &str) -> Result<Vec<i64>> {
 
 fn group_number(file: &str, ln: usize, g: i64, ngroups: usize) -> Result<usize> {
     if g < 1 || g as usize > ngroups {
-        return Err(Error::parse(file, ln, format!("group {g} out of range 1..{ngroups}")));
+        return Err(Error::parse(
+            file,
+            ln,
+            format!("group {g} out of range 1..{ngroups}"),
+        ));
     }
     Ok(g as usize - 1)
 }

@@ -14,16 +14,66 @@ use rand_chacha::ChaCha8Rng;
 
 /// Parameters.
 pub static SPECS: &[ParamSpec] = &[
-    ParamSpec { name: "n", default: "100", kind: ParamKind::Int, help: "number of cells" },
-    ParamSpec { name: "size", default: "1000", kind: ParamKind::Float, help: "side of the square box (mm)" },
-    ParamSpec { name: "modes", default: "1", kind: ParamKind::Int, help: "start points per closed cell" },
-    ParamSpec { name: "closed", default: "0", kind: ParamKind::Float, help: "fraction of closed contours" },
-    ParamSpec { name: "reversible", default: "true", kind: ParamKind::Bool, help: "open cells may be cut either way" },
-    ParamSpec { name: "length", default: "20", kind: ParamKind::Float, help: "mean stroke length / contour radius (mm)" },
-    ParamSpec { name: "tools", default: "1", kind: ParamKind::Int, help: "number of tools" },
-    ParamSpec { name: "layers", default: "1", kind: ParamKind::Int, help: "number of depth layers" },
-    ParamSpec { name: "density", default: "0", kind: ParamKind::Float, help: "probability of a precedence pair (n <= 5000)" },
-    ParamSpec { name: "preds", default: "0", kind: ParamKind::Int, help: "random predecessors per cell (sparse precedence)" },
+    ParamSpec {
+        name: "n",
+        default: "100",
+        kind: ParamKind::Int,
+        help: "number of cells",
+    },
+    ParamSpec {
+        name: "size",
+        default: "1000",
+        kind: ParamKind::Float,
+        help: "side of the square box (mm)",
+    },
+    ParamSpec {
+        name: "modes",
+        default: "1",
+        kind: ParamKind::Int,
+        help: "start points per closed cell",
+    },
+    ParamSpec {
+        name: "closed",
+        default: "0",
+        kind: ParamKind::Float,
+        help: "fraction of closed contours",
+    },
+    ParamSpec {
+        name: "reversible",
+        default: "true",
+        kind: ParamKind::Bool,
+        help: "open cells may be cut either way",
+    },
+    ParamSpec {
+        name: "length",
+        default: "20",
+        kind: ParamKind::Float,
+        help: "mean stroke length / contour radius (mm)",
+    },
+    ParamSpec {
+        name: "tools",
+        default: "1",
+        kind: ParamKind::Int,
+        help: "number of tools",
+    },
+    ParamSpec {
+        name: "layers",
+        default: "1",
+        kind: ParamKind::Int,
+        help: "number of depth layers",
+    },
+    ParamSpec {
+        name: "density",
+        default: "0",
+        kind: ParamKind::Float,
+        help: "probability of a precedence pair (n <= 5000)",
+    },
+    ParamSpec {
+        name: "preds",
+        default: "0",
+        kind: ParamKind::Int,
+        help: "random predecessors per cell (sparse precedence)",
+    },
 ];
 
 /// Generates a uniform instance.
@@ -42,7 +92,7 @@ pub fn generate(p: &Params, seed: u64) -> Result<Instance> {
     if n == 0 {
         return bad("n must be at least 1".into());
     }
-    if !(size > 0.0) || !(len >= 0.0) {
+    if size.is_nan() || size <= 0.0 || len.is_nan() || len < 0.0 {
         return bad("size must be positive and length non-negative".into());
     }
     if !(0.0..=1.0).contains(&closed) || !(0.0..=1.0).contains(&density) {
@@ -85,11 +135,19 @@ pub fn generate(p: &Params, seed: u64) -> Result<Instance> {
             let e = Point3::new(x, y, z);
             let f = Point3::new(x + l * a.cos(), y + l * a.sin(), z);
             let m = Mode::new(e, f);
-            let ms = if reversible { vec![m, m.reversed()] } else { vec![m] };
+            let ms = if reversible {
+                vec![m, m.reversed()]
+            } else {
+                vec![m]
+            };
             (ms, l, reversible)
         };
         let mut c = Cell::new(format!("c{i}"), format!("T{}", tool + 1), ms);
-        c.step = if is_closed { StepKind::PocketRough } else { StepKind::Other };
+        c.step = if is_closed {
+            StepKind::PocketRough
+        } else {
+            StepKind::Other
+        };
         c.layer = layer;
         c.z = z;
         c.cut_length = cut;
@@ -142,5 +200,6 @@ pub fn generate(p: &Params, seed: u64) -> Result<Instance> {
         matrix: None,
         first: None,
         last: None,
+        closed: false,
     })
 }

@@ -1,7 +1,7 @@
 //! `as-given`: the instance's own programmed order (the papers' "unoptimized" baseline),
 //! else file order, repaired to respect precedence.
 
-use super::{outcome_of, Context, Outcome, Params, Solver, SolverInfo};
+use super::{Context, Outcome, Params, Solver, SolverInfo, outcome_of};
 use crate::error::Result;
 use crate::model::Visit;
 use crate::precedence::ranked_topological_order;
@@ -31,10 +31,13 @@ impl Solver for AsGiven {
             rank[v.cell] = p;
             mode[v.cell] = v.mode;
         }
-        let order = ranked_topological_order(&ctx.model.dag, &rank)
-            .unwrap_or_else(|_| (0..n).collect());
+        let order =
+            ranked_topological_order(&ctx.model.dag, &rank).unwrap_or_else(|_| (0..n).collect());
         ctx.count(n as u64);
-        let out = outcome_of(ctx.model, order.into_iter().map(|c| Visit::new(c, mode[c])).collect());
+        let out = outcome_of(
+            ctx.model,
+            order.into_iter().map(|c| Visit::new(c, mode[c])).collect(),
+        );
         ctx.report(out.cost);
         Ok(out)
     }

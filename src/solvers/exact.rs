@@ -145,7 +145,10 @@ impl Solver for Exact {
         }
         // close the path
         let full = &levels[n - 1];
-        let (&all, entries) = full.iter().next().ok_or_else(|| err("no feasible order".into()))?;
+        let (&all, entries) = full
+            .iter()
+            .next()
+            .ok_or_else(|| err("no feasible order".into()))?;
         let mut best = (f64::INFINITY, u32::MAX);
         for &(u, cu) in entries {
             let (c, md) = m.cell_mode(u as usize);
@@ -158,7 +161,11 @@ impl Solver for Exact {
         let mut seq = Vec::with_capacity(n);
         let mut s = all;
         let mut u = best.1;
-        let mut cu = entries.iter().find(|e| e.0 == u).map(|e| e.1).unwrap_or(0.0);
+        let mut cu = entries
+            .iter()
+            .find(|e| e.0 == u)
+            .map(|e| e.1)
+            .unwrap_or(0.0);
         for k in (0..n).rev() {
             let (c, md) = m.cell_mode(u as usize);
             seq.push(Visit::new(c, md));
@@ -176,7 +183,8 @@ impl Solver for Exact {
                     break;
                 }
             }
-            let (p, cp) = found.ok_or_else(|| err("internal error: broken DP back-pointer".into()))?;
+            let (p, cp) =
+                found.ok_or_else(|| err("internal error: broken DP back-pointer".into()))?;
             u = p;
             cu = cp;
         }

@@ -8,13 +8,13 @@ pub mod as_given;
 pub mod exact;
 pub mod greedy;
 
-use crate::check::{check, Report};
+use crate::check::{Report, check};
 use crate::cost::CostModel;
 use crate::error::{Error, Result};
 use crate::model::{Instance, Objective, Sequence};
 use std::collections::BTreeMap;
 
-pub use crate::params::{parse_kv, ParamKind, ParamSpec, Params};
+pub use crate::params::{ParamKind, ParamSpec, Params, parse_kv};
 use std::time::{Duration, Instant};
 
 /// How much work a solver may do. Evaluation budgets make runs deterministic.
@@ -118,15 +118,15 @@ impl<'a> Context<'a> {
     }
     /// True when the budget is used up.
     pub fn exhausted(&self) -> bool {
-        if let Some(m) = self.budget.max_evals {
-            if self.evaluations >= m {
-                return true;
-            }
+        if let Some(m) = self.budget.max_evals
+            && self.evaluations >= m
+        {
+            return true;
         }
-        if let Some(t) = self.budget.time_limit {
-            if self.start.elapsed() >= t {
-                return true;
-            }
+        if let Some(t) = self.budget.time_limit
+            && self.start.elapsed() >= t
+        {
+            return true;
         }
         false
     }
@@ -189,10 +189,17 @@ pub const DEFAULT_SOLVER: &str = "greedy";
 
 /// Looks a solver up by name.
 pub fn find(name: &str) -> Result<&'static SolverInfo> {
-    registry().into_iter().find(|s| s.name == name).ok_or_else(|| Error::UnknownSolver {
-        name: name.to_string(),
-        known: registry().iter().map(|s| s.name).collect::<Vec<_>>().join(", "),
-    })
+    registry()
+        .into_iter()
+        .find(|s| s.name == name)
+        .ok_or_else(|| Error::UnknownSolver {
+            name: name.to_string(),
+            known: registry()
+                .iter()
+                .map(|s| s.name)
+                .collect::<Vec<_>>()
+                .join(", "),
+        })
 }
 
 /// The result of [`run`]: the solver's outcome and the independent checker's report.
