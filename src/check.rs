@@ -163,10 +163,10 @@ pub fn check(inst: &Instance, seq: &Sequence, objective: Objective) -> Result<Re
             for w in seq.windows(2) {
                 total += m.costs[node(w[0].cell, w[0].mode) * m.size + node(w[1].cell, w[1].mode)];
             }
-            if inst.closed {
-                if let (Some(a), Some(b)) = (seq.last(), seq.first()) {
-                    total += m.costs[node(a.cell, a.mode) * m.size + node(b.cell, b.mode)];
-                }
+            if inst.closed
+                && let (Some(a), Some(b)) = (seq.last(), seq.first())
+            {
+                total += m.costs[node(a.cell, a.mode) * m.size + node(b.cell, b.mode)];
             }
             Report {
                 cost: total,
