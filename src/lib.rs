@@ -4,6 +4,20 @@
 //! Data flow: a file or generator gives an [`model::Instance`]; [`cost::CostModel`] flattens it
 //! for search; a [`solvers::Solver`] returns a [`model::Sequence`]; [`check::check`] verifies it
 //! and recomputes the [`check::Report`] from scratch.
+//!
+//! ```
+//! use cellseq::solvers::{self, Budget, NoObserver};
+//! use std::collections::BTreeMap;
+//!
+//! // a TSPLIB SOP instance: node 1 first, node 3 last, arcs 1->2 = 1 and 2->3 = 2
+//! let text = "TYPE: SOP\nDIMENSION: 3\nEDGE_WEIGHT_SECTION\n3\n0 1 9\n-1 0 2\n-1 -1 0\nEOF\n";
+//! let inst = cellseq::formats::parse_instance("tiny.sop", text, cellseq::formats::Format::Sop)?;
+//! let obj = inst.default_objective();
+//! let run = solvers::run("exact", &inst, obj, &BTreeMap::new(), 1, Budget::default(), &mut NoObserver)?;
+//! assert_eq!(run.report.cost, 3.0);
+//! assert!(run.outcome.proven_optimal);
+//! # Ok::<(), cellseq::Error>(())
+//! ```
 
 // Index loops are the clearest form for the graph and DP code here.
 #![allow(clippy::needless_range_loop)]
