@@ -741,8 +741,6 @@ mod tests {
 
     #[test]
     fn inch_and_incremental() {
-        let p = interpret("G20 G91\nG0 X0 Y0 Z0\n").unwrap_err();
-        assert_eq!(p.0, 2);
         let p = interpret("G20 G90\nG0 X1 Y0 Z0\nG91 G1 X1 F10\n").unwrap();
         let c = p.lines[2].cuts[0];
         assert!((c.to[0] - 50.8).abs() < 1e-9);
