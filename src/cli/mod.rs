@@ -1,6 +1,7 @@
 //! Command-line interface: argument definitions and dispatch. One module per command group.
 
 mod demo;
+mod gcode;
 mod solve;
 
 use clap::{Parser, Subcommand};
@@ -29,6 +30,12 @@ enum Command {
     Generate(solve::GenerateArgs),
     /// Run the built-in demonstration on a generated instance (no files needed).
     Demo(demo::DemoArgs),
+    /// Reorder a G-code program's cells, verify it cuts the same, and write it.
+    Optimize(gcode::OptimizeArgs),
+    /// Extract the cell instance of a G-code program as JSON.
+    Import(gcode::ImportArgs),
+    /// Check that two G-code programs make the same cutting moves; report travel.
+    VerifyGcode(gcode::VerifyArgs),
 }
 
 /// Runs the parsed command.
@@ -41,5 +48,8 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<()> {
         Command::Solvers => solve::solvers(),
         Command::Generate(a) => solve::generate(a),
         Command::Demo(a) => demo::demo(a),
+        Command::Optimize(a) => gcode::optimize(a),
+        Command::Import(a) => gcode::import(a),
+        Command::VerifyGcode(a) => gcode::verify(a),
     }
 }

@@ -1,0 +1,236 @@
+//! `optimize`, `import` and `verify-gcode`: real programs in, better programs out.
+
+use anyhow::{Context as _, bail};
+use cellseq::formats::{read_text, save_instance, write_atomic};
+use cellseq::io::gcode::{self, Figures, Options};
+use clap::Args;
+use std::path::{Path, PathBuf};
+
+/// Arguments of `optimize`.
+#[derive(Args, Debug)]
+pub struct OptimizeArgs {
+    /// Input program (.ngc, .nc, .gcode, .tap, .gco, …).
+    pub input: PathBuf,
+    /// Output file (default: report only).
+    #[arg(short = 'o', long)]
+    pub output: Option<PathBuf>,
+    /// Solver from the registry.
+    #[arg(long, default_value = cellseq::solvers::DEFAULT_SOLVER)]
+    pub solver: String,
+    /// Time limit in seconds (shared among tool blocks).
+    #[arg(long, value_name = "S")]
+    pub time_limit: Option<f64>,
+    /// Seed.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Allow cutting cells in the opposite direction.
+    #[arg(long, conflicts_with = "no_reversible")]
+    pub reversible: bool,
+    /// Never reverse cells (default for G-code).
+    #[arg(long)]
+    pub no_reversible: bool,
+    /// Keep tool blocks in their original order (default).
+    #[arg(long, conflicts_with = "merge_tool_blocks")]
+    pub keep_tool_order: bool,
+    /// Merge blocks of the same tool (fewer tool changes).
+    #[arg(long)]
+    pub merge_tool_blocks: bool,
+    /// Print the report as JSON.
+    #[arg(long)]
+    pub json: bool,
+    /// Input format (default: from the extension).
+    #[arg(long, value_name = "gcode|svg|dxf")]
+    pub format: Option<String>,
+    /// XY margin (mm) added to cell footprints for the overlap rule.
+    #[arg(long, default_value_t = 0.5)]
+    pub margin: f64,
+}
+
+/// Arguments of `import`.
+#[derive(Args, Debug)]
+pub struct ImportArgs {
+    /// Input program.
+    pub input: PathBuf,
+    /// Instance file to write.
+    #[arg(short = 'o', long)]
+    pub output: PathBuf,
+    /// Merge blocks of the same tool.
+    #[arg(long)]
+    pub merge_tool_blocks: bool,
+    /// XY margin (mm) added to cell footprints for the overlap rule.
+    #[arg(long, default_value_t = 0.5)]
+    pub margin: f64,
+}
+
+/// Arguments of `verify-gcode`.
+#[derive(Args, Debug)]
+pub struct VerifyArgs {
+    /// The original program.
+    pub original: PathBuf,
+    /// The program to check against it.
+    pub optimized: PathBuf,
+    /// Print the report as JSON.
+    #[arg(long)]
+    pub json: bool,
+}
+
+fn format_of(path: &Path, given: Option<&str>) -> anyhow::Result<&'static str> {
+    let f = match given {
+        Some(g) => g.to_ascii_lowercase(),
+        None => path
+            .extension()
+            .and_then(|e| e.to_str())
+            .unwrap_or("")
+            .to_ascii_lowercase(),
+    };
+    Ok(match f.as_str() {
+        "gcode" | "ngc" | "nc" | "tap" | "gco" | "g" | "cnc" | "txt" => "gcode",
+        "svg" => "svg",
+        "dxf" => "dxf",
+        other => bail!(
+            "{}: cannot tell the format from '{other}' (use --format gcode)",
+            path.display()
+        ),
+    })
+}
+
+fn print_figures(before: &Figures, after: &Figures) {
+    let pct = |a: f64, b: f64| if a > 0.0 { 100.0 * (a - b) / a } else { 0.0 };
+    println!("{:<16} {:>14} {:>14} {:>8}", "", "before", "after", "saved");
+    println!(
+        "{:<16} {:>14.1} {:>14.1} {:>7.1}%",
+        "air length mm",
+        before.air_length,
+        after.air_length,
+        pct(before.air_length, after.air_length)
+    );
+    println!("{:<16} {:>14} {:>14}", "lifts", before.lifts, after.lifts);
+    println!(
+        "{:<16} {:>14} {:>14}",
+        "tool changes", before.tool_changes, after.tool_changes
+    );
+    println!(
+        "{:<16} {:>14.1} {:>14.1} {:>7.1}%",
+        "est. time s",
+        before.est_time_s,
+        after.est_time_s,
+        pct(before.est_time_s, after.est_time_s)
+    );
+    println!(
+        "{:<16} {:>14.1} {:>14.1}",
+        "cut length mm", before.cut_length, after.cut_length
+    );
+}
+
+/// Runs `optimize`.
+pub fn optimize(a: OptimizeArgs) -> anyhow::Result<()> {
+    let fmt = format_of(&a.input, a.format.as_deref())?;
+    if fmt != "gcode" {
+        bail!(
+            "{}: {fmt} input is not supported yet (only G-code)",
+            a.input.display()
+        );
+    }
+    let file = a.input.display().to_string();
+    let text = read_text(&a.input)?;
+    let parsed = gcode::parse(&file, &text)?;
+    let opts = Options {
+        solver: a.solver.clone(),
+        time_limit: a.time_limit,
+        seed: a.seed,
+        merge: a.merge_tool_blocks,
+        margin: a.margin,
+        reversible: a.reversible && !a.no_reversible,
+    };
+    let out = gcode::optimize(&parsed, &opts)?;
+    if let Some(o) = &a.output {
+        write_atomic(o, out.text.as_bytes()).with_context(|| format!("writing {}", o.display()))?;
+    }
+    if a.json {
+        let v = serde_json::json!({
+            "input": file,
+            "output": a.output.as_ref().map(|p| p.display().to_string()),
+            "solver": a.solver,
+            "cells": parsed.layout.cells.len(),
+            "tool_blocks": parsed.layout.blocks.len(),
+            "verified_cutting_moves": out.cuts,
+            "inner_first_dropped_groups": out.inner_first_dropped,
+            "solve_s": out.solve_s,
+            "kept_original_order": out.kept_original,
+            "before": out.before,
+            "after": out.after,
+        });
+        println!("{}", serde_json::to_string_pretty(&v)?);
+    } else {
+        println!(
+            "{file}: {} cells in {} tool blocks; solver {} ({:.3} s); {} cutting moves verified identical",
+            parsed.layout.cells.len(),
+            parsed.layout.blocks.len(),
+            a.solver,
+            out.solve_s,
+            out.cuts
+        );
+        if out.kept_original {
+            println!(
+                "note: the solver's order had more air travel than the original order; original order kept"
+            );
+        }
+        if out.inner_first_dropped > 0 {
+            println!(
+                "note: in {} group(s) inner-first contradicted the original order of overlapping cells; original order kept",
+                out.inner_first_dropped
+            );
+        }
+        print_figures(&out.before, &out.after);
+        if let Some(o) = &a.output {
+            println!("wrote {}", o.display());
+        }
+    }
+    Ok(())
+}
+
+/// Runs `import`.
+pub fn import(a: ImportArgs) -> anyhow::Result<()> {
+    let fmt = format_of(&a.input, None)?;
+    if fmt != "gcode" {
+        bail!(
+            "{}: {fmt} input is not supported yet (only G-code)",
+            a.input.display()
+        );
+    }
+    let file = a.input.display().to_string();
+    let text = read_text(&a.input)?;
+    let parsed = gcode::parse(&file, &text)?;
+    let inst = gcode::import(&parsed, a.merge_tool_blocks, a.margin)?;
+    cellseq::validate::validate(&inst, &file)?;
+    save_instance(&a.output, &inst)?;
+    println!(
+        "{}: {} cells, {} precedence edges -> {}",
+        file,
+        inst.n(),
+        inst.precedence.len(),
+        a.output.display()
+    );
+    Ok(())
+}
+
+/// Runs `verify-gcode`.
+pub fn verify(a: VerifyArgs) -> anyhow::Result<()> {
+    let (fa, fb) = (
+        a.original.display().to_string(),
+        a.optimized.display().to_string(),
+    );
+    let ta = read_text(&a.original)?;
+    let tb = read_text(&a.optimized)?;
+    let v = gcode::verify_files(&fa, &ta, &fb, &tb)?;
+    if a.json {
+        println!("{}", serde_json::to_string_pretty(&v)?);
+    } else {
+        println!(
+            "equivalent: {} cutting moves match (per tool, feed, speed, offset)",
+            v.cuts
+        );
+        print_figures(&v.before, &v.after);
+    }
+    Ok(())
+}

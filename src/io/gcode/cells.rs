@@ -1,0 +1,436 @@
+//! Splitting an interpreted program into cells, tool blocks, header and footer; default
+//! precedence (overlap keeps order, inner closed contours first).
+
+use super::interp::{CutKind, Motion, Program, State, known};
+
+/// How cells are delimited.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Split {
+    /// Milling/drilling: a cell runs from a descent below `safe` to the next rise to it;
+    /// travel is regenerated at `travel` (both mm).
+    Z {
+        /// Threshold height (the file's safe height).
+        safe: f64,
+        /// Travel height used for regenerated rapids (highest between-cell rapid).
+        travel: f64,
+    },
+    /// 2-D (laser, plasma, plotter): a cell is a run of feed moves, ended by a rapid or M5.
+    Flat,
+}
+
+/// One cell: a contiguous run of lines cut together.
+#[derive(Debug, Clone)]
+pub struct GCell {
+    /// Body lines `[start, end)` (indices into the program's lines).
+    pub start: usize,
+    /// End (exclusive).
+    pub end: usize,
+    /// Gap lines emitted before the cell (non-motion, or motion lines to be stripped).
+    pub prefix: Vec<usize>,
+    /// Tool block index.
+    pub block: usize,
+    /// Tool number.
+    pub tool: u32,
+    /// Entry point (mm).
+    pub entry: [f64; 3],
+    /// Exit point (mm).
+    pub exit: [f64; 3],
+    /// State before the first body line.
+    pub state: State,
+    /// True for a single canned-cycle hole.
+    pub cycle: bool,
+    /// XY bounding box of the cuts.
+    pub bbox: [f64; 4],
+    /// Length cut (mm).
+    pub cut_length: f64,
+    /// Lowest Z of the cuts (mm).
+    pub depth: f64,
+    /// XY outline when the cell is a closed contour.
+    pub closed: Option<Vec<[f64; 2]>>,
+}
+
+/// A tool block: consecutive cells of one tool, with the lines that change to it.
+#[derive(Debug, Clone)]
+pub struct Block {
+    /// Tool number.
+    pub tool: u32,
+    /// Gap lines holding the tool change (empty for the first block: it is in the header).
+    pub preamble: Vec<usize>,
+    /// Index of the first line of that gap.
+    pub gap_start: usize,
+    /// Number of coordinate-system changes (G10/G52/G92) before the block; blocks of
+    /// different epochs never merge.
+    pub epoch: usize,
+}
+
+/// The program cut into pieces.
+#[derive(Debug, Clone)]
+pub struct Layout {
+    /// How cells were delimited.
+    pub split: Split,
+    /// Lines `[0, header_end)` are written unchanged first.
+    pub header_end: usize,
+    /// Lines `[footer_start, n)` are written unchanged last.
+    pub footer_start: usize,
+    /// Cells in program order.
+    pub cells: Vec<GCell>,
+    /// Tool blocks in program order.
+    pub blocks: Vec<Block>,
+    /// Position at the end of the header (mm), when known.
+    pub start: Option<[f64; 3]>,
+}
+
+const EPS: f64 = 1e-6;
+
+/// Splits a program. Errors: `(line, message)`.
+pub fn split(p: &Program) -> Result<Layout, (usize, String)> {
+    let split = if p.has_z { find_safe(p)? } else { Split::Flat };
+    let safe = match split {
+        Split::Z { safe, .. } => safe,
+        Split::Flat => f64::INFINITY,
+    };
+    let n = p.lines.len();
+    let mut ranges: Vec<(usize, usize, bool)> = Vec::new();
+    let mut open: Option<usize> = None;
+    for (i, li) in p.lines.iter().enumerate() {
+        let zafter = li.pos_after[2];
+        if let Some(s) = open {
+            match split {
+                Split::Z { .. } => {
+                    if li.motion == Motion::Cycle {
+                        ranges.push((s, i, false));
+                        ranges.push((i, i + 1, true));
+                        open = None;
+                        continue;
+                    }
+                    if li.motion == Motion::Home {
+                        return Err((
+                            li.line,
+                            "G28/G30/G53 move while cutting (below the safe height)".into(),
+                        ));
+                    }
+                    if li.tool_change {
+                        return Err((li.line, "tool change while below the safe height".into()));
+                    }
+                    if li.motion != Motion::None && zafter.is_some_and(|z| z >= safe - EPS) {
+                        ranges.push((s, i + 1, false));
+                        open = None;
+                    }
+                }
+                Split::Flat => {
+                    if matches!(li.motion, Motion::Rapid | Motion::Home) || li.tool_change || li.end
+                    {
+                        ranges.push((s, i, false));
+                        open = None;
+                    } else if li.spindle_off {
+                        ranges.push((s, i + 1, false));
+                        open = None;
+                    }
+                }
+            }
+            continue;
+        }
+        let starts = match split {
+            Split::Z { .. } => {
+                if li.motion == Motion::Cycle {
+                    ranges.push((i, i + 1, true));
+                    continue;
+                }
+                li.motion == Motion::Feed
+                    || (li.motion == Motion::Rapid
+                        && matches!((li.pos_before[2], zafter), (Some(a), Some(b)) if b < safe - EPS && b < a - EPS))
+            }
+            Split::Flat => li.motion == Motion::Feed,
+        };
+        if starts {
+            open = Some(i);
+            if let (Split::Z { .. }, Some(z)) = (split, zafter)
+                && z >= safe - EPS
+            {
+                ranges.push((i, i + 1, false));
+                open = None;
+            }
+        }
+    }
+    if let Some(s) = open {
+        // cut to the end: the trailing non-motion lines belong to the footer
+        let mut e = n;
+        while e > s + 1 && p.lines[e - 1].motion == Motion::None {
+            e -= 1;
+        }
+        ranges.push((s, e, false));
+    }
+    ranges.retain(|r| r.1 > r.0);
+    if ranges.is_empty() {
+        return Err((0, "no cutting moves found".into()));
+    }
+    let header_end = ranges[0].0;
+    let footer_start = ranges[ranges.len() - 1].1;
+    for li in &p.lines[header_end..footer_start] {
+        if li.end {
+            return Err((li.line, "program end (M2/M30) before the last cut".into()));
+        }
+    }
+    let mut cells = Vec::with_capacity(ranges.len());
+    let mut blocks = vec![Block {
+        tool: p.lines[header_end].before.tool,
+        preamble: Vec::new(),
+        gap_start: 0,
+        epoch: 0,
+    }];
+    let mut epoch = 0;
+    let mut prev_end = header_end;
+    for &(s, e, cycle) in &ranges {
+        let gap: Vec<usize> = (prev_end..s).collect();
+        let mut prefix = Vec::new();
+        let boundary = |g: usize| p.lines[g].tool_change || p.lines[g].setup;
+        if gap.iter().any(|&g| p.lines[g].setup) {
+            epoch += 1;
+        }
+        if gap.iter().any(|&g| boundary(g)) {
+            let last_change = *gap.iter().rev().find(|&&g| boundary(g)).unwrap_or(&s);
+            blocks.push(Block {
+                tool: p.lines[s].before.tool,
+                preamble: gap
+                    .iter()
+                    .copied()
+                    .filter(|&g| {
+                        g <= last_change
+                            || p.lines[g].motion == Motion::None
+                            || has_other_words(p, g)
+                    })
+                    .collect(),
+                gap_start: prev_end,
+                epoch,
+            });
+        } else if !cells.is_empty() {
+            prefix = gap
+                .iter()
+                .copied()
+                .filter(|&g| p.lines[g].motion == Motion::None || has_other_words(p, g))
+                .collect();
+        }
+        prev_end = e;
+        let first = &p.lines[s];
+        let last = &p.lines[e - 1];
+        let st = first.before;
+        if st.cutter_comp {
+            return Err((
+                first.line,
+                "cutter radius compensation (G41/G42) active at the start of a cut".into(),
+            ));
+        }
+        let before = known(&first.pos_before).ok_or((
+            first.line,
+            "position unknown at the start of a cut (after G28/G30/G53)".to_string(),
+        ))?;
+        let exit = known(&last.pos_after).ok_or((
+            last.line,
+            "position unknown at the end of a cut".to_string(),
+        ))?;
+        let mut entry = before;
+        if !cycle
+            && first.motion == Motion::Rapid
+            && st.absolute
+            && let Some(t) = known(&first.pos_after)
+        {
+            entry = [t[0], t[1], before[2]];
+        }
+        let mut bbox = [
+            f64::INFINITY,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::NEG_INFINITY,
+        ];
+        let mut cut_length = 0.0;
+        let mut depth = f64::INFINITY;
+        let mut pts: Vec<[f64; 2]> = vec![[entry[0], entry[1]]];
+        let mut planar = true;
+        for li in &p.lines[s..e] {
+            if li.motion == Motion::Rapid
+                && let Some(t) = known(&li.pos_after)
+            {
+                pts.push([t[0], t[1]]);
+                depth = depth.min(t[2]);
+            }
+            for c in &li.cuts {
+                let b = c.bbox();
+                bbox = [
+                    bbox[0].min(b[0]),
+                    bbox[1].min(b[1]),
+                    bbox[2].max(b[2]),
+                    bbox[3].max(b[3]),
+                ];
+                cut_length += c.length();
+                depth = depth.min(c.to[2]).min(c.from[2]);
+                if matches!(c.kind, CutKind::Arc { plane, .. } if plane != 17) {
+                    planar = false;
+                }
+                c.polyline(&mut pts);
+            }
+        }
+        if cycle {
+            entry = p.lines[s].cuts[0].from;
+        }
+        let exit = if cycle { entry } else { exit };
+        if !bbox[0].is_finite() {
+            bbox = [entry[0], entry[1], entry[0], entry[1]];
+        }
+        let closed_xy = (pts[0][0] - exit[0]).hypot(pts[0][1] - exit[1]) < 1e-3;
+        let closed = (planar && !cycle && closed_xy && pts.len() >= 4 && area(&pts).abs() > 1e-6)
+            .then_some(pts);
+        cells.push(GCell {
+            start: s,
+            end: e,
+            prefix,
+            block: blocks.len() - 1,
+            tool: st.tool,
+            entry,
+            exit,
+            state: st,
+            cycle,
+            bbox,
+            cut_length,
+            depth: if depth.is_finite() { depth } else { entry[2] },
+            closed,
+        });
+    }
+    let start = known(&p.lines[header_end].pos_before);
+    Ok(Layout {
+        split,
+        header_end,
+        footer_start,
+        cells,
+        blocks,
+        start,
+    })
+}
+
+/// True when a motion line also carries words other than motion and axes (M, S, F, T…).
+pub fn has_other_words(p: &Program, i: usize) -> bool {
+    p.lines[i].words.words.iter().any(|&(c, v)| {
+        !(matches!(c, 'X' | 'Y' | 'Z' | 'I' | 'J' | 'K' | 'R') || c == 'G' && is_motion_g(v))
+    })
+}
+
+/// G codes that move (dropped when a gap line is stripped of its motion).
+pub fn is_motion_g(v: f64) -> bool {
+    let c = (v * 10.0).round() as i64;
+    matches!(c, 0 | 10 | 20 | 30 | 280 | 300 | 530 | 730 | 800..=890)
+}
+
+fn find_safe(p: &Program) -> Result<Split, (usize, String)> {
+    use std::collections::BTreeMap;
+    let mut counts: BTreeMap<i64, usize> = BTreeMap::new();
+    for li in &p.lines {
+        if let Some(z) = li.xy_rapid_z {
+            *counts.entry((z * 1000.0).round() as i64).or_default() += 1;
+        }
+    }
+    let Some((&best, _)) = counts.iter().max_by(|a, b| a.1.cmp(b.1).then(a.0.cmp(b.0))) else {
+        return Err((
+            0,
+            "cannot find the safe height: no rapid XY moves at a known Z".into(),
+        ));
+    };
+    let safe = best as f64 / 1000.0;
+    let travel = counts
+        .keys()
+        .map(|&k| k as f64 / 1000.0)
+        .filter(|&z| z >= safe)
+        .fold(safe, f64::max);
+    Ok(Split::Z { safe, travel })
+}
+
+/// Signed area of a closed polyline.
+pub fn area(pts: &[[f64; 2]]) -> f64 {
+    let mut a = 0.0;
+    for i in 0..pts.len() {
+        let p = pts[i];
+        let q = pts[(i + 1) % pts.len()];
+        a += p[0] * q[1] - q[0] * p[1];
+    }
+    a / 2.0
+}
+
+fn inside(poly: &[[f64; 2]], x: f64, y: f64) -> bool {
+    let mut c = false;
+    let n = poly.len();
+    let mut j = n - 1;
+    for i in 0..n {
+        let (a, b) = (poly[i], poly[j]);
+        if (a[1] > y) != (b[1] > y) && x < (b[0] - a[0]) * (y - a[1]) / (b[1] - a[1]) + a[0] {
+            c = !c;
+        }
+        j = i;
+    }
+    c
+}
+
+/// True when closed cell `outer` strictly encloses every sample point of `inner`.
+fn encloses(outer: &GCell, inner: &GCell, tol: f64) -> bool {
+    let Some(poly) = &outer.closed else {
+        return false;
+    };
+    let (a, b) = (outer.bbox, inner.bbox);
+    if !(a[0] < b[0] - tol && a[1] < b[1] - tol && a[2] > b[2] + tol && a[3] > b[3] + tol) {
+        return false;
+    }
+    let mut samples = vec![
+        [inner.entry[0], inner.entry[1]],
+        [inner.exit[0], inner.exit[1]],
+    ];
+    if let Some(q) = &inner.closed {
+        let step = (q.len() / 16).max(1);
+        samples.extend(q.iter().step_by(step).copied());
+    }
+    samples.push([b[0], b[1]]);
+    samples.push([b[2], b[3]]);
+    samples.iter().all(|s| inside(poly, s[0], s[1]))
+}
+
+/// Default precedence among `cells` (indices into the layout, in program order): pairs whose
+/// XY boxes (grown by `margin`) overlap keep their order, except that a closed contour
+/// enclosing the other cell goes after it. Returns edges over positions in `cells`, and
+/// whether the inner-first rule had to be dropped because it contradicted the order rule.
+pub fn precedence(l: &Layout, cells: &[usize], margin: f64) -> (Vec<(usize, usize)>, bool) {
+    let mut by_x: Vec<usize> = (0..cells.len()).collect();
+    by_x.sort_by(|&a, &b| l.cells[cells[a]].bbox[0].total_cmp(&l.cells[cells[b]].bbox[0]));
+    let mut plain = Vec::new();
+    let mut inverted = Vec::new();
+    for (k, &a) in by_x.iter().enumerate() {
+        let ba = l.cells[cells[a]].bbox;
+        for &b in &by_x[k + 1..] {
+            let bb = l.cells[cells[b]].bbox;
+            if bb[0] > ba[2] + 2.0 * margin {
+                break;
+            }
+            if bb[1] > ba[3] + 2.0 * margin || ba[1] > bb[3] + 2.0 * margin {
+                continue;
+            }
+            let (i, j) = if a < b { (a, b) } else { (b, a) };
+            let (ci, cj) = (&l.cells[cells[i]], &l.cells[cells[j]]);
+            if encloses(ci, cj, margin.max(1e-3)) {
+                inverted.push((j, i));
+                plain.push((i, j));
+            } else {
+                plain.push((i, j));
+            }
+        }
+    }
+    if inverted.is_empty() {
+        return (plain, false);
+    }
+    let inv: std::collections::HashSet<(usize, usize)> =
+        inverted.iter().map(|&(j, i)| (i, j)).collect();
+    let mixed: Vec<(usize, usize)> = plain
+        .iter()
+        .map(|&e| if inv.contains(&e) { (e.1, e.0) } else { e })
+        .collect();
+    let dag = crate::precedence::Dag::new(cells.len(), &mixed);
+    if crate::precedence::topological_order(&dag).is_ok() {
+        (mixed, false)
+    } else {
+        (plain, true)
+    }
+}

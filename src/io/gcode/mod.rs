@@ -1,0 +1,361 @@
+//! G-code (RS-274: LinuxCNC, Fanuc-style, GRBL): read a program, split it into cells, build
+//! an [`Instance`], write the program back in a solved order, and verify equivalence.
+//!
+//! Pipeline: [`lex`] tokenizes lines, [`interp`] executes them with full modal state and lists
+//! every cutting move, [`cells`] splits the program (header, tool blocks, cells, footer) and
+//! derives the default precedence, [`write`] re-emits it, [`verify`] compares the cutting moves
+//! of two programs as multisets and measures air travel.
+
+pub mod cells;
+pub mod interp;
+pub mod lex;
+pub mod verify;
+pub mod write;
+
+use crate::error::{Error, Result};
+use crate::geom::Point3;
+use crate::model::{Cell, Instance, Machine, Metadata, Mode, Objective, StepKind, Tool, Visit};
+use crate::solvers::{self, Budget, NoObserver};
+use cells::{Layout, Split};
+use interp::Program;
+pub use verify::Figures;
+
+/// A parsed program with its cell layout.
+#[derive(Debug, Clone)]
+pub struct Parsed {
+    /// File name (for messages).
+    pub file: String,
+    /// The interpreted lines.
+    pub program: Program,
+    /// Header, blocks, cells, footer.
+    pub layout: Layout,
+}
+
+/// Interprets and splits a program; errors name the file and line.
+pub fn parse(file: &str, text: &str) -> Result<Parsed> {
+    let program = interp::interpret(text).map_err(|(l, m)| Error::parse(file, l, m))?;
+    let layout = cells::split(&program).map_err(|(l, m)| {
+        if l == 0 {
+            Error::invalid(file, m)
+        } else {
+            Error::parse(file, l, m)
+        }
+    })?;
+    Ok(Parsed {
+        file: file.to_string(),
+        program,
+        layout,
+    })
+}
+
+/// The safe height used to count lifts (`None` for 2-D programs).
+pub fn safe_height(p: &Parsed) -> Option<f64> {
+    match p.layout.split {
+        Split::Z { safe, .. } => Some(safe),
+        Split::Flat => None,
+    }
+}
+
+/// Groups of cells sequenced independently, in their fixed order: tool blocks, or (with
+/// `merge`) all cells of a tool, tools in first-use order.
+pub fn groups(l: &Layout, merge: bool) -> Vec<Vec<usize>> {
+    let mut out: Vec<Vec<usize>> = Vec::new();
+    let mut keys: Vec<u64> = Vec::new();
+    for (i, c) in l.cells.iter().enumerate() {
+        let k = if merge {
+            ((l.blocks[c.block].epoch as u64) << 32) | c.tool as u64
+        } else {
+            c.block as u64
+        };
+        match keys.iter().position(|&x| x == k) {
+            Some(g) => out[g].push(i),
+            None => {
+                keys.push(k);
+                out.push(vec![i]);
+            }
+        }
+    }
+    out
+}
+
+/// Options of [`optimize`].
+#[derive(Debug, Clone)]
+pub struct Options {
+    /// Solver name from the registry.
+    pub solver: String,
+    /// Total time limit (s), shared among groups by size.
+    pub time_limit: Option<f64>,
+    /// Seed.
+    pub seed: u64,
+    /// Merge blocks of the same tool.
+    pub merge: bool,
+    /// XY margin (mm) added to footprints for the overlap rule.
+    pub margin: f64,
+    /// Allow reversal (not supported for G-code: refused).
+    pub reversible: bool,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        Options {
+            solver: solvers::DEFAULT_SOLVER.to_string(),
+            time_limit: None,
+            seed: 1,
+            merge: false,
+            margin: 0.5,
+            reversible: false,
+        }
+    }
+}
+
+fn p3(a: [f64; 3]) -> Point3 {
+    Point3::new(a[0], a[1], a[2])
+}
+
+/// The instance of a group of cells (indices into the layout), starting at `home`.
+/// Also returns whether the inner-first rule was dropped (it contradicted the overlap rule).
+pub fn group_instance(
+    p: &Parsed,
+    cells: &[usize],
+    home: [f64; 3],
+    margin: f64,
+) -> (Instance, bool) {
+    let l = &p.layout;
+    let (precedence, dropped) = cells::precedence(l, cells, margin);
+    let mut clearance = match l.split {
+        Split::Z { travel, .. } => travel,
+        Split::Flat => 0.0,
+    };
+    for &c in cells {
+        clearance = clearance.max(l.cells[c].entry[2]).max(l.cells[c].exit[2]);
+    }
+    clearance = clearance.max(home[2]);
+    let mut tools: Vec<Tool> = Vec::new();
+    let out_cells: Vec<Cell> = cells
+        .iter()
+        .map(|&ci| {
+            let c = &l.cells[ci];
+            let tid = format!("T{}", c.tool);
+            if !tools.iter().any(|t| t.id == tid) {
+                tools.push(Tool {
+                    id: tid.clone(),
+                    diameter: 1.0,
+                    name: None,
+                    feed: None,
+                });
+            }
+            let mut cell = Cell::new(
+                format!("c{}", ci + 1),
+                tid,
+                vec![Mode::new(p3(c.entry), p3(c.exit))],
+            );
+            cell.step = if c.cycle {
+                StepKind::Hole
+            } else {
+                StepKind::Other
+            };
+            cell.z = c.depth;
+            cell.cut_length = c.cut_length;
+            cell.feature = Some(format!("line {}", p.program.lines[c.start].line));
+            cell
+        })
+        .collect();
+    let machine = Machine {
+        home: p3(home),
+        tool_change: p3(home),
+        clearance,
+        rapid_feed: verify::RAPID_MM_MIN,
+        initial_tool: out_cells.first().map(|c| c.tool.clone()),
+        ..Machine::default()
+    };
+    let n = out_cells.len();
+    let inst = Instance {
+        name: p.file.clone(),
+        meta: Metadata {
+            generator: Some("gcode".into()),
+            ..Metadata::default()
+        },
+        machine,
+        tools,
+        cells: out_cells,
+        precedence,
+        as_given: Some((0..n).map(|i| Visit::new(i, 0)).collect()),
+        matrix: None,
+        first: None,
+        last: None,
+    };
+    (inst, dropped)
+}
+
+/// The whole program as one instance (groups chained by precedence), for `cellseq import`.
+pub fn import(p: &Parsed, merge: bool, margin: f64) -> Result<Instance> {
+    let gs = groups(&p.layout, merge);
+    let all: Vec<usize> = gs.iter().flatten().copied().collect();
+    let home = p.layout.start.unwrap_or(p.layout.cells[0].entry);
+    let (mut inst, _) = group_instance(p, &all, home, margin);
+    // overlap edges only within a group; groups in order
+    let mut pos = 0;
+    let mut starts = Vec::new();
+    for g in &gs {
+        starts.push(pos);
+        pos += g.len();
+    }
+    let mut edges: Vec<(usize, usize)> = Vec::new();
+    for (k, g) in gs.iter().enumerate() {
+        let local: Vec<usize> = g.clone();
+        let (e, _) = cells::precedence(&p.layout, &local, margin);
+        edges.extend(e.into_iter().map(|(a, b)| (a + starts[k], b + starts[k])));
+        if k + 1 < gs.len() {
+            let pairs = g.len() * gs[k + 1].len();
+            if edges.len() + pairs > 20_000_000 {
+                return Err(Error::invalid(
+                    &p.file,
+                    "too many tool-block precedence edges to export",
+                ));
+            }
+            for a in 0..g.len() {
+                for b in 0..gs[k + 1].len() {
+                    edges.push((starts[k] + a, starts[k + 1] + b));
+                }
+            }
+        }
+    }
+    inst.precedence = edges;
+    Ok(inst)
+}
+
+/// The result of [`optimize`].
+#[derive(Debug, Clone)]
+pub struct Optimized {
+    /// The new order (indices into the layout's cells).
+    pub order: Vec<usize>,
+    /// The new program text.
+    pub text: String,
+    /// Figures of the original.
+    pub before: Figures,
+    /// Figures of the new program.
+    pub after: Figures,
+    /// Cutting moves compared.
+    pub cuts: usize,
+    /// Groups where the inner-first rule was dropped.
+    pub inner_first_dropped: usize,
+    /// Solver seconds.
+    pub solve_s: f64,
+    /// True when the solver's order was worse than the original order, which was kept.
+    pub kept_original: bool,
+}
+
+/// Tolerance (mm) of the cutting-move comparison.
+pub const TOLERANCE: f64 = 1e-3;
+
+/// Sequences the cells group by group with a registry solver, writes the program and
+/// verifies it against the original (an error if any cutting move differs).
+pub fn optimize(p: &Parsed, opts: &Options) -> Result<Optimized> {
+    if opts.reversible {
+        return Err(Error::invalid(
+            &p.file,
+            "reversing G-code cells is not supported yet; run without --reversible",
+        ));
+    }
+    let l = &p.layout;
+    let gs = groups(l, opts.merge);
+    let total: usize = l.cells.len();
+    let mut order = Vec::with_capacity(total);
+    let mut home = l.start.unwrap_or(l.cells[0].entry);
+    let mut dropped = 0;
+    let mut solve_s = 0.0;
+    for g in &gs {
+        let (inst, d) = group_instance(p, g, home, opts.margin);
+        dropped += d as usize;
+        crate::validate::validate(&inst, &p.file)?;
+        let budget = Budget {
+            time_limit: opts
+                .time_limit
+                .map(|t| std::time::Duration::from_secs_f64(t * g.len() as f64 / total as f64)),
+            max_evals: None,
+        };
+        let r = solvers::run(
+            &opts.solver,
+            &inst,
+            Objective::Air,
+            &Default::default(),
+            opts.seed,
+            budget,
+            &mut NoObserver,
+        )?;
+        solve_s += r.elapsed_s;
+        for v in &r.outcome.sequence {
+            order.push(g[v.cell]);
+        }
+        if let Some(v) = r.outcome.sequence.last() {
+            home = l.cells[g[v.cell]].exit;
+        }
+    }
+    let mut text = write::write(&p.program, l, &order, opts.merge);
+    let mut check = verify_texts(&p.file, &p.program, "<optimized>", &text, safe_height(p))?;
+    // never worse than the program's own order (regenerated the same way)
+    let given: Vec<usize> = gs.iter().flatten().copied().collect();
+    let mut kept_original = false;
+    if given != order {
+        let t2 = write::write(&p.program, l, &given, opts.merge);
+        let c2 = verify_texts(&p.file, &p.program, "<optimized>", &t2, safe_height(p))?;
+        if c2.after.air_length < check.after.air_length - 1e-9 {
+            text = t2;
+            check = c2;
+            order = given;
+            kept_original = true;
+        }
+    }
+    Ok(Optimized {
+        kept_original,
+        order,
+        text,
+        before: check.before,
+        after: check.after,
+        cuts: check.cuts,
+        inner_first_dropped: dropped,
+        solve_s,
+    })
+}
+
+/// What [`verify_texts`] found.
+#[derive(Debug, Clone, Copy, Serialize)]
+pub struct Verification {
+    /// Cutting moves matched.
+    pub cuts: usize,
+    /// Original figures.
+    pub before: Figures,
+    /// New figures.
+    pub after: Figures,
+}
+
+use serde::Serialize;
+
+/// Interprets `new_text` and checks its cutting moves against the original's.
+pub fn verify_texts(
+    orig_file: &str,
+    orig: &Program,
+    new_file: &str,
+    new_text: &str,
+    safe: Option<f64>,
+) -> Result<Verification> {
+    let np = interp::interpret(new_text).map_err(|(l, m)| Error::parse(new_file, l, m))?;
+    let cuts = verify::same_cuts(orig, &np, TOLERANCE)
+        .map_err(|m| Error::invalid(new_file, format!("not equivalent to {orig_file}: {m}")))?;
+    Ok(Verification {
+        cuts,
+        before: verify::figures(orig, safe),
+        after: verify::figures(&np, safe),
+    })
+}
+
+/// `verify-gcode`: parses both files and compares them.
+pub fn verify_files(
+    orig_file: &str,
+    orig_text: &str,
+    new_file: &str,
+    new_text: &str,
+) -> Result<Verification> {
+    let p = parse(orig_file, orig_text)?;
+    verify_texts(orig_file, &p.program, new_file, new_text, safe_height(&p))
+}
