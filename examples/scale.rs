@@ -12,9 +12,11 @@ fn peak_rss_mib() -> f64 {
     std::fs::read_to_string("/proc/self/status")
         .ok()
         .and_then(|s| {
-            s.lines()
-                .find(|l| l.starts_with("VmHWM:"))
-                .and_then(|l| l.split_whitespace().nth(1).and_then(|v| v.parse::<f64>().ok()))
+            s.lines().find(|l| l.starts_with("VmHWM:")).and_then(|l| {
+                l.split_whitespace()
+                    .nth(1)
+                    .and_then(|v| v.parse::<f64>().ok())
+            })
         })
         .map(|kb| kb / 1024.0)
         .unwrap_or(f64::NAN)
@@ -22,7 +24,11 @@ fn peak_rss_mib() -> f64 {
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().skip(1).collect();
-    let n: usize = args.first().map(|s| s.parse()).transpose()?.unwrap_or(100_000);
+    let n: usize = args
+        .first()
+        .map(|s| s.parse())
+        .transpose()?
+        .unwrap_or(100_000);
     let solver = args.get(1).cloned().unwrap_or_else(|| "greedy".into());
     let mut gp: BTreeMap<String, String> = BTreeMap::new();
     gp.insert("n".into(), n.to_string());
@@ -38,9 +44,21 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     }
     let t = Instant::now();
     let inst = cellseq::generate::generate("uniform", &gp, 1)?;
-    println!("generated {} cells in {:.2} s", inst.n(), t.elapsed().as_secs_f64());
+    println!(
+        "generated {} cells in {:.2} s",
+        inst.n(),
+        t.elapsed().as_secs_f64()
+    );
     let t = Instant::now();
-    let r = solvers::run(&solver, &inst, Objective::Air, &sp, 1, Budget::default(), &mut NoObserver)?;
+    let r = solvers::run(
+        &solver,
+        &inst,
+        Objective::Air,
+        &sp,
+        1,
+        Budget::default(),
+        &mut NoObserver,
+    )?;
     println!(
         "{solver}: air {:.0} mm in {:.2} s (solver {:.2} s incl. check), peak RSS {:.0} MiB",
         r.report.air_length,

@@ -183,6 +183,7 @@ pub fn group_instance(
         matrix: None,
         first: None,
         last: None,
+        closed: false,
     };
     (inst, dropped)
 }
