@@ -13,6 +13,7 @@ pub mod generate;
 pub mod geom;
 pub mod model;
 pub mod params;
+pub mod plot;
 pub mod precedence;
 pub mod solvers;
 pub mod validate;

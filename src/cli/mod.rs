@@ -1,6 +1,7 @@
 //! Command-line interface: argument definitions and dispatch. One module per command group.
 
 mod demo;
+mod plot;
 mod solve;
 
 use clap::{Parser, Subcommand};
@@ -29,6 +30,8 @@ enum Command {
     Generate(solve::GenerateArgs),
     /// Run the built-in demonstration on a generated instance (no files needed).
     Demo(demo::DemoArgs),
+    /// Draw an instance (and a solution's air moves) to an SVG or PNG picture.
+    Plot(plot::PlotArgs),
 }
 
 /// Runs the parsed command.
@@ -41,5 +44,6 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<()> {
         Command::Solvers => solve::solvers(),
         Command::Generate(a) => solve::generate(a),
         Command::Demo(a) => demo::demo(a),
+        Command::Plot(a) => plot::plot(a),
     }
 }
