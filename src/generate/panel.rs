@@ -56,6 +56,12 @@ pub static SPECS: &[ParamSpec] = &[
         help: "grid spacing (mm)",
     },
     ParamSpec {
+        name: "pitch_var",
+        default: "0.3",
+        kind: ParamKind::Float,
+        help: "column widths and row heights vary by ± this fraction of the pitch (< 0.5)",
+    },
+    ParamSpec {
         name: "skew",
         default: "0",
         kind: ParamKind::Float,
@@ -267,6 +273,7 @@ pub fn generate(p: &Params, seed: u64) -> Result<Instance> {
     let rows = p.int("rows") as usize;
     let cols = p.int("cols") as usize;
     let pitch = p.float("pitch");
+    let pitch_var = p.float("pitch_var");
     let skew = p.float("skew");
     let jitter = p.float("jitter");
     let rib = p.float("rib");
@@ -288,8 +295,15 @@ pub fn generate(p: &Params, seed: u64) -> Result<Instance> {
     if !(0.0 < dmin && dmin <= dmax && dmax < thickness) {
         return bad("need 0 < depth_min <= depth_max < thickness".into());
     }
-    if !(0.0 < rmin && rmin <= rmax && 2.0 * rmax + rib < 0.6 * pitch) {
-        return bad("need 0 < radius_min <= radius_max and 2 radius_max + rib < 0.6 pitch".into());
+    if !(0.0..0.5).contains(&pitch_var) {
+        return bad("pitch_var must lie in [0, 0.5)".into());
+    }
+    let min_pitch = pitch * (1.0 - pitch_var);
+    if !(0.0 < rmin && rmin <= rmax && 2.0 * rmax + rib < 0.6 * min_pitch) {
+        return bad(
+            "need 0 < radius_min <= radius_max and 2 radius_max + rib < 0.6 pitch (1 - pitch_var)"
+                .into(),
+        );
     }
     if !(0.0..0.2).contains(&jitter) || !(-1.0..=1.0).contains(&skew) {
         return bad("jitter must lie in [0, 0.2) and skew in [-1, 1]".into());
@@ -305,12 +319,19 @@ pub fn generate(p: &Params, seed: u64) -> Result<Instance> {
     let mu = p.float("mu");
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
 
-    // grid nodes
+    // grid nodes: irregular column widths and row heights, skew, inner-node jitter
+    let mut col_x = vec![flange];
+    for _ in 0..cols {
+        let w = pitch * (1.0 + rng.random_range(-pitch_var..=pitch_var));
+        col_x.push(col_x.last().copied().unwrap_or(0.0) + w);
+    }
+    let mut row_y = vec![flange];
+    for _ in 0..rows {
+        let h = pitch * (1.0 + rng.random_range(-pitch_var..=pitch_var));
+        row_y.push(row_y.last().copied().unwrap_or(0.0) + h);
+    }
     let node = |i: usize, j: usize, d: (f64, f64)| -> (f64, f64) {
-        (
-            flange + i as f64 * pitch + j as f64 * pitch * skew + d.0,
-            flange + j as f64 * pitch + d.1,
-        )
+        (col_x[i] + (row_y[j] - flange) * skew + d.0, row_y[j] + d.1)
     };
     let mut nodes = vec![vec![(0.0, 0.0); rows + 1]; cols + 1];
     for (i, col) in nodes.iter_mut().enumerate() {
@@ -318,8 +339,8 @@ pub fn generate(p: &Params, seed: u64) -> Result<Instance> {
             let inner = i > 0 && i < cols && j > 0 && j < rows;
             let d = if inner && jitter > 0.0 {
                 (
-                    rng.random_range(-jitter..jitter) * pitch,
-                    rng.random_range(-jitter..jitter) * pitch,
+                    rng.random_range(-jitter..jitter) * min_pitch,
+                    rng.random_range(-jitter..jitter) * min_pitch,
                 )
             } else {
                 (0.0, 0.0)
@@ -607,7 +628,22 @@ pub fn generate(p: &Params, seed: u64) -> Result<Instance> {
         }
     }
     // roughing tool groups, merged by mu
-    toolsel::merge_groups(&jobs, &mut rough_assign, &lib, mu);
+    let census = |assign: &[String]| -> String {
+        let mut parts: Vec<String> = Vec::new();
+        for t in &lib.tools {
+            let k = assign.iter().filter(|a| **a == t.id).count();
+            if k > 0 {
+                parts.push(format!("{}x{k}", t.id));
+            }
+        }
+        parts.join(" ")
+    };
+    let before = census(&rough_assign);
+    let merges = toolsel::merge_groups(&jobs, &mut rough_assign, &lib, mu);
+    let comment = format!(
+        "pocket roughing tools (eta_min {eta_min}): {before}; after {merges} merge(s) at mu > {mu}: {}",
+        census(&rough_assign)
+    );
     for (pk, tid) in pockets.iter().zip(&rough_assign) {
         let t = lib.get(tid).expect("library tool");
         for &c in &pk.rough {
@@ -784,7 +820,10 @@ pub fn generate(p: &Params, seed: u64) -> Result<Instance> {
     };
     Ok(Instance {
         name: format!("panel-{rows}x{cols}-s{seed}"),
-        meta: Metadata::default(),
+        meta: Metadata {
+            comment: Some(comment),
+            ..Metadata::default()
+        },
         machine,
         tools,
         cells: b.cells,
