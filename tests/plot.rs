@@ -31,3 +31,53 @@ fn bad_output_names_are_errors() {
         "{e}"
     );
 }
+
+#[test]
+fn cli_generate_solve_plot() {
+    let exe = env!("CARGO_BIN_EXE_cellseq");
+    let dir = tempfile::tempdir().unwrap();
+    let inst = dir.path().join("p.json");
+    let sol = dir.path().join("s.json");
+    let pic = dir.path().join("p.svg");
+    let run = |args: &[&str]| std::process::Command::new(exe).args(args).output().unwrap();
+    let i = inst.to_str().unwrap();
+    let o = run(&[
+        "generate", "panel", "--param", "rows=1", "--param", "cols=2", "--seed", "3", "-o", i,
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let o = run(&[
+        "solve",
+        i,
+        "--solver",
+        "greedy",
+        "--out",
+        sol.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let o = run(&[
+        "plot",
+        i,
+        "--solution",
+        sol.to_str().unwrap(),
+        "-o",
+        pic.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let svg = std::fs::read_to_string(&pic).unwrap();
+    assert!(svg.contains("greedy") && svg.contains("lifts"));
+    let o = run(&["plot", i, "-o", dir.path().join("p.gif").to_str().unwrap()]);
+    assert!(!o.status.success());
+    assert!(String::from_utf8_lossy(&o.stderr).contains("p.gif"));
+    let o = run(&[
+        "generate",
+        "panel",
+        "--param",
+        "rows=99999999999",
+        "--param",
+        "cols=99999999999",
+        "-o",
+        i,
+    ]);
+    assert!(!o.status.success());
+    assert!(String::from_utf8_lossy(&o.stderr).contains("rows"));
+}

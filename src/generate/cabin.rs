@@ -129,7 +129,11 @@ pub fn generate(p: &Params, seed: u64) -> Result<Instance> {
     if !(0.0..=1.0).contains(&of) {
         return bad("open_fraction must lie in [0, 1]".into());
     }
-    if nf + ngroups * nholes + nfaces > 2_000_000 {
+    if nf
+        .saturating_add(ngroups.saturating_mul(nholes))
+        .saturating_add(nfaces)
+        > 2_000_000
+    {
         return bad("too many cells".into());
     }
     let lib = ToolLibrary::load(p.word("tools"))?;

@@ -152,7 +152,7 @@ pub fn generate(p: &Params, seed: u64) -> Result<Instance> {
         return bad("feeds must be positive".into());
     }
     let circ = std::f64::consts::PI * d;
-    let max_feats = mean + mean / 2;
+    let max_feats = mean.saturating_add(mean / 2);
     if max_feats > 0 && circ / max_feats as f64 <= 50.0 + 3.0 * td {
         return bad(format!(
             "{mean} features per region do not fit on a circumference of {circ:.0} mm: raise diameter"

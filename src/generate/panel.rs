@@ -284,7 +284,7 @@ pub fn generate(p: &Params, seed: u64) -> Result<Instance> {
     let ap = p.float("ap");
     let delta = p.float("delta");
     let bad = |m: String| Err(Error::Param(format!("panel: {m}")));
-    if rows == 0 || cols == 0 || rows * cols > 100_000 {
+    if rows == 0 || cols == 0 || rows.saturating_mul(cols) > 100_000 {
         return bad("rows and cols must be at least 1 (at most 100000 pockets)".into());
     }
     if !(pitch > 0.0 && rib > 0.0 && flange > 0.0 && thickness > 0.0 && ap > 0.0 && delta >= 0.0) {
