@@ -31,6 +31,7 @@ pub mod geom;
 pub mod io;
 pub mod model;
 pub mod params;
+pub mod plot;
 pub mod precedence;
 pub mod solvers;
 pub mod validate;

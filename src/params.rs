@@ -14,6 +14,8 @@ pub enum ParamKind {
     Bool,
     /// One of the listed words.
     Choice(&'static [&'static str]),
+    /// Free text (a file path, a list); the owner checks it.
+    Text,
 }
 
 /// One documented solver parameter.
@@ -99,6 +101,7 @@ fn check_value(owner: &str, spec: &ParamSpec, v: &str) -> Result<()> {
         ParamKind::Float => v.parse::<f64>().is_ok_and(|x| x.is_finite()),
         ParamKind::Bool => v == "true" || v == "false",
         ParamKind::Choice(c) => c.contains(&v),
+        ParamKind::Text => !v.is_empty(),
     };
     if ok {
         Ok(())
@@ -108,6 +111,7 @@ fn check_value(owner: &str, spec: &ParamSpec, v: &str) -> Result<()> {
             ParamKind::Float => "a finite number".to_string(),
             ParamKind::Bool => "true or false".to_string(),
             ParamKind::Choice(c) => format!("one of {}", c.join(", ")),
+            ParamKind::Text => "non-empty text".to_string(),
         };
         Err(Error::Param(format!(
             "'{owner}': parameter '{}' must be {want}, got '{v}'",

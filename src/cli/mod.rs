@@ -2,6 +2,7 @@
 
 mod demo;
 mod gcode;
+mod plot;
 mod solve;
 
 use clap::{Parser, Subcommand};
@@ -36,6 +37,8 @@ enum Command {
     Import(gcode::ImportArgs),
     /// Check that two G-code programs make the same cutting moves; report travel.
     VerifyGcode(gcode::VerifyArgs),
+    /// Draw an instance (and a solution's air moves) to an SVG or PNG picture.
+    Plot(plot::PlotArgs),
 }
 
 /// Runs the parsed command.
@@ -51,5 +54,6 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<()> {
         Command::Optimize(a) => gcode::optimize(a),
         Command::Import(a) => gcode::import(a),
         Command::VerifyGcode(a) => gcode::verify(a),
+        Command::Plot(a) => plot::plot(a),
     }
 }

@@ -316,6 +316,7 @@ pub fn solvers() -> Result<()> {
                 ParamKind::Float => "float".to_string(),
                 ParamKind::Bool => "bool".to_string(),
                 ParamKind::Choice(c) => c.join("|"),
+                ParamKind::Text => "text".to_string(),
             };
             println!("    --param {}={}  [{kind}]  {}", p.name, p.default, p.help);
         }

@@ -5,6 +5,11 @@
 //! To add a generator: write a module with a `SPECS` parameter list and a
 //! `generate(&Params, seed) -> Result<Instance>` function, and list it in [`KINDS`].
 
+pub mod cabin;
+pub mod casing;
+pub mod common;
+pub mod panel;
+pub mod toolsel;
 pub mod uniform;
 
 use crate::error::{Error, Result};
@@ -25,12 +30,32 @@ pub struct GeneratorInfo {
 }
 
 /// All generator kinds.
-pub static KINDS: &[GeneratorInfo] = &[GeneratorInfo {
-    name: "uniform",
-    summary: "cells at random in a box (n, modes, tools, precedence density) for scaling studies",
-    params: uniform::SPECS,
-    generate: uniform::generate,
-}];
+pub static KINDS: &[GeneratorInfo] = &[
+    GeneratorInfo {
+        name: "panel",
+        summary: "aircraft integral panel: pockets on a grid, ribs, flange, outer contour, holes (paper 002)",
+        params: panel::SPECS,
+        generate: panel::generate,
+    },
+    GeneratorInfo {
+        name: "casing",
+        summary: "layered casing: annular regions split into fan-shaped sub-regions over 5 layers (paper 004)",
+        params: casing::SPECS,
+        generate: casing::generate,
+    },
+    GeneratorInfo {
+        name: "cabin",
+        summary: "large cabin part: open/closed features, hole groups, several tools (patent 003)",
+        params: cabin::SPECS,
+        generate: cabin::generate,
+    },
+    GeneratorInfo {
+        name: "uniform",
+        summary: "cells at random in a box (n, modes, tools, precedence density) for scaling studies",
+        params: uniform::SPECS,
+        generate: uniform::generate,
+    },
+];
 
 /// Generates an instance of `kind` from `KEY=VALUE` parameters and a seed.
 pub fn generate(kind: &str, given: &BTreeMap<String, String>, seed: u64) -> Result<Instance> {
