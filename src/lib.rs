@@ -11,6 +11,7 @@ pub mod error;
 pub mod formats;
 pub mod generate;
 pub mod geom;
+pub mod harness;
 pub mod model;
 pub mod params;
 pub mod precedence;

@@ -1,6 +1,7 @@
 //! Command-line interface: argument definitions and dispatch. One module per command group.
 
 mod demo;
+mod harness;
 mod solve;
 
 use clap::{Parser, Subcommand};
@@ -27,8 +28,16 @@ enum Command {
     Solvers,
     /// Generate an instance from a seeded generator.
     Generate(solve::GenerateArgs),
-    /// Run the built-in demonstration on a generated instance (no files needed).
+    /// Run the built-in demonstration campaign into results/demo/ (no files needed).
     Demo(demo::DemoArgs),
+    /// Validate an experiment plan without running it.
+    Check(harness::CheckArgs),
+    /// Run (or resume) an experiment plan.
+    Run(harness::RunArgs),
+    /// Merge result directories or shards, dropping duplicate trials.
+    Merge(harness::MergeArgs),
+    /// Tables, tests and plots from a results directory.
+    Report(harness::ReportArgs),
 }
 
 /// Runs the parsed command.
@@ -41,5 +50,9 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<()> {
         Command::Solvers => solve::solvers(),
         Command::Generate(a) => solve::generate(a),
         Command::Demo(a) => demo::demo(a),
+        Command::Check(a) => harness::check(a),
+        Command::Run(a) => harness::run(a),
+        Command::Merge(a) => harness::merge(a),
+        Command::Report(a) => harness::report(a),
     }
 }
