@@ -119,7 +119,8 @@ pub struct SolverSpec {
 pub struct Paper {
     /// Citation.
     pub source: String,
-    /// The figures.
+    /// The figures (may be empty: the source is then only cited).
+    #[serde(default)]
     pub figures: Vec<Figure>,
 }
 
@@ -142,6 +143,7 @@ pub struct Figure {
 pub const FIGURE_METRICS: &[&str] = &[
     "reduction_pct",
     "air_reduction_pct",
+    "path_reduction_pct",
     "time_reduction_pct",
     "lifts",
     "tool_changes",

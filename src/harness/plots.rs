@@ -14,7 +14,10 @@ static REGISTER: Once = Once::new();
 const FONT_NAME: &str = "sans-serif";
 const SIZE: (u32, u32) = (900, 560);
 
-fn register() {
+/// Registers the embedded DejaVu Sans as plotters' `sans-serif` (idempotent). Anything else
+/// that draws with plotters in this crate's build (e.g. criterion's HTML report in benches)
+/// needs this, because the `ab_glyph` feature has no system-font fallback.
+pub fn register() {
     REGISTER.call_once(|| {
         // The bytes are a valid TTF shipped with the crate; failure would leave text unrendered.
         let _ = register_font(FONT_NAME, FontStyle::Normal, FONT);

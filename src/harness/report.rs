@@ -80,6 +80,8 @@ pub struct SummaryRow {
     pub reduction_pct: f64,
     /// Mean air-length reduction, %.
     pub air_reduction_pct: f64,
+    /// Mean total-path reduction, %.
+    pub path_reduction_pct: f64,
     /// Mean machining-time reduction, %.
     pub time_reduction_pct: f64,
     /// Mean lifts.
@@ -113,6 +115,7 @@ fn summarize(rows: &[&Row], instance: &str, solver: &str) -> SummaryRow {
         ci95_hi: hi,
         reduction_pct: m(|r| r.reduction_pct),
         air_reduction_pct: m(|r| r.air_reduction_pct),
+        path_reduction_pct: m(|r| r.path_reduction_pct),
         time_reduction_pct: m(|r| r.time_reduction_pct),
         lifts: m(|r| r.lifts.map(|x| x as f64)),
         tool_changes: m(|r| r.tool_changes.map(|x| x as f64)),
@@ -262,16 +265,16 @@ pub fn report(dir: &Path, out: &Path) -> Result<ReportFiles> {
     let _ = writeln!(md, "## Per instance and solver\n");
     let _ = writeln!(
         md,
-        "| instance | solver | ok/runs | mean | median | best | std | 95 % CI | red. % | air red. % | time red. % | lifts | tool ch. | mach. time s | gap bks % | wall s |"
+        "| instance | solver | ok/runs | mean | median | best | std | 95 % CI | red. % | air red. % | path red. % | time red. % | lifts | tool ch. | mach. time s | gap bks % | wall s |"
     );
     let _ = writeln!(
         md,
-        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
     );
     for s in &summary {
         let _ = writeln!(
             md,
-            "| {} | {} | {}/{} | {} | {} | {} | {} | [{}, {}] | {} | {} | {} | {} | {} | {} | {} | {} |",
+            "| {} | {} | {}/{} | {} | {} | {} | {} | [{}, {}] | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
             s.instance,
             s.solver,
             s.feasible,
@@ -284,6 +287,7 @@ pub fn report(dir: &Path, out: &Path) -> Result<ReportFiles> {
             fmt(s.ci95_hi),
             fmt(s.reduction_pct),
             fmt(s.air_reduction_pct),
+            fmt(s.path_reduction_pct),
             fmt(s.time_reduction_pct),
             fmt(s.lifts),
             fmt(s.tool_changes),
@@ -527,6 +531,7 @@ pub fn report(dir: &Path, out: &Path) -> Result<ReportFiles> {
                 .filter_map(|r| match f.metric.as_str() {
                     "reduction_pct" => r.reduction_pct,
                     "air_reduction_pct" => r.air_reduction_pct,
+                    "path_reduction_pct" => r.path_reduction_pct,
                     "time_reduction_pct" => r.time_reduction_pct,
                     "lifts" => r.lifts.map(|x| x as f64),
                     "tool_changes" => r.tool_changes.map(|x| x as f64),

@@ -50,6 +50,8 @@ pub struct Row {
     pub cost: Option<f64>,
     /// Air length, mm.
     pub air_length: Option<f64>,
+    /// Total path length (cut + air), mm.
+    pub path_length: Option<f64>,
     /// Lifts.
     pub lifts: Option<u64>,
     /// Tool changes.
@@ -62,6 +64,8 @@ pub struct Row {
     pub reduction_pct: Option<f64>,
     /// Air-length reduction against as-given, %.
     pub air_reduction_pct: Option<f64>,
+    /// Total-path-length reduction against as-given, %.
+    pub path_reduction_pct: Option<f64>,
     /// Machining-time reduction against as-given, %.
     pub time_reduction_pct: Option<f64>,
     /// Best-known value (bks.csv beside the instance file).
@@ -153,12 +157,14 @@ impl Default for Row {
             error: String::new(),
             cost: None,
             air_length: None,
+            path_length: None,
             lifts: None,
             tool_changes: None,
             machining_time: None,
             as_given_cost: None,
             reduction_pct: None,
             air_reduction_pct: None,
+            path_reduction_pct: None,
             time_reduction_pct: None,
             best_known: None,
             gap_bks_pct: None,

@@ -51,8 +51,8 @@ pub struct Prepared {
     pub instance: Instance,
     /// Its objective.
     pub objective: Objective,
-    /// as-given report: (cost, air length, machining time).
-    pub as_given: Option<(f64, f64, f64)>,
+    /// as-given report: (cost, air length, machining time, path length).
+    pub as_given: Option<(f64, f64, f64, f64)>,
     /// Best-known value and whether proven optimal.
     pub bks: Option<(f64, bool)>,
     /// Precedence density.
@@ -84,7 +84,14 @@ pub fn prepare(plan: &Plan, idx: usize) -> Result<Prepared> {
         &mut NoObserver,
     )
     .ok()
-    .map(|r| (r.report.cost, r.report.air_length, r.report.machining_time));
+    .map(|r| {
+        (
+            r.report.cost,
+            r.report.air_length,
+            r.report.machining_time,
+            r.report.path_length,
+        )
+    });
     let density = instance.precedence_density();
     Ok(Prepared {
         instance,
@@ -176,12 +183,14 @@ pub fn run_trial(plan: &Plan, prep: &Prepared, t: &Trial, calib_s: f64) -> (Row,
             row.feasible = true;
             row.cost = Some(rep.cost);
             row.air_length = Some(rep.air_length);
+            row.path_length = Some(rep.path_length);
             row.lifts = Some(rep.lifts);
             row.tool_changes = Some(rep.tool_changes);
             row.machining_time = Some(rep.machining_time);
             row.reduction_pct = pct_less(row.as_given_cost, row.cost);
             if !inst.is_matrix() {
                 row.air_reduction_pct = pct_less(prep.as_given.map(|a| a.1), row.air_length);
+                row.path_reduction_pct = pct_less(prep.as_given.map(|a| a.3), row.path_length);
                 row.time_reduction_pct = pct_less(prep.as_given.map(|a| a.2), row.machining_time);
             }
             row.gap_bks_pct = gap(row.cost, row.best_known);
