@@ -64,6 +64,7 @@ fn opts(out: &Path, threads: usize) -> RunOptions {
         out: out.to_path_buf(),
         progress: false,
         throttle_ms: 0,
+        replace_foreign: false,
     }
 }
 
@@ -347,4 +348,27 @@ fn paper_plans_are_well_formed_toml_plans() {
             );
         }
     }
+}
+
+#[test]
+fn another_plans_results_are_never_mixed_in() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("o");
+    let a = Plan::parse("plan.toml", PLAN, dir.path()).unwrap();
+    run_plan(&a, &opts(&out, 2)).unwrap();
+    let b = Plan::parse(
+        "plan.toml",
+        &PLAN.replace("seed = 7", "seed = 8"),
+        dir.path(),
+    )
+    .unwrap();
+    let e = run_plan(&b, &opts(&out, 2)).unwrap_err().to_string();
+    assert!(
+        e.contains("do not belong to this plan") && e.contains("results.csv"),
+        "{e}"
+    );
+    let mut o = opts(&out, 2);
+    o.replace_foreign = true;
+    let s = run_plan(&b, &o).unwrap();
+    assert_eq!((s.ran, s.skipped), (s.planned, 0));
 }

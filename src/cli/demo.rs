@@ -38,6 +38,7 @@ pub fn demo(a: DemoArgs) -> Result<()> {
         out: a.out.clone(),
         progress: true,
         throttle_ms: 0,
+        replace_foreign: true,
     };
     super::harness::execute(&plan, &opts)?;
     let r = report::report(&a.out, &a.out.join("report"))?;

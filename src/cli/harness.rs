@@ -105,6 +105,7 @@ pub fn run(a: RunArgs) -> Result<()> {
         out,
         progress: true,
         throttle_ms: a.throttle_ms,
+        replace_foreign: false,
     };
     execute(&plan, &opts)
 }

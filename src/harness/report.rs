@@ -233,6 +233,30 @@ pub fn report(dir: &Path, out: &Path) -> Result<ReportFiles> {
         );
     }
 
+    // instances and their features
+    let _ = writeln!(md, "## Instances\n");
+    let _ = writeln!(
+        md,
+        "| instance | source | n | tools | cells per tool | precedence density | as-given cost | best known |\n|---|---|---|---|---|---|---|---|"
+    );
+    for i in &instances {
+        if let Some(r) = rows.iter().find(|r| &r.instance == i) {
+            let _ = writeln!(
+                md,
+                "| {} | {} | {} | {} | {} | {} | {} | {} |",
+                r.instance,
+                r.generator,
+                r.n,
+                r.tools,
+                fmt(r.n as f64 / r.tools.max(1) as f64),
+                fmt(r.precedence_density),
+                r.as_given_cost.map(fmt).unwrap_or_else(|| "–".into()),
+                r.best_known.map(fmt).unwrap_or_else(|| "–".into())
+            );
+        }
+    }
+    let _ = writeln!(md);
+
     // failures
     let failed: Vec<&Row> = rows.iter().filter(|r| !r.feasible).collect();
     if !failed.is_empty() {

@@ -26,6 +26,8 @@ pub struct Row {
     pub gen_params: String,
     /// Number of cells.
     pub n: usize,
+    /// Number of distinct tools the cells use.
+    pub tools: usize,
     /// Precedence density (transitive closure / n(n-1)/2).
     pub precedence_density: f64,
     /// Solver registry name.
@@ -145,6 +147,7 @@ impl Default for Row {
             generator: String::new(),
             gen_params: String::new(),
             n: 0,
+            tools: 0,
             precedence_density: 0.0,
             solver: String::new(),
             solver_id: String::new(),

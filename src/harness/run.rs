@@ -28,6 +28,9 @@ pub struct RunOptions {
     pub progress: bool,
     /// Sleep this long after each trial (testing hook for interruption tests).
     pub throttle_ms: u64,
+    /// When the output already holds trials of another plan: discard them (true, used by the
+    /// demo) or refuse to run (false), so results are never mixed or silently lost.
+    pub replace_foreign: bool,
 }
 
 /// What a run did.
@@ -164,6 +167,7 @@ pub fn run_trial(plan: &Plan, prep: &Prepared, t: &Trial, calib_s: f64) -> (Row,
         generator: inst.meta.generator.clone().unwrap_or_else(|| "file".into()),
         gen_params: kv(&inst.meta.params),
         n: inst.n(),
+        tools: inst.used_tools().len(),
         precedence_density: prep.density,
         solver: sref.name.clone(),
         solver_id: sref.id.clone(),
@@ -351,6 +355,19 @@ pub fn run_plan(plan: &Plan, opts: &RunOptions) -> Result<RunSummary> {
     // resume: keep complete rows of this plan, drop torn lines and traces of unfinished trials
     let (mut done_rows, torn) = read_lenient::<Row>(&files.results)?;
     let before = done_rows.len();
+    let foreign = done_rows
+        .iter()
+        .filter(|r| !order.contains_key(&r.run_key))
+        .count();
+    if foreign > 0 && !opts.replace_foreign {
+        return Err(Error::invalid(
+            files.results.display().to_string(),
+            format!(
+                "{foreign} of its {before} trials do not belong to this plan (another plan, seed, \
+                 budget or shard wrote them); choose another --out directory"
+            ),
+        ));
+    }
     let mut seen = BTreeSet::new();
     done_rows.retain(|r| order.contains_key(&r.run_key) && seen.insert(r.run_key.clone()));
     let (mut done_traces, torn_t) = read_lenient::<TraceRow>(&files.traces)?;
