@@ -213,6 +213,8 @@ where
     chart
         .configure_mesh()
         .x_desc("cells n")
+        .x_labels(6)
+        .x_label_formatter(&|x| format!("{x:.0}"))
         .y_desc("wall seconds per trial (mean)")
         .label_style((FONT_NAME, 13))
         .draw()
@@ -249,7 +251,7 @@ where
         .background_style(WHITE.mix(0.8))
         .border_style(BLACK)
         .label_font((FONT_NAME, 13))
-        .position(SeriesLabelPosition::UpperLeft)
+        .position(SeriesLabelPosition::LowerRight)
         .draw()
         .map_err(err)?;
     root.present().map_err(err)?;

@@ -620,11 +620,14 @@ pub fn report(dir: &Path, out: &Path) -> Result<ReportFiles> {
             let pts = instances
                 .iter()
                 .filter_map(|i| {
+                    // feasible trials only: a quick refusal says nothing about scaling
                     let g = by.get(&(i.clone(), s.clone()))?;
-                    Some((
-                        g[0].n as f64,
-                        mean(&g.iter().map(|r| r.wall_elapsed_s).collect::<Vec<_>>()),
-                    ))
+                    let t: Vec<f64> = g
+                        .iter()
+                        .filter(|r| r.feasible)
+                        .map(|r| r.wall_elapsed_s)
+                        .collect();
+                    (!t.is_empty()).then(|| (g[0].n as f64, mean(&t)))
                 })
                 .collect();
             (s.clone(), pts)
@@ -725,7 +728,7 @@ pub fn report(dir: &Path, out: &Path) -> Result<ReportFiles> {
         plots::curve_plot(
             &plot_dir,
             "convergence",
-            "Convergence: median gap to best found (band: quartiles)",
+            "Convergence: median gap to best found, runs with a solution by then (band: quartiles)",
             "wall seconds",
             "gap to best found %",
             &conv,
