@@ -28,6 +28,7 @@ pub mod error;
 pub mod formats;
 pub mod generate;
 pub mod geom;
+pub mod harness;
 pub mod io;
 pub mod model;
 pub mod params;

@@ -1,58 +1,48 @@
-//! `demo`: the built-in default job — needs no files.
+//! `demo`: the built-in campaign — needs no files. Runs the plan embedded from
+//! `experiments/demo.toml` and writes results, report and plots into `results/demo/`.
 
 use anyhow::Result;
-use cellseq::solvers::{self, Budget, NoObserver};
+use cellseq::harness::plan::Plan;
+use cellseq::harness::run::RunOptions;
+use cellseq::harness::{DEMO_PLAN, report};
 use clap::Args;
-use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
 
 #[derive(Args, Debug)]
 pub struct DemoArgs {
-    /// Seed of the generated instance and of the solvers.
-    #[arg(long, default_value_t = 1)]
-    seed: u64,
+    /// Output directory.
+    #[arg(long, default_value = "results/demo")]
+    out: PathBuf,
+    /// Worker threads (default: all cores).
+    #[arg(long)]
+    threads: Option<usize>,
 }
 
 pub fn demo(a: DemoArgs) -> Result<()> {
-    let params: BTreeMap<String, String> = [("n", "14"), ("tools", "2"), ("density", "0.05")]
-        .into_iter()
-        .map(|(k, v)| (k.to_string(), v.to_string()))
-        .collect();
-    let inst = cellseq::generate::generate("uniform", &params, a.seed)?;
-    let objective = inst.default_objective();
+    let plan = Plan::parse(
+        "experiments/demo.toml (built in)",
+        DEMO_PLAN,
+        Path::new("."),
+    )?;
     println!(
-        "instance {} ({} cells), objective {}",
-        inst.name,
-        inst.n(),
-        objective.name()
+        "demo campaign: {} instances x {} solvers x {} replicates ({} trials, evaluation budget {})",
+        plan.instances.len(),
+        plan.solvers.len(),
+        plan.file.replicates,
+        plan.trials().len(),
+        plan.file.budget.label()
     );
-    println!(
-        "{:<12} {:>12} {:>12} {:>6} {:>6}",
-        "solver", "time_s", "air_mm", "lifts", "tools"
-    );
-    for s in solvers::registry() {
-        let budget = Budget {
-            time_limit: None,
-            max_evals: Some(2_000_000),
-        };
-        match solvers::run(
-            s.name,
-            &inst,
-            objective,
-            &BTreeMap::new(),
-            a.seed,
-            budget,
-            &mut NoObserver,
-        ) {
-            Ok(r) => println!(
-                "{:<12} {:>12.3} {:>12.3} {:>6} {:>6}",
-                s.name,
-                r.report.machining_time,
-                r.report.air_length,
-                r.report.lifts,
-                r.report.tool_changes
-            ),
-            Err(e) => println!("{:<12} failed: {e}", s.name),
-        }
-    }
+    let opts = RunOptions {
+        threads: a.threads,
+        shard: None,
+        out: a.out.clone(),
+        progress: true,
+        throttle_ms: 0,
+        replace_foreign: true,
+    };
+    super::harness::execute(&plan, &opts)?;
+    let r = report::report(&a.out, &a.out.join("report"))?;
+    println!("report    {}", r.markdown.display());
+    println!("plots     {}", a.out.join("report").join("plots").display());
     Ok(())
 }

@@ -2,6 +2,7 @@
 
 mod demo;
 mod gcode;
+mod harness;
 mod plot;
 mod solve;
 
@@ -29,7 +30,7 @@ enum Command {
     Solvers,
     /// Generate an instance from a seeded generator.
     Generate(solve::GenerateArgs),
-    /// Run the built-in demonstration on a generated instance (no files needed).
+    /// Run the built-in demonstration campaign into results/demo/ (no files needed).
     Demo(demo::DemoArgs),
     /// Reorder a G-code program's cells, verify it cuts the same, and write it.
     Optimize(gcode::OptimizeArgs),
@@ -39,6 +40,14 @@ enum Command {
     VerifyGcode(gcode::VerifyArgs),
     /// Draw an instance (and a solution's air moves) to an SVG or PNG picture.
     Plot(plot::PlotArgs),
+    /// Validate an experiment plan without running it.
+    Check(harness::CheckArgs),
+    /// Run (or resume) an experiment plan.
+    Run(harness::RunArgs),
+    /// Merge result directories or shards, dropping duplicate trials.
+    Merge(harness::MergeArgs),
+    /// Tables, tests and plots from a results directory.
+    Report(harness::ReportArgs),
 }
 
 /// Runs the parsed command.
@@ -55,5 +64,9 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<()> {
         Command::Import(a) => gcode::import(a),
         Command::VerifyGcode(a) => gcode::verify(a),
         Command::Plot(a) => plot::plot(a),
+        Command::Check(a) => harness::check(a),
+        Command::Run(a) => harness::run(a),
+        Command::Merge(a) => harness::merge(a),
+        Command::Report(a) => harness::report(a),
     }
 }

@@ -1,0 +1,134 @@
+//! `check`, `run`, `merge`, `report`: the research harness (see `cellseq::harness`).
+
+use anyhow::{Result, bail};
+use cellseq::harness::plan::Plan;
+use cellseq::harness::run::{RunOptions, run_plan};
+use cellseq::harness::{report, results};
+use clap::Args;
+use std::path::{Path, PathBuf};
+
+#[derive(Args, Debug)]
+pub struct CheckArgs {
+    /// Experiment plan (TOML).
+    plan: PathBuf,
+}
+
+#[derive(Args, Debug)]
+pub struct RunArgs {
+    /// Experiment plan (TOML).
+    plan: PathBuf,
+    /// Worker threads (default: all cores).
+    #[arg(long)]
+    threads: Option<usize>,
+    /// Run only shard I of N (1-based), e.g. `--shard 2/8`.
+    #[arg(long, value_name = "I/N")]
+    shard: Option<String>,
+    /// Output directory (default: results/<plan name>).
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Testing hook: sleep this many milliseconds after each trial.
+    #[arg(long, hide = true, default_value_t = 0)]
+    throttle_ms: u64,
+}
+
+#[derive(Args, Debug)]
+pub struct MergeArgs {
+    /// Directories holding results*.csv / traces*.csv / manifest*.json.
+    #[arg(required = true)]
+    dirs: Vec<PathBuf>,
+    /// Output directory (default: the first directory).
+    #[arg(long)]
+    out: Option<PathBuf>,
+}
+
+#[derive(Args, Debug)]
+pub struct ReportArgs {
+    /// Results directory (results.csv, traces.csv, manifest.json).
+    dir: PathBuf,
+    /// Report directory (default: DIR/report).
+    #[arg(long)]
+    out: Option<PathBuf>,
+}
+
+/// Parses `I/N`.
+pub fn parse_shard(s: &str) -> Result<(usize, usize)> {
+    let Some((i, n)) = s.split_once('/') else {
+        bail!("--shard '{s}': expected I/N, e.g. 1/4");
+    };
+    let (Ok(i), Ok(n)) = (i.trim().parse::<usize>(), n.trim().parse::<usize>()) else {
+        bail!("--shard '{s}': expected I/N with whole numbers, e.g. 1/4");
+    };
+    if n == 0 || i == 0 || i > n {
+        bail!("--shard '{s}': I must lie in 1..=N");
+    }
+    Ok((i, n))
+}
+
+pub fn check(a: CheckArgs) -> Result<()> {
+    let plan = Plan::load(&a.plan)?;
+    println!(
+        "ok: {} instances x {} solvers x {} replicates = {} trials (reference {})",
+        plan.instances.len(),
+        plan.solvers.len(),
+        plan.file.replicates,
+        plan.trials().len(),
+        plan.reference
+    );
+    Ok(())
+}
+
+/// Runs a plan and prints a summary.
+pub fn execute(plan: &Plan, opts: &RunOptions) -> Result<()> {
+    let s = run_plan(plan, opts)?;
+    println!(
+        "{} trials: {} run now, {} already done, {} without a feasible result",
+        s.planned, s.ran, s.skipped, s.failed
+    );
+    println!("results   {}", s.files.results.display());
+    println!("traces    {}", s.files.traces.display());
+    println!("manifest  {}", s.files.manifest.display());
+    Ok(())
+}
+
+pub fn run(a: RunArgs) -> Result<()> {
+    let plan = Plan::load(&a.plan)?;
+    let shard = a.shard.as_deref().map(parse_shard).transpose()?;
+    if a.threads == Some(0) {
+        bail!("--threads must be at least 1");
+    }
+    let out = a
+        .out
+        .unwrap_or_else(|| Path::new("results").join(&plan.file.name));
+    let opts = RunOptions {
+        threads: a.threads,
+        shard,
+        out,
+        progress: true,
+        throttle_ms: a.throttle_ms,
+        replace_foreign: false,
+    };
+    execute(&plan, &opts)
+}
+
+pub fn merge(a: MergeArgs) -> Result<()> {
+    for d in &a.dirs {
+        if !d.is_dir() {
+            bail!("{}: not a directory", d.display());
+        }
+    }
+    let out = a.out.unwrap_or_else(|| a.dirs[0].clone());
+    let (rows, dups) = results::merge(&a.dirs, &out)?;
+    println!(
+        "merged {rows} trials ({dups} duplicates dropped) into {}",
+        out.join("results.csv").display()
+    );
+    Ok(())
+}
+
+pub fn report(a: ReportArgs) -> Result<()> {
+    let out = a.out.unwrap_or_else(|| a.dir.join("report"));
+    let r = report::report(&a.dir, &out)?;
+    println!("report    {}", r.markdown.display());
+    println!("plots     {}", out.join("plots").display());
+    Ok(())
+}

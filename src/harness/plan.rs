@@ -1,0 +1,599 @@
+//! Experiment plans (`experiments/*.toml`): parsing, validation and expansion into trials.
+//!
+//! A plan lists instances (files, globs, or generator specs with parameter grids), solvers with
+//! parameters (a list value is a grid), replicates, a budget, an objective and a reference
+//! solver. [`Plan::load`] / [`Plan::parse`] validate everything that can be validated without
+//! running: unknown solvers, generators or parameters, malformed values, missing files, globs
+//! that match nothing, empty grids, duplicate ids and a reference that is not in the plan.
+
+use super::hash::{hex, stable_hash, trial_seed};
+use crate::error::{Error, Result};
+use crate::generate::KINDS;
+use crate::model::Objective;
+use crate::params::Params;
+use crate::solvers;
+use serde::Deserialize;
+use std::collections::{BTreeMap, BTreeSet};
+use std::path::{Path, PathBuf};
+
+/// The plan file as written.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PlanFile {
+    /// Campaign name.
+    pub name: String,
+    /// Master seed of every trial seed.
+    #[serde(default = "one")]
+    pub seed: u64,
+    /// Independent runs per (instance, solver).
+    #[serde(default = "one_u32")]
+    pub replicates: u32,
+    /// `time`, `air` or `matrix`; the instance's default when absent.
+    #[serde(default)]
+    pub objective: Option<String>,
+    /// Solver id every other solver is tested against (default: the first solver).
+    #[serde(default)]
+    pub reference: Option<String>,
+    /// Work limit of each trial.
+    pub budget: BudgetSpec,
+    /// Instance sources.
+    pub instances: Vec<InstanceSpec>,
+    /// Solvers.
+    pub solvers: Vec<SolverSpec>,
+    /// Published figures to print beside ours.
+    #[serde(default)]
+    pub paper: Option<Paper>,
+}
+
+fn one() -> u64 {
+    1
+}
+fn one_u32() -> u32 {
+    1
+}
+
+/// A trial budget: any combination of limits; at least one must be set.
+#[derive(Debug, Clone, Default, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct BudgetSpec {
+    /// Wall-clock seconds.
+    #[serde(default)]
+    pub seconds: Option<f64>,
+    /// Counted evaluations (deterministic).
+    #[serde(default)]
+    pub evaluations: Option<u64>,
+    /// Multiples of the machine calibration unit (seconds of the calibration kernel).
+    #[serde(default)]
+    pub calibration_units: Option<f64>,
+}
+
+impl BudgetSpec {
+    /// The budget as written in the `budget` column (no machine-dependent numbers).
+    pub fn label(&self) -> String {
+        let mut parts = Vec::new();
+        if let Some(e) = self.evaluations {
+            parts.push(format!("evals={e}"));
+        }
+        if let Some(s) = self.seconds {
+            parts.push(format!("seconds={s}"));
+        }
+        if let Some(c) = self.calibration_units {
+            parts.push(format!("calib={c}"));
+        }
+        parts.join(";")
+    }
+}
+
+/// One instance source: `files` (paths or globs, relative to the plan file) or a generator.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct InstanceSpec {
+    /// Files or glob patterns.
+    #[serde(default)]
+    pub files: Vec<String>,
+    /// Generator kind.
+    #[serde(default)]
+    pub generator: Option<String>,
+    /// Generator seeds (default `[1]`).
+    #[serde(default)]
+    pub seeds: Option<Vec<u64>>,
+    /// Generator parameters; a list is a grid axis.
+    #[serde(default)]
+    pub grid: BTreeMap<String, toml::Value>,
+}
+
+/// One solver entry; `name = "*"` means every registered solver with default parameters.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SolverSpec {
+    /// Registry name, or `*`.
+    pub name: String,
+    /// Parameters; a list is a grid axis.
+    #[serde(default)]
+    pub params: BTreeMap<String, toml::Value>,
+}
+
+/// Published results to print beside ours.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Paper {
+    /// Citation.
+    pub source: String,
+    /// The figures (may be empty: the source is then only cited).
+    #[serde(default)]
+    pub figures: Vec<Figure>,
+}
+
+/// One published figure and the metric of ours it corresponds to.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Figure {
+    /// Human label.
+    pub label: String,
+    /// One of [`FIGURE_METRICS`].
+    pub metric: String,
+    /// The paper's value.
+    pub value: f64,
+    /// Solver id the metric is taken from (default: the best solver by mean reduction).
+    #[serde(default)]
+    pub solver: Option<String>,
+}
+
+/// Metrics a paper figure can be compared with (means over the solver's feasible trials).
+pub const FIGURE_METRICS: &[&str] = &[
+    "reduction_pct",
+    "air_reduction_pct",
+    "path_reduction_pct",
+    "time_reduction_pct",
+    "lifts",
+    "tool_changes",
+    "machining_time",
+    "air_length",
+];
+
+/// Where an instance comes from.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Source {
+    /// An instance file.
+    File(PathBuf),
+    /// A generator call.
+    Generated {
+        /// Generator kind.
+        kind: String,
+        /// Parameters.
+        params: BTreeMap<String, String>,
+        /// Seed.
+        seed: u64,
+    },
+}
+
+/// An instance of the campaign.
+#[derive(Debug, Clone, PartialEq)]
+pub struct InstanceRef {
+    /// Unique id (file stem, or generator, grid values and seed).
+    pub id: String,
+    /// Source.
+    pub source: Source,
+}
+
+/// A solver configuration of the campaign.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SolverRef {
+    /// Unique id: the name, with the given parameters in brackets.
+    pub id: String,
+    /// Registry name.
+    pub name: String,
+    /// Given parameters (defaults are filled in by the solver).
+    pub params: BTreeMap<String, String>,
+}
+
+/// One run: an instance, a solver configuration and a replicate.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Trial {
+    /// Position in plan order.
+    pub index: usize,
+    /// Index into [`Plan::instances`].
+    pub instance: usize,
+    /// Index into [`Plan::solvers`].
+    pub solver: usize,
+    /// Replicate number (0-based).
+    pub replicate: u32,
+    /// Derived seed.
+    pub seed: u64,
+    /// Idempotency key.
+    pub key: String,
+}
+
+/// A validated, expanded plan.
+#[derive(Debug, Clone)]
+pub struct Plan {
+    /// The file contents, parsed.
+    pub file: PlanFile,
+    /// The plan text (stored in the manifest).
+    pub text: String,
+    /// Hash of the plan text.
+    pub hash: String,
+    /// Instances in plan order.
+    pub instances: Vec<InstanceRef>,
+    /// Solver configurations in plan order.
+    pub solvers: Vec<SolverRef>,
+    /// Objective, when the plan fixes one.
+    pub objective: Option<Objective>,
+    /// Reference solver id.
+    pub reference: String,
+}
+
+fn value_text(v: &toml::Value) -> Option<String> {
+    match v {
+        toml::Value::String(s) => Some(s.clone()),
+        toml::Value::Integer(i) => Some(i.to_string()),
+        toml::Value::Float(f) => Some(f.to_string()),
+        toml::Value::Boolean(b) => Some(b.to_string()),
+        _ => None,
+    }
+}
+
+/// Expands `{k: v or [v...]}` into the cartesian product, in key order then value order.
+fn expand_grid(
+    file: &str,
+    what: &str,
+    grid: &BTreeMap<String, toml::Value>,
+) -> Result<Vec<BTreeMap<String, String>>> {
+    let mut out = vec![BTreeMap::new()];
+    for (k, v) in grid {
+        let values: Vec<String> = match v {
+            toml::Value::Array(a) => {
+                if a.is_empty() {
+                    return Err(Error::invalid(
+                        file,
+                        format!("{what}: parameter '{k}' has an empty grid"),
+                    ));
+                }
+                a.iter()
+                    .map(|x| {
+                        value_text(x).ok_or_else(|| {
+                            Error::invalid(
+                                file,
+                                format!("{what}: parameter '{k}' has a non-scalar value"),
+                            )
+                        })
+                    })
+                    .collect::<Result<_>>()?
+            }
+            other => vec![value_text(other).ok_or_else(|| {
+                Error::invalid(
+                    file,
+                    format!("{what}: parameter '{k}' has a non-scalar value"),
+                )
+            })?],
+        };
+        let mut next = Vec::with_capacity(out.len() * values.len());
+        for base in &out {
+            for v in &values {
+                let mut m = base.clone();
+                m.insert(k.clone(), v.clone());
+                next.push(m);
+            }
+        }
+        out = next;
+    }
+    Ok(out)
+}
+
+fn params_suffix(p: &BTreeMap<String, String>) -> String {
+    p.iter()
+        .map(|(k, v)| format!("{k}={v}"))
+        .collect::<Vec<_>>()
+        .join(",")
+}
+
+impl Plan {
+    /// Reads and validates a plan file; relative paths are resolved against its directory.
+    pub fn load(path: &Path) -> Result<Plan> {
+        let text = crate::formats::read_text(path)?;
+        let base = path.parent().unwrap_or(Path::new(".")).to_path_buf();
+        Plan::parse(&path.display().to_string(), &text, &base)
+    }
+
+    /// Parses and validates plan text. `file` names the plan in errors.
+    pub fn parse(file: &str, text: &str, base: &Path) -> Result<Plan> {
+        let pf: PlanFile = toml::from_str(text).map_err(|e| Error::invalid(file, e.to_string()))?;
+        let bad = |m: String| Error::invalid(file, m);
+        if pf.replicates == 0 {
+            return Err(bad("replicates must be at least 1".into()));
+        }
+        let b = &pf.budget;
+        if b.seconds.is_none() && b.evaluations.is_none() && b.calibration_units.is_none() {
+            return Err(bad(
+                "budget: set seconds, evaluations or calibration_units".into()
+            ));
+        }
+        for (name, v) in [
+            ("seconds", b.seconds),
+            ("calibration_units", b.calibration_units),
+        ] {
+            if let Some(x) = v
+                && !(x.is_finite() && x > 0.0)
+            {
+                return Err(bad(format!(
+                    "budget.{name} must be a positive number, got {x}"
+                )));
+            }
+        }
+        let objective = match &pf.objective {
+            None => None,
+            Some(s) => Some(Objective::parse(s).ok_or_else(|| {
+                bad(format!(
+                    "unknown objective '{s}' (known: time, air, matrix)"
+                ))
+            })?),
+        };
+        // instances
+        if pf.instances.is_empty() {
+            return Err(bad("no [[instances]]".into()));
+        }
+        let mut instances = Vec::new();
+        for (i, spec) in pf.instances.iter().enumerate() {
+            let what = format!("instances[{i}]");
+            match (&spec.generator, spec.files.is_empty()) {
+                (Some(_), false) => {
+                    return Err(bad(format!(
+                        "{what}: give either files or generator, not both"
+                    )));
+                }
+                (None, true) => return Err(bad(format!("{what}: give files or a generator"))),
+                (None, false) => {
+                    if spec.seeds.is_some() || !spec.grid.is_empty() {
+                        return Err(bad(format!(
+                            "{what}: seeds and grid apply to generators only"
+                        )));
+                    }
+                    for pat in &spec.files {
+                        let full = base.join(pat);
+                        let full_s = full.display().to_string();
+                        let mut found: Vec<PathBuf> = glob::glob(&full_s)
+                            .map_err(|e| bad(format!("{what}: bad pattern '{pat}': {e}")))?
+                            .filter_map(|p| p.ok())
+                            .filter(|p| p.is_file())
+                            .collect();
+                        found.sort();
+                        if found.is_empty() {
+                            return Err(bad(format!("{what}: '{pat}' matches no file ({full_s})")));
+                        }
+                        for p in found {
+                            instances.push(InstanceRef {
+                                id: crate::formats::stem_name(&p),
+                                source: Source::File(p),
+                            });
+                        }
+                    }
+                }
+                (Some(kind), true) => {
+                    let info = KINDS.iter().find(|k| k.name == kind).ok_or_else(|| {
+                        bad(format!(
+                            "{what}: unknown generator '{kind}' (known: {})",
+                            KINDS.iter().map(|k| k.name).collect::<Vec<_>>().join(", ")
+                        ))
+                    })?;
+                    let seeds = spec.seeds.clone().unwrap_or_else(|| vec![1]);
+                    if seeds.is_empty() {
+                        return Err(bad(format!("{what}: empty seeds list")));
+                    }
+                    for params in expand_grid(file, &what, &spec.grid)? {
+                        Params::new(kind, info.params, &params)
+                            .map_err(|e| bad(format!("{what}: {e}")))?;
+                        for &seed in &seeds {
+                            let mut id = kind.clone();
+                            for (k, v) in &params {
+                                id.push_str(&format!("-{k}{v}"));
+                            }
+                            id.push_str(&format!("-s{seed}"));
+                            instances.push(InstanceRef {
+                                id,
+                                source: Source::Generated {
+                                    kind: kind.clone(),
+                                    params: params.clone(),
+                                    seed,
+                                },
+                            });
+                        }
+                    }
+                }
+            }
+        }
+        let mut seen = BTreeSet::new();
+        for inst in &instances {
+            if !seen.insert(inst.id.clone()) {
+                return Err(bad(format!("instance id '{}' occurs twice", inst.id)));
+            }
+        }
+        // solvers
+        if pf.solvers.is_empty() {
+            return Err(bad("no [[solvers]]".into()));
+        }
+        let mut solvers_out = Vec::new();
+        for (i, spec) in pf.solvers.iter().enumerate() {
+            let what = format!("solvers[{i}]");
+            if spec.name == "*" {
+                if !spec.params.is_empty() {
+                    return Err(bad(format!("{what}: '*' takes no parameters")));
+                }
+                for info in solvers::registry() {
+                    solvers_out.push(SolverRef {
+                        id: info.name.to_string(),
+                        name: info.name.to_string(),
+                        params: BTreeMap::new(),
+                    });
+                }
+                continue;
+            }
+            let info = solvers::find(&spec.name).map_err(|e| bad(format!("{what}: {e}")))?;
+            for params in expand_grid(file, &what, &spec.params)? {
+                Params::new(info.name, info.params, &params)
+                    .map_err(|e| bad(format!("{what}: {e}")))?;
+                let id = if params.is_empty() {
+                    info.name.to_string()
+                } else {
+                    format!("{}[{}]", info.name, params_suffix(&params))
+                };
+                solvers_out.push(SolverRef {
+                    id,
+                    name: info.name.to_string(),
+                    params,
+                });
+            }
+        }
+        let mut seen = BTreeSet::new();
+        solvers_out.retain(|s| seen.insert(s.id.clone()));
+        let reference = match &pf.reference {
+            Some(r) => {
+                if !solvers_out.iter().any(|s| &s.id == r) {
+                    return Err(bad(format!(
+                        "reference solver '{r}' is not among the plan's solvers ({})",
+                        solvers_out
+                            .iter()
+                            .map(|s| s.id.as_str())
+                            .collect::<Vec<_>>()
+                            .join(", ")
+                    )));
+                }
+                r.clone()
+            }
+            None => solvers_out[0].id.clone(),
+        };
+        if let Some(p) = &pf.paper {
+            for f in &p.figures {
+                if !FIGURE_METRICS.contains(&f.metric.as_str()) {
+                    return Err(bad(format!(
+                        "paper figure '{}': unknown metric '{}' (known: {})",
+                        f.label,
+                        f.metric,
+                        FIGURE_METRICS.join(", ")
+                    )));
+                }
+                if let Some(s) = &f.solver
+                    && !solvers_out.iter().any(|x| &x.id == s)
+                {
+                    return Err(bad(format!(
+                        "paper figure '{}': solver '{s}' is not in the plan",
+                        f.label
+                    )));
+                }
+            }
+        }
+        Ok(Plan {
+            hash: hex(stable_hash(&[text.as_bytes()])),
+            text: text.to_string(),
+            file: pf,
+            instances,
+            solvers: solvers_out,
+            objective,
+            reference,
+        })
+    }
+
+    /// Every trial in plan order: instance-major, then solver, then replicate.
+    pub fn trials(&self) -> Vec<Trial> {
+        let mut out = Vec::new();
+        let budget = self.file.budget.label();
+        let objective = self.objective.map(|o| o.name()).unwrap_or("default");
+        for (ii, inst) in self.instances.iter().enumerate() {
+            for (si, s) in self.solvers.iter().enumerate() {
+                for r in 0..self.file.replicates {
+                    let seed = trial_seed(self.file.seed, &inst.id, &s.id, r);
+                    let key = hex(stable_hash(&[
+                        inst.id.as_bytes(),
+                        source_text(&inst.source).as_bytes(),
+                        s.id.as_bytes(),
+                        &r.to_le_bytes(),
+                        &seed.to_le_bytes(),
+                        budget.as_bytes(),
+                        objective.as_bytes(),
+                    ]));
+                    out.push(Trial {
+                        index: out.len(),
+                        instance: ii,
+                        solver: si,
+                        replicate: r,
+                        seed,
+                        key,
+                    });
+                }
+            }
+        }
+        out
+    }
+}
+
+fn source_text(s: &Source) -> String {
+    match s {
+        Source::File(p) => format!("file:{}", p.display()),
+        Source::Generated { kind, params, seed } => {
+            format!("gen:{kind}:{}:{seed}", params_suffix(params))
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parse(t: &str) -> Result<Plan> {
+        Plan::parse("plan.toml", t, Path::new("."))
+    }
+
+    const OK: &str = r#"
+name = "t"
+replicates = 2
+[budget]
+evaluations = 1000
+[[instances]]
+generator = "uniform"
+seeds = [1, 2]
+grid = { n = [5, 8], tools = 2 }
+[[solvers]]
+name = "greedy"
+[[solvers]]
+name = "as-given"
+"#;
+
+    #[test]
+    fn expands_grid_and_trials() {
+        let p = parse(OK).unwrap();
+        assert_eq!(p.instances.len(), 4);
+        assert_eq!(p.instances[0].id, "uniform-n5-tools2-s1");
+        assert_eq!(p.solvers.len(), 2);
+        assert_eq!(p.reference, "greedy");
+        let t = p.trials();
+        assert_eq!(t.len(), 16);
+        let keys: BTreeSet<_> = t.iter().map(|x| x.key.clone()).collect();
+        assert_eq!(keys.len(), 16);
+    }
+
+    #[test]
+    fn rejects_bad_plans() {
+        let cases = [
+            (OK.replace("\"greedy\"", "\"nope\""), "unknown solver"),
+            (OK.replace("n = [5, 8]", "n = []"), "empty grid"),
+            (OK.replace("tools = 2", "toolz = 2"), "no parameter 'toolz'"),
+            (OK.replace("generator = \"uniform\"", "generator = \"x\""), "unknown generator"),
+            (OK.replace("evaluations = 1000", ""), "budget"),
+            (OK.replace("replicates = 2", "replicates = 2\nreference = \"sa\""), "reference solver"),
+            (
+                OK.replace("[[instances]]\ngenerator = \"uniform\"\nseeds = [1, 2]\ngrid = { n = [5, 8], tools = 2 }", "[[instances]]\nfiles = [\"nowhere/*.sop\"]"),
+                "matches no file",
+            ),
+        ];
+        for (text, want) in cases {
+            let e = parse(&text).unwrap_err().to_string();
+            assert!(e.contains(want), "{e} should mention {want}");
+            assert!(e.starts_with("plan.toml"), "{e}");
+        }
+    }
+
+    #[test]
+    fn star_means_all_registered() {
+        let p = parse(&OK.replace("name = \"greedy\"", "name = \"*\"")).unwrap();
+        assert_eq!(p.solvers.len(), solvers::registry().len());
+    }
+}

@@ -1,0 +1,838 @@
+//! `cellseq report`: tables, tests and plots from a results directory, deterministically
+//! (same input files, same output bytes for the tables; plots depend on the same data only).
+
+use super::hash::stable_hash;
+use super::plan::PlanFile;
+use super::plots;
+use super::results::{Row, TraceRow, read_lenient, read_strict};
+use super::stats::{
+    bootstrap_ci_mean, friedman, holm, mean, median, quantile, std_dev, wilcoxon_signed_rank,
+};
+use crate::error::{Error, Result};
+use std::collections::{BTreeMap, BTreeSet};
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+/// Bootstrap resamples for the confidence intervals.
+pub const BOOTSTRAP_RESAMPLES: usize = 2000;
+/// Relative gap to the best found cost that counts as reaching the target (ECDF of time).
+pub const TARGET_GAP: f64 = 0.01;
+
+/// What the report wrote.
+#[derive(Debug, Clone)]
+pub struct ReportFiles {
+    /// The Markdown report.
+    pub markdown: PathBuf,
+    /// Every file written.
+    pub files: Vec<PathBuf>,
+}
+
+fn fmt(x: f64) -> String {
+    if x.is_nan() {
+        "–".into()
+    } else if x.abs() >= 1e5 || (x != 0.0 && x.abs() < 1e-3) {
+        format!("{x:.4e}")
+    } else {
+        format!("{x:.3}")
+    }
+}
+
+fn opt(v: &[Option<f64>]) -> Vec<f64> {
+    v.iter().flatten().copied().collect()
+}
+
+/// Order of first appearance.
+fn ordered<'a>(it: impl Iterator<Item = &'a str>) -> Vec<String> {
+    let mut seen = BTreeSet::new();
+    let mut out = Vec::new();
+    for s in it {
+        if seen.insert(s.to_string()) {
+            out.push(s.to_string());
+        }
+    }
+    out
+}
+
+/// One line of the summary table.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct SummaryRow {
+    /// Instance id.
+    pub instance: String,
+    /// Solver id.
+    pub solver: String,
+    /// Trials.
+    pub runs: usize,
+    /// Feasible trials.
+    pub feasible: usize,
+    /// Mean cost.
+    pub mean: f64,
+    /// Median cost.
+    pub median: f64,
+    /// Best cost.
+    pub best: f64,
+    /// Standard deviation of the cost.
+    pub std: f64,
+    /// 95 % bootstrap CI of the mean, lower end.
+    pub ci95_lo: f64,
+    /// 95 % bootstrap CI of the mean, upper end.
+    pub ci95_hi: f64,
+    /// Mean reduction against as-given (objective), %.
+    pub reduction_pct: f64,
+    /// Mean air-length reduction, %.
+    pub air_reduction_pct: f64,
+    /// Mean total-path reduction, %.
+    pub path_reduction_pct: f64,
+    /// Mean machining-time reduction, %.
+    pub time_reduction_pct: f64,
+    /// Mean lifts.
+    pub lifts: f64,
+    /// Mean tool changes.
+    pub tool_changes: f64,
+    /// Mean machining time, s.
+    pub machining_time: f64,
+    /// Mean gap to best known, %.
+    pub gap_bks_pct: f64,
+    /// Mean wall seconds.
+    pub wall_runtime_s: f64,
+}
+
+fn summarize(rows: &[&Row], instance: &str, solver: &str) -> SummaryRow {
+    let ok: Vec<&&Row> = rows.iter().filter(|r| r.feasible).collect();
+    let cost: Vec<f64> = ok.iter().filter_map(|r| r.cost).collect();
+    let m = |f: fn(&Row) -> Option<f64>| mean(&opt(&ok.iter().map(|r| f(r)).collect::<Vec<_>>()));
+    let seed = stable_hash(&[instance.as_bytes(), solver.as_bytes()]);
+    let (lo, hi) = bootstrap_ci_mean(&cost, 0.95, BOOTSTRAP_RESAMPLES, seed);
+    SummaryRow {
+        instance: instance.into(),
+        solver: solver.into(),
+        runs: rows.len(),
+        feasible: ok.len(),
+        mean: mean(&cost),
+        median: median(&cost),
+        best: quantile(&cost, 0.0),
+        std: std_dev(&cost),
+        ci95_lo: lo,
+        ci95_hi: hi,
+        reduction_pct: m(|r| r.reduction_pct),
+        air_reduction_pct: m(|r| r.air_reduction_pct),
+        path_reduction_pct: m(|r| r.path_reduction_pct),
+        time_reduction_pct: m(|r| r.time_reduction_pct),
+        lifts: m(|r| r.lifts.map(|x| x as f64)),
+        tool_changes: m(|r| r.tool_changes.map(|x| x as f64)),
+        machining_time: m(|r| r.machining_time),
+        gap_bks_pct: m(|r| r.gap_bks_pct),
+        wall_runtime_s: mean(&rows.iter().map(|r| r.wall_elapsed_s).collect::<Vec<_>>()),
+    }
+}
+
+fn write_csv<T: serde::Serialize>(path: &Path, rows: &[T]) -> Result<()> {
+    let mut w = csv::Writer::from_writer(Vec::new());
+    for r in rows {
+        w.serialize(r)
+            .map_err(|e| Error::invalid(path.display().to_string(), e.to_string()))?;
+    }
+    let bytes = w
+        .into_inner()
+        .map_err(|e| Error::invalid(path.display().to_string(), e.to_string()))?;
+    crate::formats::write_atomic(path, &bytes)
+}
+
+/// One Wilcoxon comparison.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct TestRow {
+    /// Instance id (`ALL` for the pooled test over (instance, replicate) pairs).
+    pub instance: String,
+    /// Solver compared with the reference.
+    pub solver: String,
+    /// Reference solver.
+    pub reference: String,
+    /// Pairs used.
+    pub pairs: usize,
+    /// Mean of solver − reference cost.
+    pub mean_diff: f64,
+    /// V statistic.
+    pub v: f64,
+    /// Two-sided p-value.
+    pub p: f64,
+    /// Holm-adjusted p-value (over all per-instance comparisons; the pooled rows separately).
+    pub p_holm: f64,
+    /// `better`, `worse` or `n.s.` at the 5 % level after correction.
+    pub verdict: String,
+}
+
+/// Writes the report of the results in `dir` into `out`.
+pub fn report(dir: &Path, out: &Path) -> Result<ReportFiles> {
+    let results = dir.join("results.csv");
+    if !results.exists() {
+        return Err(Error::invalid(
+            dir.display().to_string(),
+            "no results.csv here (run `cellseq run`, or `cellseq merge` the shards first)",
+        ));
+    }
+    let rows: Vec<Row> = read_strict(&results)?;
+    if rows.is_empty() {
+        return Err(Error::invalid(
+            results.display().to_string(),
+            "no trials in the file",
+        ));
+    }
+    let traces: Vec<TraceRow> = read_lenient(&dir.join("traces.csv"))?.0;
+    let manifest: Option<serde_json::Value> = std::fs::read_to_string(dir.join("manifest.json"))
+        .ok()
+        .and_then(|t| serde_json::from_str(&t).ok());
+    let plan: Option<PlanFile> = manifest
+        .as_ref()
+        .and_then(|m| m["plan"].as_str())
+        .and_then(|t| toml::from_str(t).ok());
+    std::fs::create_dir_all(out).map_err(|e| Error::io(out.display().to_string(), e))?;
+    let mut files = Vec::new();
+
+    let instances = ordered(rows.iter().map(|r| r.instance.as_str()));
+    let solvers = ordered(rows.iter().map(|r| r.solver_id.as_str()));
+    let reference = manifest
+        .as_ref()
+        .and_then(|m| m["reference"].as_str().map(String::from))
+        .filter(|r| solvers.contains(r))
+        .unwrap_or_else(|| solvers[0].clone());
+    let mut by: BTreeMap<(String, String), Vec<&Row>> = BTreeMap::new();
+    for r in &rows {
+        by.entry((r.instance.clone(), r.solver_id.clone()))
+            .or_default()
+            .push(r);
+    }
+
+    let mut md = String::new();
+    let title = plan
+        .as_ref()
+        .map(|p| p.name.clone())
+        .unwrap_or_else(|| dir.display().to_string());
+    let _ = writeln!(md, "# Report: {title}\n");
+    let _ = writeln!(
+        md,
+        "{} trials, {} instances, {} solvers; reference solver `{reference}`. Costs are the objective \
+         (`{}`); reductions are against the as-given (as-programmed) order; CIs are 95 % percentile \
+         bootstrap ({BOOTSTRAP_RESAMPLES} resamples, fixed seed).\n",
+        rows.len(),
+        instances.len(),
+        solvers.len(),
+        ordered(rows.iter().map(|r| r.objective.as_str())).join(", ")
+    );
+    if let Some(m) = &manifest {
+        let _ = writeln!(
+            md,
+            "Run: cellseq {} (commit {}), plan hash `{}`, {} thread(s) on {}, calibration unit {} s.\n",
+            m["crate_version"].as_str().unwrap_or("?"),
+            m["git_commit"].as_str().unwrap_or("unknown"),
+            m["plan_hash"].as_str().unwrap_or("?"),
+            m["threads"],
+            m["cpu_model"].as_str().unwrap_or("?"),
+            m["calibration_seconds"]
+                .as_f64()
+                .map(fmt)
+                .unwrap_or_else(|| "?".into())
+        );
+    }
+
+    // instances and their features
+    let _ = writeln!(md, "## Instances\n");
+    let _ = writeln!(
+        md,
+        "| instance | source | n | tools | cells per tool | precedence density | as-given cost | best known |\n|---|---|---|---|---|---|---|---|"
+    );
+    for i in &instances {
+        if let Some(r) = rows.iter().find(|r| &r.instance == i) {
+            let _ = writeln!(
+                md,
+                "| {} | {} | {} | {} | {} | {} | {} | {} |",
+                r.instance,
+                r.generator,
+                r.n,
+                r.tools,
+                fmt(r.n as f64 / r.tools.max(1) as f64),
+                fmt(r.precedence_density),
+                r.as_given_cost.map(fmt).unwrap_or_else(|| "–".into()),
+                r.best_known.map(fmt).unwrap_or_else(|| "–".into())
+            );
+        }
+    }
+    let _ = writeln!(md);
+
+    // failures
+    let failed: Vec<&Row> = rows.iter().filter(|r| !r.feasible).collect();
+    if !failed.is_empty() {
+        let _ = writeln!(
+            md,
+            "## Trials without a feasible result ({})\n",
+            failed.len()
+        );
+        let mut seen = BTreeSet::new();
+        for r in &failed {
+            if seen.insert((r.instance.clone(), r.solver_id.clone())) {
+                let _ = writeln!(md, "- `{}` on `{}`: {}", r.solver_id, r.instance, r.error);
+            }
+        }
+        let _ = writeln!(md);
+    }
+
+    // summary table
+    let mut summary = Vec::new();
+    for i in &instances {
+        for s in &solvers {
+            if let Some(g) = by.get(&(i.clone(), s.clone())) {
+                summary.push(summarize(g, i, s));
+            }
+        }
+    }
+    let sum_csv = out.join("summary.csv");
+    write_csv(&sum_csv, &summary)?;
+    files.push(sum_csv);
+    let _ = writeln!(md, "## Per instance and solver\n");
+    let _ = writeln!(
+        md,
+        "| instance | solver | ok/runs | mean | median | best | std | 95 % CI | red. % | air red. % | path red. % | time red. % | lifts | tool ch. | mach. time s | gap bks % | wall s |"
+    );
+    let _ = writeln!(
+        md,
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
+    );
+    for s in &summary {
+        let _ = writeln!(
+            md,
+            "| {} | {} | {}/{} | {} | {} | {} | {} | [{}, {}] | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
+            s.instance,
+            s.solver,
+            s.feasible,
+            s.runs,
+            fmt(s.mean),
+            fmt(s.median),
+            fmt(s.best),
+            fmt(s.std),
+            fmt(s.ci95_lo),
+            fmt(s.ci95_hi),
+            fmt(s.reduction_pct),
+            fmt(s.air_reduction_pct),
+            fmt(s.path_reduction_pct),
+            fmt(s.time_reduction_pct),
+            fmt(s.lifts),
+            fmt(s.tool_changes),
+            fmt(s.machining_time),
+            fmt(s.gap_bks_pct),
+            fmt(s.wall_runtime_s)
+        );
+    }
+    let _ = writeln!(md);
+
+    // per-solver overview
+    let _ = writeln!(md, "## Per solver (all instances)\n");
+    let _ = writeln!(
+        md,
+        "| solver | ok/runs | mean red. % | median red. % | mean lifts | mean tool ch. | mean wall s |"
+    );
+    let _ = writeln!(md, "|---|---|---|---|---|---|---|");
+    let mut overview = Vec::new();
+    for s in &solvers {
+        let g: Vec<&Row> = rows.iter().filter(|r| &r.solver_id == s).collect();
+        let ok: Vec<&&Row> = g.iter().filter(|r| r.feasible).collect();
+        let red = opt(&ok.iter().map(|r| r.reduction_pct).collect::<Vec<_>>());
+        let lifts: Vec<f64> = ok
+            .iter()
+            .filter_map(|r| r.lifts.map(|x| x as f64))
+            .collect();
+        let tc: Vec<f64> = ok
+            .iter()
+            .filter_map(|r| r.tool_changes.map(|x| x as f64))
+            .collect();
+        let wall: Vec<f64> = g.iter().map(|r| r.wall_elapsed_s).collect();
+        let _ = writeln!(
+            md,
+            "| {s} | {}/{} | {} | {} | {} | {} | {} |",
+            ok.len(),
+            g.len(),
+            fmt(mean(&red)),
+            fmt(median(&red)),
+            fmt(mean(&lifts)),
+            fmt(mean(&tc)),
+            fmt(mean(&wall))
+        );
+        overview.push((s.clone(), red, lifts));
+    }
+    let _ = writeln!(md);
+
+    // Wilcoxon vs reference
+    let cost_of = |i: &str, s: &str| -> BTreeMap<u32, f64> {
+        by.get(&(i.to_string(), s.to_string()))
+            .map(|g| {
+                g.iter()
+                    .filter(|r| r.feasible)
+                    .filter_map(|r| r.cost.map(|c| (r.replicate, c)))
+                    .collect()
+            })
+            .unwrap_or_default()
+    };
+    let mut tests: Vec<TestRow> = Vec::new();
+    let mut pooled: Vec<TestRow> = Vec::new();
+    for s in solvers.iter().filter(|s| **s != reference) {
+        let (mut px, mut py) = (Vec::new(), Vec::new());
+        for i in &instances {
+            let a = cost_of(i, s);
+            let b = cost_of(i, &reference);
+            let (mut x, mut y) = (Vec::new(), Vec::new());
+            for (rep, c) in &a {
+                if let Some(d) = b.get(rep) {
+                    x.push(*c);
+                    y.push(*d);
+                }
+            }
+            px.extend(&x);
+            py.extend(&y);
+            if x.is_empty() {
+                continue;
+            }
+            let w = wilcoxon_signed_rank(&x, &y);
+            let diff: Vec<f64> = x.iter().zip(&y).map(|(a, b)| a - b).collect();
+            tests.push(TestRow {
+                instance: i.clone(),
+                solver: s.clone(),
+                reference: reference.clone(),
+                pairs: x.len(),
+                mean_diff: mean(&diff),
+                v: w.v,
+                p: w.p,
+                p_holm: f64::NAN,
+                verdict: String::new(),
+            });
+        }
+        if !px.is_empty() {
+            let w = wilcoxon_signed_rank(&px, &py);
+            let diff: Vec<f64> = px.iter().zip(&py).map(|(a, b)| a - b).collect();
+            pooled.push(TestRow {
+                instance: "ALL".into(),
+                solver: s.clone(),
+                reference: reference.clone(),
+                pairs: px.len(),
+                mean_diff: mean(&diff),
+                v: w.v,
+                p: w.p,
+                p_holm: f64::NAN,
+                verdict: String::new(),
+            });
+        }
+    }
+    for group in [&mut tests, &mut pooled] {
+        let adj = holm(&group.iter().map(|t| t.p).collect::<Vec<_>>());
+        for (t, a) in group.iter_mut().zip(adj) {
+            t.p_holm = a;
+            t.verdict = if a < 0.05 {
+                if t.mean_diff < 0.0 { "better" } else { "worse" }.into()
+            } else {
+                "n.s.".into()
+            };
+        }
+    }
+    let _ = writeln!(
+        md,
+        "## Paired Wilcoxon signed-rank tests against `{reference}`\n\nPairs are replicates of the same \
+         instance; two-sided; Holm correction over all per-instance comparisons (pooled rows corrected \
+         among themselves). `better` = lower cost than the reference at the 5 % level.\n"
+    );
+    let _ = writeln!(
+        md,
+        "| instance | solver | pairs | mean diff | V | p | p (Holm) | verdict |"
+    );
+    let _ = writeln!(md, "|---|---|---|---|---|---|---|---|");
+    for t in pooled.iter().chain(&tests) {
+        let _ = writeln!(
+            md,
+            "| {} | {} | {} | {} | {} | {} | {} | {} |",
+            t.instance,
+            t.solver,
+            t.pairs,
+            fmt(t.mean_diff),
+            t.v,
+            fmt(t.p),
+            fmt(t.p_holm),
+            t.verdict
+        );
+    }
+    let _ = writeln!(md);
+    let tests_csv = out.join("wilcoxon.csv");
+    write_csv(
+        &tests_csv,
+        &pooled.iter().chain(&tests).cloned().collect::<Vec<_>>(),
+    )?;
+    files.push(tests_csv);
+
+    // Friedman over instances (blocks) with solvers feasible everywhere
+    let complete: Vec<&String> = solvers
+        .iter()
+        .filter(|s| instances.iter().all(|i| !cost_of(i, s).is_empty()))
+        .collect();
+    let _ = writeln!(md, "## Friedman test over instances\n");
+    let blocks: Vec<Vec<f64>> = instances
+        .iter()
+        .map(|i| {
+            complete
+                .iter()
+                .map(|s| mean(&cost_of(i, s).values().copied().collect::<Vec<_>>()))
+                .collect()
+        })
+        .collect();
+    match friedman(&blocks) {
+        Some(f) => {
+            let _ = writeln!(
+                md,
+                "Blocks: {} instances (mean cost per instance); treatments: {} solvers with a feasible result on \
+                 every instance. Friedman chi-squared = {}, df = {}, p = {}.\n",
+                blocks.len(),
+                complete.len(),
+                fmt(f.statistic),
+                f.df,
+                fmt(f.p)
+            );
+            let mut order: Vec<usize> = (0..complete.len()).collect();
+            order.sort_by(|&a, &b| f.avg_ranks[a].total_cmp(&f.avg_ranks[b]));
+            let _ = writeln!(md, "| solver | average rank (1 = best) |\n|---|---|");
+            let mut csv_rows = Vec::new();
+            for k in order {
+                let _ = writeln!(md, "| {} | {} |", complete[k], fmt(f.avg_ranks[k]));
+                csv_rows.push((complete[k].clone(), f.avg_ranks[k]));
+            }
+            let p = out.join("friedman.csv");
+            let mut w = csv::Writer::from_writer(Vec::new());
+            let _ = w.write_record(["solver", "average_rank", "statistic", "df", "p"]);
+            for (s, r) in csv_rows {
+                let _ = w.write_record([
+                    s,
+                    r.to_string(),
+                    f.statistic.to_string(),
+                    f.df.to_string(),
+                    f.p.to_string(),
+                ]);
+            }
+            crate::formats::write_atomic(&p, &w.into_inner().unwrap_or_default())?;
+            files.push(p);
+        }
+        None => {
+            let _ = writeln!(
+                md,
+                "Not enough data (needs at least 2 instances and 2 solvers feasible on all of them)."
+            );
+        }
+    }
+    let _ = writeln!(md);
+
+    // paper comparison
+    if let Some(paper) = plan.as_ref().and_then(|p| p.paper.clone()) {
+        let _ = writeln!(
+            md,
+            "## Paper figures beside ours\n\nSource: {}\n",
+            paper.source
+        );
+        let _ = writeln!(md, "| figure | paper | ours | solver |\n|---|---|---|---|");
+        let best_solver = solvers
+            .iter()
+            .filter(|s| **s != "as-given")
+            .map(|s| {
+                let red: Vec<f64> = rows
+                    .iter()
+                    .filter(|r| &r.solver_id == s)
+                    .filter_map(|r| r.reduction_pct)
+                    .collect();
+                (s.clone(), mean(&red))
+            })
+            .filter(|(_, m)| m.is_finite())
+            .max_by(|a, b| a.1.total_cmp(&b.1))
+            .map(|x| x.0);
+        for f in &paper.figures {
+            let solver = f
+                .solver
+                .clone()
+                .or_else(|| best_solver.clone())
+                .unwrap_or_default();
+            let vals: Vec<f64> = rows
+                .iter()
+                .filter(|r| r.solver_id == solver && r.feasible)
+                .filter_map(|r| match f.metric.as_str() {
+                    "reduction_pct" => r.reduction_pct,
+                    "air_reduction_pct" => r.air_reduction_pct,
+                    "path_reduction_pct" => r.path_reduction_pct,
+                    "time_reduction_pct" => r.time_reduction_pct,
+                    "lifts" => r.lifts.map(|x| x as f64),
+                    "tool_changes" => r.tool_changes.map(|x| x as f64),
+                    "machining_time" => r.machining_time,
+                    "air_length" => r.air_length,
+                    _ => None,
+                })
+                .collect();
+            let _ = writeln!(
+                md,
+                "| {} | {} | {} | {} |",
+                f.label,
+                f.value,
+                fmt(mean(&vals)),
+                solver
+            );
+        }
+        let _ = writeln!(md);
+    }
+
+    // plots
+    let plot_dir = out.join("plots");
+    std::fs::create_dir_all(&plot_dir).map_err(|e| Error::io(plot_dir.display().to_string(), e))?;
+    let perr = |e: String| {
+        Error::invalid(
+            plot_dir.display().to_string(),
+            format!("plotting failed: {e}"),
+        )
+    };
+    let mut plots_written = Vec::new();
+    let red_groups: plots::Groups = overview
+        .iter()
+        .map(|(s, r, _)| (s.clone(), r.clone()))
+        .collect();
+    plots_written.extend(
+        plots::box_plot(
+            &plot_dir,
+            "reduction_box",
+            "Reduction against as-given per solver",
+            "reduction %",
+            &red_groups,
+        )
+        .map_err(perr)?,
+    );
+    let lift_groups: plots::Groups = overview
+        .iter()
+        .map(|(s, _, l)| (s.clone(), l.clone()))
+        .collect();
+    plots_written.extend(
+        plots::box_plot(
+            &plot_dir,
+            "lifts_box",
+            "Lifts per solver",
+            "lifts",
+            &lift_groups,
+        )
+        .map_err(perr)?,
+    );
+    let scaling: plots::Scaling = solvers
+        .iter()
+        .map(|s| {
+            let pts = instances
+                .iter()
+                .filter_map(|i| {
+                    // feasible trials only: a quick refusal says nothing about scaling
+                    let g = by.get(&(i.clone(), s.clone()))?;
+                    let t: Vec<f64> = g
+                        .iter()
+                        .filter(|r| r.feasible)
+                        .map(|r| r.wall_elapsed_s)
+                        .collect();
+                    (!t.is_empty()).then(|| (g[0].n as f64, mean(&t)))
+                })
+                .collect();
+            (s.clone(), pts)
+        })
+        .collect();
+    plots_written.extend(plots::scaling_plot(&plot_dir, &scaling).map_err(perr)?);
+
+    // best found per instance (for convergence and time-to-target)
+    let best_found: BTreeMap<&str, f64> = instances
+        .iter()
+        .filter_map(|i| {
+            let b = rows
+                .iter()
+                .filter(|r| &r.instance == i && r.feasible)
+                .filter_map(|r| r.cost)
+                .fold(f64::INFINITY, f64::min);
+            b.is_finite().then_some((i.as_str(), b))
+        })
+        .collect();
+    let mut runs: BTreeMap<&str, Vec<&TraceRow>> = BTreeMap::new();
+    for t in &traces {
+        runs.entry(t.run_key.as_str()).or_default().push(t);
+    }
+    let row_of: BTreeMap<&str, &Row> = rows.iter().map(|r| (r.run_key.as_str(), r)).collect();
+    let tmin = traces
+        .iter()
+        .map(|t| t.wall_elapsed_s)
+        .filter(|x| *x > 0.0)
+        .fold(f64::INFINITY, f64::min);
+    let tmax = rows.iter().map(|r| r.wall_elapsed_s).fold(0.0, f64::max);
+    let grid: Vec<f64> = if tmin.is_finite() && tmax > tmin {
+        (0..60)
+            .map(|k| tmin * (tmax / tmin).powf(k as f64 / 59.0))
+            .collect()
+    } else {
+        Vec::new()
+    };
+    let mut conv: plots::Bands = Vec::new();
+    let mut ttt: plots::Bands = Vec::new();
+    for s in &solvers {
+        let keys: Vec<&str> = rows
+            .iter()
+            .filter(|r| &r.solver_id == s)
+            .map(|r| r.run_key.as_str())
+            .collect();
+        let mut pts = Vec::new();
+        for &t in &grid {
+            let gaps: Vec<f64> = keys
+                .iter()
+                .filter_map(|k| {
+                    let r = row_of.get(k)?;
+                    let bf = *best_found.get(r.instance.as_str())?;
+                    let tr = runs.get(k)?;
+                    let b = tr
+                        .iter()
+                        .filter(|p| p.wall_elapsed_s <= t)
+                        .map(|p| p.best)
+                        .fold(f64::INFINITY, f64::min);
+                    (b.is_finite() && bf.abs() > 0.0).then(|| 100.0 * (b - bf) / bf.abs())
+                })
+                .collect();
+            if !gaps.is_empty() {
+                pts.push((
+                    t,
+                    median(&gaps),
+                    quantile(&gaps, 0.25),
+                    quantile(&gaps, 0.75),
+                ));
+            }
+        }
+        conv.push((s.clone(), pts));
+        // time to target
+        let mut times: Vec<f64> = keys
+            .iter()
+            .filter_map(|k| {
+                let r = row_of.get(k)?;
+                let bf = *best_found.get(r.instance.as_str())?;
+                let target = bf + TARGET_GAP * bf.abs();
+                runs.get(k)?
+                    .iter()
+                    .find(|p| p.best <= target)
+                    .map(|p| p.wall_elapsed_s.max(1e-7))
+            })
+            .collect();
+        times.sort_by(f64::total_cmp);
+        let total = keys.len().max(1) as f64;
+        let e: Vec<_> = times
+            .iter()
+            .enumerate()
+            .map(|(k, &t)| {
+                let y = (k + 1) as f64 / total;
+                (t, y, y, y)
+            })
+            .collect();
+        ttt.push((s.clone(), e));
+    }
+    plots_written.extend(
+        plots::curve_plot(
+            &plot_dir,
+            "convergence",
+            "Convergence: median gap to best found, runs with a solution by then (band: quartiles)",
+            "wall seconds",
+            "gap to best found %",
+            &conv,
+            None,
+            true,
+        )
+        .map_err(perr)?,
+    );
+    plots_written.extend(
+        plots::curve_plot(
+            &plot_dir,
+            "ecdf_time_to_target",
+            &format!(
+                "ECDF of time to reach {} % of the best found",
+                TARGET_GAP * 100.0
+            ),
+            "wall seconds",
+            "fraction of runs",
+            &ttt,
+            Some((0.0, 1.02)),
+            true,
+        )
+        .map_err(perr)?,
+    );
+    // Dolan-More performance profile over (instance, replicate) problems
+    let mut problems: BTreeMap<(String, u32), BTreeMap<String, f64>> = BTreeMap::new();
+    for r in &rows {
+        let e = problems
+            .entry((r.instance.clone(), r.replicate))
+            .or_default();
+        e.insert(
+            r.solver_id.clone(),
+            if r.feasible {
+                r.cost.unwrap_or(f64::INFINITY)
+            } else {
+                f64::INFINITY
+            },
+        );
+    }
+    let mut ratios: BTreeMap<String, Vec<f64>> = BTreeMap::new();
+    for costs in problems.values() {
+        let best = costs.values().copied().fold(f64::INFINITY, f64::min);
+        for s in &solvers {
+            let c = costs.get(s).copied().unwrap_or(f64::INFINITY);
+            let r = if best > 0.0 && best.is_finite() {
+                c / best
+            } else if c == best && c.is_finite() {
+                1.0
+            } else {
+                f64::INFINITY
+            };
+            ratios.entry(s.clone()).or_default().push(r);
+        }
+    }
+    let tau_max = ratios
+        .values()
+        .flatten()
+        .copied()
+        .filter(|r| r.is_finite())
+        .fold(1.0, f64::max)
+        .max(1.0001)
+        * 1.05;
+    let taus: Vec<f64> = (0..80).map(|k| tau_max.powf(k as f64 / 79.0)).collect();
+    let profile: plots::Bands = solvers
+        .iter()
+        .map(|s| {
+            let rs = &ratios[s];
+            let pts = taus
+                .iter()
+                .map(|&t| {
+                    let y = rs.iter().filter(|&&r| r <= t).count() as f64 / rs.len().max(1) as f64;
+                    (t, y, y, y)
+                })
+                .collect();
+            (s.clone(), pts)
+        })
+        .collect();
+    plots_written.extend(
+        plots::curve_plot(
+            &plot_dir,
+            "performance_profile",
+            "Dolan-Moré performance profile",
+            "tau (cost / best cost on the problem)",
+            "fraction of problems within tau",
+            &profile,
+            Some((0.0, 1.02)),
+            true,
+        )
+        .map_err(perr)?,
+    );
+    let _ = writeln!(md, "## Plots\n");
+    for p in plots_written
+        .iter()
+        .filter(|p| p.extension().is_some_and(|e| e == "png"))
+    {
+        let name = p.file_name().and_then(|s| s.to_str()).unwrap_or("");
+        let _ = writeln!(md, "![{name}](plots/{name})\n");
+    }
+    files.extend(plots_written);
+    let md_path = out.join("report.md");
+    crate::formats::write_atomic(&md_path, md.as_bytes())?;
+    files.push(md_path.clone());
+    Ok(ReportFiles {
+        markdown: md_path,
+        files,
+    })
+}
