@@ -5,6 +5,7 @@
 //! for search; a [`solvers::Solver`] returns a [`model::Sequence`]; [`check::check`] verifies it
 //! and recomputes the [`check::Report`] from scratch.
 
+pub mod bound;
 pub mod check;
 pub mod cost;
 pub mod error;

@@ -1,5 +1,6 @@
 //! Command-line interface: argument definitions and dispatch. One module per command group.
 
+mod bound;
 mod demo;
 mod solve;
 
@@ -27,6 +28,8 @@ enum Command {
     Solvers,
     /// Generate an instance from a seeded generator.
     Generate(solve::GenerateArgs),
+    /// Lower bounds on the optimum of an instance.
+    Bound(bound::BoundArgs),
     /// Run the built-in demonstration on a generated instance (no files needed).
     Demo(demo::DemoArgs),
 }
@@ -40,6 +43,7 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<()> {
         Command::Eval(a) => solve::eval(a),
         Command::Solvers => solve::solvers(),
         Command::Generate(a) => solve::generate(a),
+        Command::Bound(a) => bound::bound(a),
         Command::Demo(a) => demo::demo(a),
     }
 }
