@@ -31,23 +31,29 @@ pub fn bound(a: BoundArgs) -> Result<()> {
     let inst = load(&a.file)?;
     let objective = objective_of(&inst, a.objective.as_deref())?;
     let t = Instant::now();
-    // a greedy solution sizes the subgradient steps
-    let upper = solvers::run(
-        "greedy",
-        &inst,
-        objective,
-        &BTreeMap::new(),
-        1,
-        Budget::default(),
-        &mut NoObserver,
-    )
-    .ok()
-    .map(|r| r.report.cost);
+    // a greedy solution sizes the subgradient steps (only needed where the Lagrangian runs)
+    let defaults = BoundOptions::default();
+    let upper = (inst.n() <= defaults.lagrangian_max_cells && a.iterations > 0)
+        .then(|| {
+            let given = BTreeMap::new();
+            solvers::run(
+                "greedy",
+                &inst,
+                objective,
+                &given,
+                1,
+                Budget::default(),
+                &mut NoObserver,
+            )
+            .ok()
+            .map(|r| r.report.cost)
+        })
+        .flatten();
     let model = CostModel::new(&inst, objective);
     let opts = BoundOptions {
         lagrangian_iterations: a.iterations,
         upper,
-        ..BoundOptions::default()
+        ..defaults
     };
     let b = bound::compute(&model, &opts);
     let total = t.elapsed().as_secs_f64();
