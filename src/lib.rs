@@ -22,6 +22,7 @@
 // Index loops are the clearest form for the graph and DP code here.
 #![allow(clippy::needless_range_loop)]
 
+pub mod bound;
 pub mod check;
 pub mod cost;
 pub mod error;

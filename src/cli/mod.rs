@@ -1,5 +1,6 @@
 //! Command-line interface: argument definitions and dispatch. One module per command group.
 
+mod bound;
 mod demo;
 mod gcode;
 mod harness;
@@ -31,6 +32,9 @@ enum Command {
     /// Generate an instance from a seeded generator.
     Generate(solve::GenerateArgs),
     /// Run the built-in demonstration campaign into results/demo/ (no files needed).
+    /// Lower bounds on the optimum of an instance.
+    Bound(bound::BoundArgs),
+    /// Run the built-in demonstration on a generated instance (no files needed).
     Demo(demo::DemoArgs),
     /// Reorder a G-code program's cells, verify it cuts the same, and write it.
     Optimize(gcode::OptimizeArgs),
@@ -59,6 +63,7 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<()> {
         Command::Eval(a) => solve::eval(a),
         Command::Solvers => solve::solvers(),
         Command::Generate(a) => solve::generate(a),
+        Command::Bound(a) => bound::bound(a),
         Command::Demo(a) => demo::demo(a),
         Command::Optimize(a) => gcode::optimize(a),
         Command::Import(a) => gcode::import(a),

@@ -50,6 +50,9 @@ pub struct SolveArgs {
     /// Print one JSON object instead of the human-readable report.
     #[arg(long)]
     pub json: bool,
+    /// Skip the lower bound computed after solving (`lower_bound`, `certified_gap_percent`).
+    #[arg(long)]
+    pub no_bound: bool,
 }
 
 #[derive(Args, Debug)]
@@ -154,7 +157,7 @@ pub fn solve(a: SolveArgs) -> Result<()> {
         time_limit: a.time_limit.map(Duration::from_secs_f64),
         max_evals: a.max_evals,
     };
-    let r = solvers::run(
+    let mut r = solvers::run(
         &a.solver,
         &inst,
         objective,
@@ -163,6 +166,9 @@ pub fn solve(a: SolveArgs) -> Result<()> {
         budget,
         &mut NoObserver,
     )?;
+    if !a.no_bound {
+        attach_bound(&inst, &mut r);
+    }
     let bk = best_known(&a.file).map(|b| b.0);
     if let Some(out) = &a.out {
         let sol = solution_file(&inst, &a.solver, a.seed, &r);
@@ -178,6 +184,26 @@ pub fn solve(a: SolveArgs) -> Result<()> {
         print_report(&inst, &a.solver, &r, bk);
     }
     Ok(())
+}
+
+/// Largest instance for which `solve` computes a lower bound after solving.
+pub const SOLVE_BOUND_MAX_CELLS: usize = 200_000;
+
+/// Raises the run's lower bound with [`cellseq::bound::compute`] (cheap settings).
+pub fn attach_bound(inst: &Instance, r: &mut RunResult) {
+    if inst.n() > SOLVE_BOUND_MAX_CELLS || r.outcome.proven_optimal {
+        return;
+    }
+    let model = cellseq::cost::CostModel::new(inst, r.objective);
+    let opts = cellseq::bound::BoundOptions {
+        lagrangian_iterations: 100,
+        lagrangian_max_cells: 200,
+        assignment_max_cells: 1000,
+        upper: Some(r.report.cost),
+        ..Default::default()
+    };
+    let b = cellseq::bound::compute(&model, &opts).best;
+    r.outcome.lower_bound = Some(r.outcome.lower_bound.map_or(b, |x| x.max(b)));
 }
 
 /// The solution file of a run.
@@ -223,6 +249,8 @@ pub fn result_json(
         "gap_percent": gap(rep.cost, bk),
         "proven_optimal": r.outcome.proven_optimal,
         "lower_bound": r.outcome.lower_bound,
+        "certified_gap_percent": r.outcome.lower_bound
+            .and_then(|lb| cellseq::bound::certified_gap_percent(rep.cost, lb)),
         "evaluations": r.evaluations,
         "elapsed_s": r.elapsed_s,
         "sequence": json::to_refs(inst, &r.outcome.sequence),
@@ -252,6 +280,12 @@ fn print_report(inst: &Instance, solver: &str, r: &RunResult, bk: Option<f64>) {
     }
     if r.outcome.proven_optimal {
         println!("proven optimal  yes");
+    }
+    if let Some(lb) = r.outcome.lower_bound {
+        println!("lower bound     {}", fmt_num(lb));
+        if let Some(g) = cellseq::bound::certified_gap_percent(rep.cost, lb) {
+            println!("certified gap   {g:.3} %");
+        }
     }
     println!("feasible        yes (independent checker)");
     println!("evaluations     {}", r.evaluations);

@@ -408,6 +408,17 @@ pub fn parse_pcglns(file: &str, text: &str) -> Result<Instance> {
     let mut tok = Tokens::new(file, &start_lines);
     let (ln, s) = tok.next_int("the start group")?;
     let start = group_number(file, ln, s, ngroups)?;
+    if groups[start].len() != 1 {
+        return Err(Error::parse(
+            file,
+            ln,
+            format!(
+                "start group {} has {} nodes; closed PCGLNS tours need a single-node start group",
+                start + 1,
+                groups[start].len()
+            ),
+        ));
+    }
     for g in 0..ngroups {
         if g != start {
             edges.insert((start, g));

@@ -5,6 +5,7 @@
 //! [`registry`]. The conformance tests in `tests/conformance.rs` then cover it automatically.
 
 pub mod as_given;
+pub mod beam;
 pub mod exact;
 pub mod greedy;
 
@@ -181,7 +182,7 @@ pub struct SolverInfo {
 
 /// Every registered solver, in display order.
 pub fn registry() -> Vec<&'static SolverInfo> {
-    vec![&as_given::INFO, &greedy::INFO, &exact::INFO]
+    vec![&as_given::INFO, &greedy::INFO, &exact::INFO, &beam::INFO]
 }
 
 /// Name of the solver `cellseq solve` uses when none is named.

@@ -1,0 +1,120 @@
+//! The assignment bound: a minimum-cost assignment (Hungarian method, O(d³)) on the cell
+//! graph closed into a cycle through home. Every feasible sequence plus its return to home is
+//! a cyclic permutation, hence an assignment, so the optimum assignment is a lower bound.
+
+use super::cells::CellGraph;
+
+/// Solves the assignment problem on a dense square matrix (`INFINITY` = forbidden).
+/// Returns the optimal value and the column of each row, or `None` if no finite assignment
+/// exists.
+pub fn hungarian(d: usize, cost: impl Fn(usize, usize) -> f64) -> Option<(f64, Vec<usize>)> {
+    if d == 0 {
+        return Some((0.0, Vec::new()));
+    }
+    // Replace forbidden entries by a penalty larger than any finite assignment.
+    let mut finite_max = 0.0f64;
+    for i in 0..d {
+        for j in 0..d {
+            let c = cost(i, j);
+            if c.is_finite() {
+                finite_max = finite_max.max(c.abs());
+            }
+        }
+    }
+    let big = (finite_max + 1.0) * (d as f64 + 1.0) * 4.0;
+    let a = |i: usize, j: usize| {
+        let c = cost(i, j);
+        if c.is_finite() { c } else { big }
+    };
+    // e-maxx formulation, 1-based with a virtual column 0.
+    let inf = f64::INFINITY;
+    let mut u = vec![0.0; d + 1];
+    let mut v = vec![0.0; d + 1];
+    let mut p = vec![0usize; d + 1];
+    let mut way = vec![0usize; d + 1];
+    for i in 1..=d {
+        p[0] = i;
+        let mut j0 = 0usize;
+        let mut minv = vec![inf; d + 1];
+        let mut used = vec![false; d + 1];
+        loop {
+            used[j0] = true;
+            let i0 = p[j0];
+            let mut delta = inf;
+            let mut j1 = 0usize;
+            for j in 1..=d {
+                if !used[j] {
+                    let cur = a(i0 - 1, j - 1) - u[i0] - v[j];
+                    if cur < minv[j] {
+                        minv[j] = cur;
+                        way[j] = j0;
+                    }
+                    if minv[j] < delta {
+                        delta = minv[j];
+                        j1 = j;
+                    }
+                }
+            }
+            for j in 0..=d {
+                if used[j] {
+                    u[p[j]] += delta;
+                    v[j] -= delta;
+                } else {
+                    minv[j] -= delta;
+                }
+            }
+            j0 = j1;
+            if p[j0] == 0 {
+                break;
+            }
+        }
+        loop {
+            let j1 = way[j0];
+            p[j0] = p[j1];
+            j0 = j1;
+            if j0 == 0 {
+                break;
+            }
+        }
+    }
+    let mut col = vec![0usize; d];
+    for j in 1..=d {
+        col[p[j] - 1] = j - 1;
+    }
+    let mut total = 0.0;
+    for (i, &j) in col.iter().enumerate() {
+        let c = cost(i, j);
+        if !c.is_finite() {
+            return None;
+        }
+        total += c;
+    }
+    Some((total, col))
+}
+
+/// The assignment bound on the arc part of the cost (without the model's constant).
+pub fn assignment_bound(g: &CellGraph) -> Option<f64> {
+    hungarian(g.size(), |i, j| g.c(i, j)).map(|r| r.0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn hungarian_small_matrix() {
+        let m = [[4.0, 1.0, 3.0], [2.0, 0.0, 5.0], [3.0, 2.0, 2.0]];
+        let (v, col) = hungarian(3, |i, j| m[i][j]).unwrap();
+        assert_eq!(v, 5.0);
+        assert_eq!(col, vec![1, 0, 2]);
+    }
+
+    #[test]
+    fn hungarian_forbidden() {
+        let inf = f64::INFINITY;
+        let m = [[inf, 1.0], [inf, 2.0]];
+        assert!(hungarian(2, |i, j| m[i][j]).is_none());
+        let m = [[inf, 7.0], [3.0, inf]];
+        assert_eq!(hungarian(2, |i, j| m[i][j]).unwrap().0, 10.0);
+    }
+}

@@ -1,0 +1,151 @@
+//! Lower bounds on the optimum of any instance, through [`CostModel`].
+//!
+//! All bounds use arc costs minimised over modes and remove every arc that the transitive
+//! closure of the precedence forbids (j ≺ i, or some k with i ≺ k ≺ j). The open path is closed
+//! into a cycle through a home node (start arcs out of it, finish arcs into it).
+//!
+//! - `degree`: Σ cheapest in-arc, and Σ cheapest out-arc, over cells and home; the max.
+//! - `degree_knn`: the in-degree bound of large geometric instances from K nearest
+//!   neighbours only (memory linear in n).
+//! - `assignment`: Hungarian method on the cell graph.
+//! - `lagrangian`: minimum spanning 1-arborescence with subgradient out-degree penalties.
+//!
+//! [`compute`] runs what is affordable for the instance size and reports each with its time.
+
+pub mod arborescence;
+pub mod assignment;
+pub mod cells;
+pub mod closure;
+pub mod knn;
+
+use crate::cost::CostModel;
+use cells::CellGraph;
+use closure::Closure;
+use std::time::Instant;
+
+/// Which bounds to compute and the size limits of the dense ones.
+#[derive(Debug, Clone, Copy)]
+pub struct BoundOptions {
+    /// Largest n for the dense cell graph (O(n²) memory); larger geometric instances get the
+    /// K-nearest-neighbour degree bound only.
+    pub dense_max_cells: usize,
+    /// Largest n for the assignment bound (O(n³) time).
+    pub assignment_max_cells: usize,
+    /// Largest n for the Lagrangian arborescence bound.
+    pub lagrangian_max_cells: usize,
+    /// Subgradient iterations of the Lagrangian bound.
+    pub lagrangian_iterations: usize,
+    /// Neighbours per node in the K-nearest-neighbour degree bound.
+    pub knn: usize,
+    /// A known solution cost (with the constant), used to size subgradient steps.
+    pub upper: Option<f64>,
+}
+
+impl Default for BoundOptions {
+    fn default() -> Self {
+        BoundOptions {
+            dense_max_cells: 3000,
+            assignment_max_cells: 1500,
+            lagrangian_max_cells: 400,
+            lagrangian_iterations: 300,
+            knn: 16,
+            upper: None,
+        }
+    }
+}
+
+/// One computed bound.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BoundValue {
+    /// Bound name (`degree`, `degree_knn`, `assignment`, `lagrangian`).
+    pub name: &'static str,
+    /// Its value, in objective units, constant included.
+    pub value: f64,
+    /// Seconds it took (the shared cell graph is charged to the first dense bound).
+    pub seconds: f64,
+}
+
+/// All bounds computed for an instance and the best of them.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Bounds {
+    /// Each bound in the order computed.
+    pub parts: Vec<BoundValue>,
+    /// The largest of them (rounded up when all costs are integers).
+    pub best: f64,
+    /// Name of the largest.
+    pub best_name: &'static str,
+}
+
+/// Computes every affordable lower bound of the model's optimum.
+pub fn compute(m: &CostModel, opt: &BoundOptions) -> Bounds {
+    let n = m.n();
+    let mut parts = Vec::new();
+    let constant = m.constant();
+    let t0 = Instant::now();
+    let closure = (n <= opt.dense_max_cells)
+        .then(|| Closure::new(&m.dag))
+        .flatten();
+    if let Some(cl) = closure {
+        let g = CellGraph::new(m, &cl);
+        let integral = g.integral() && constant.fract() == 0.0;
+        let round = |v: f64| {
+            if integral { (v - 1e-6).ceil() } else { v }
+        };
+        let mi: f64 = g.min_in().iter().filter(|c| c.is_finite()).sum();
+        let mo: f64 = g.min_out().iter().filter(|c| c.is_finite()).sum();
+        parts.push(BoundValue {
+            name: "degree",
+            value: round(constant + mi.max(mo)),
+            seconds: t0.elapsed().as_secs_f64(),
+        });
+        if n <= opt.assignment_max_cells {
+            let t = Instant::now();
+            if let Some(a) = assignment::assignment_bound(&g) {
+                parts.push(BoundValue {
+                    name: "assignment",
+                    value: round(constant + a),
+                    seconds: t.elapsed().as_secs_f64(),
+                });
+            }
+        }
+        if n <= opt.lagrangian_max_cells && opt.lagrangian_iterations > 0 {
+            let t = Instant::now();
+            let upper = opt.upper.map(|u| u - constant);
+            if let Some(l) = arborescence::lagrangian_bound(&g, opt.lagrangian_iterations, upper) {
+                parts.push(BoundValue {
+                    name: "lagrangian",
+                    value: round(constant + l.bound),
+                    seconds: t.elapsed().as_secs_f64(),
+                });
+            }
+        }
+    } else if m.is_geometric() {
+        let v = knn::knn_in_bound(m, opt.knn.max(1));
+        parts.push(BoundValue {
+            name: "degree_knn",
+            value: constant + v,
+            seconds: t0.elapsed().as_secs_f64(),
+        });
+    }
+    if parts.is_empty() {
+        parts.push(BoundValue {
+            name: "constant",
+            value: constant,
+            seconds: 0.0,
+        });
+    }
+    let best = parts
+        .iter()
+        .fold(&parts[0], |a, b| if b.value > a.value { b } else { a })
+        .clone();
+    Bounds {
+        parts,
+        best: best.value,
+        best_name: best.name,
+    }
+}
+
+/// Certified gap of a solution cost against a lower bound, in percent of the bound.
+pub fn certified_gap_percent(cost: f64, lower: f64) -> Option<f64> {
+    (lower > 0.0).then(|| 100.0 * (cost - lower).max(0.0) / lower)
+}

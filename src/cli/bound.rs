@@ -1,0 +1,111 @@
+//! `bound`: lower bounds on the optimum of an instance.
+
+use super::solve::{load, objective_of};
+use anyhow::Result;
+use cellseq::bound::{self, BoundOptions};
+use cellseq::cost::CostModel;
+use cellseq::formats::best_known;
+use cellseq::solvers::{self, Budget, NoObserver};
+use clap::Args;
+use serde_json::json;
+use std::collections::BTreeMap;
+use std::path::PathBuf;
+use std::time::Instant;
+
+#[derive(Args, Debug)]
+pub struct BoundArgs {
+    /// Instance file.
+    file: PathBuf,
+    /// Objective: time (default), air, or matrix.
+    #[arg(long)]
+    objective: Option<String>,
+    /// Subgradient iterations of the Lagrangian arborescence bound (0 = skip it).
+    #[arg(long, default_value_t = 300)]
+    iterations: usize,
+    /// Print one JSON object.
+    #[arg(long)]
+    json: bool,
+}
+
+pub fn bound(a: BoundArgs) -> Result<()> {
+    let inst = load(&a.file)?;
+    let objective = objective_of(&inst, a.objective.as_deref())?;
+    let t = Instant::now();
+    // a greedy solution sizes the subgradient steps (only needed where the Lagrangian runs)
+    let defaults = BoundOptions::default();
+    let upper = (inst.n() <= defaults.lagrangian_max_cells && a.iterations > 0)
+        .then(|| {
+            let given = BTreeMap::new();
+            solvers::run(
+                "greedy",
+                &inst,
+                objective,
+                &given,
+                1,
+                Budget::default(),
+                &mut NoObserver,
+            )
+            .ok()
+            .map(|r| r.report.cost)
+        })
+        .flatten();
+    let model = CostModel::new(&inst, objective);
+    let opts = BoundOptions {
+        lagrangian_iterations: a.iterations,
+        upper,
+        ..defaults
+    };
+    let b = bound::compute(&model, &opts);
+    let total = t.elapsed().as_secs_f64();
+    let bk = best_known(&a.file).map(|x| x.0);
+    if a.json {
+        let parts: Vec<_> = b
+            .parts
+            .iter()
+            .map(|p| json!({"name": p.name, "value": p.value, "seconds": p.seconds}))
+            .collect();
+        println!(
+            "{}",
+            json!({
+                "instance": inst.name,
+                "cells": inst.n(),
+                "objective": model.objective().name(),
+                "bounds": parts,
+                "lower_bound": b.best,
+                "best_bound": b.best_name,
+                "upper_bound": upper,
+                "best_known": bk,
+                "certified_gap_percent": upper.and_then(|u| bound::certified_gap_percent(u, b.best)),
+                "elapsed_s": total,
+            })
+        );
+    } else {
+        println!("instance        {} ({} cells)", inst.name, inst.n());
+        println!("objective       {}", model.objective().name());
+        for p in &b.parts {
+            println!("{:<15} {}  ({:.3} s)", p.name, fmt(p.value), p.seconds);
+        }
+        println!("lower bound     {}  ({})", fmt(b.best), b.best_name);
+        if let Some(u) = upper {
+            println!("greedy          {}", fmt(u));
+        }
+        if let Some(k) = bk {
+            let g = bound::certified_gap_percent(k, b.best).unwrap_or(0.0);
+            println!(
+                "best known      {}  (bound is {:.3} % below)",
+                fmt(k),
+                100.0 * g / (100.0 + g)
+            );
+        }
+        println!("elapsed         {total:.3} s");
+    }
+    Ok(())
+}
+
+fn fmt(x: f64) -> String {
+    if x.fract() == 0.0 && x.abs() < 1e15 {
+        format!("{x:.0}")
+    } else {
+        format!("{x:.3}")
+    }
+}

@@ -1,0 +1,229 @@
+//! Lower bounds never exceed the optimum; the beam search agrees with the exact DP and proves
+//! known optima.
+
+use cellseq::bound::{self, BoundOptions};
+use cellseq::cost::CostModel;
+use cellseq::formats::{self, Format};
+use cellseq::model::{Instance, Objective};
+use cellseq::solvers::{self, Budget, NoObserver};
+use proptest::prelude::*;
+use std::collections::BTreeMap;
+use std::path::Path;
+
+fn load(rel: &str) -> Instance {
+    formats::load_instance(&Path::new(env!("CARGO_MANIFEST_DIR")).join(rel))
+        .expect("instance loads")
+}
+
+fn exact(inst: &Instance, obj: Objective) -> f64 {
+    let r = solvers::run(
+        "exact",
+        inst,
+        obj,
+        &BTreeMap::new(),
+        1,
+        Budget::default(),
+        &mut NoObserver,
+    )
+    .expect("exact solves");
+    assert!(r.outcome.proven_optimal);
+    r.report.cost
+}
+
+fn beam(inst: &Instance, obj: Objective) -> solvers::RunResult {
+    solvers::run(
+        "beam",
+        inst,
+        obj,
+        &BTreeMap::new(),
+        1,
+        Budget::default(),
+        &mut NoObserver,
+    )
+    .expect("beam solves")
+}
+
+fn all_bounds(inst: &Instance, obj: Objective) -> bound::Bounds {
+    let m = CostModel::new(inst, obj);
+    bound::compute(&m, &BoundOptions::default())
+}
+
+fn check_instance(inst: &Instance, obj: Objective) {
+    let opt = exact(inst, obj);
+    let b = all_bounds(inst, obj);
+    for p in &b.parts {
+        assert!(
+            p.value <= opt + 1e-6 * opt.abs().max(1.0),
+            "{}: bound {} = {} exceeds the optimum {opt}",
+            inst.name,
+            p.name,
+            p.value
+        );
+    }
+    let r = beam(inst, obj);
+    assert!(
+        r.outcome.proven_optimal,
+        "{}: beam did not prove optimality",
+        inst.name
+    );
+    assert!(
+        (r.report.cost - opt).abs() <= 1e-6 * opt.abs().max(1.0),
+        "{}: beam {} vs exact {opt}",
+        inst.name,
+        r.report.cost
+    );
+}
+
+#[test]
+fn bounds_and_beam_on_small_tsplib_sop() {
+    for name in ["ESC07", "ESC11", "ESC12", "br17.10", "br17.12"] {
+        let inst = load(&format!("instances/tsplib-sop/{name}.sop"));
+        check_instance(&inst, Objective::Matrix);
+    }
+}
+
+#[test]
+fn bounds_and_beam_on_small_pcgtsp() {
+    for name in ["ESC07", "ESC12"] {
+        let inst = load(&format!("instances/pcgtsplib/{name}.pcglns"));
+        check_instance(&inst, Objective::Matrix);
+    }
+}
+
+#[test]
+fn beam_proves_known_optima() {
+    // values from instances/tsplib-sop/bks.csv (proven optimal there)
+    for (name, opt) in [("ESC25", 1681.0), ("ESC63", 62.0)] {
+        let inst = load(&format!("instances/tsplib-sop/{name}.sop"));
+        let r = beam(&inst, Objective::Matrix);
+        assert!(r.outcome.proven_optimal, "{name} not proven");
+        assert_eq!(r.report.cost, opt, "{name}");
+        let b = all_bounds(&inst, Objective::Matrix);
+        assert!(b.best <= opt, "{name}: bound {} above the optimum", b.best);
+    }
+}
+
+#[test]
+fn lagrangian_beats_assignment_on_ry48p() {
+    let inst = load("instances/tsplib-sop/ry48p.1.sop");
+    let b = all_bounds(&inst, Objective::Matrix);
+    let get = |n: &str| {
+        b.parts
+            .iter()
+            .find(|p| p.name == n)
+            .map(|p| p.value)
+            .unwrap()
+    };
+    assert!(get("lagrangian") > get("assignment"));
+    assert!(get("assignment") > get("degree"));
+    assert!(b.best <= 15805.0);
+}
+
+#[test]
+fn knn_bound_is_below_a_solution_on_a_large_geometric_instance() {
+    let mut p = BTreeMap::new();
+    p.insert("n".to_string(), "4000".to_string());
+    p.insert("tools".to_string(), "2".to_string());
+    let inst = cellseq::generate::generate("uniform", &p, 3).unwrap();
+    let m = CostModel::new(&inst, Objective::Time);
+    let opts = BoundOptions {
+        dense_max_cells: 1000,
+        ..BoundOptions::default()
+    };
+    let b = bound::compute(&m, &opts);
+    assert_eq!(b.best_name, "degree_knn");
+    let g = solvers::run(
+        "greedy",
+        &inst,
+        Objective::Time,
+        &BTreeMap::new(),
+        1,
+        Budget::default(),
+        &mut NoObserver,
+    )
+    .unwrap();
+    assert!(b.best > m.constant() && b.best <= g.report.cost);
+}
+
+/// A random PCGTSP (PCGLNS) text: `groups` clusters of 1–3 nodes, integer costs, random
+/// precedence between clusters; cluster 1 is the start.
+fn pcglns_text(groups: usize, sizes: &[usize], costs: &[u32], prec: &[bool]) -> String {
+    // the start group holds one node, as in PCGTSPLIB (closed tours return to it)
+    let sizes: Vec<usize> = std::iter::once(1)
+        .chain(sizes[1..].iter().copied())
+        .collect();
+    let sizes = &sizes[..];
+    let dim: usize = sizes.iter().sum();
+    let mut s = format!(
+        "NAME : rnd\nTYPE : PCGLNS\nDIMENSION : {dim}\nGTSP_SETS : {groups}\nEDGE_WEIGHT_TYPE : EXPLICIT\nEDGE_WEIGHT_FORMAT : FULL_MATRIX\nEDGE_WEIGHT_SECTION\n"
+    );
+    for i in 0..dim {
+        let row: Vec<String> = (0..dim)
+            .map(|j| {
+                if i == j {
+                    "0".into()
+                } else {
+                    costs[(i * dim + j) % costs.len()].to_string()
+                }
+            })
+            .collect();
+        s += &row.join(" ");
+        s += "\n";
+    }
+    s += "GTSP_SET_SECTION\n";
+    let mut node = 1;
+    for (g, &k) in sizes.iter().enumerate() {
+        let ids: Vec<String> = (node..node + k).map(|x| x.to_string()).collect();
+        s += &format!("{} {} -1\n", g + 1, ids.join(" "));
+        node += k;
+    }
+    s += "GTSP_SET_ORDERING\n";
+    let mut idx = 0;
+    for a in 2..=groups {
+        let mut after = Vec::new();
+        for b in a + 1..=groups {
+            if prec[idx % prec.len()] {
+                after.push(b.to_string());
+            }
+            idx += 1;
+        }
+        if !after.is_empty() {
+            s += &format!("{a} {} -1\n", after.join(" "));
+        }
+    }
+    s += "START_GROUP_SECTION\n1\nEOF\n";
+    s
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(40))]
+
+    #[test]
+    fn bounds_below_optimum_and_beam_exact_on_random_matrix(
+        sizes in prop::collection::vec(1usize..=3, 3..=7),
+        costs in prop::collection::vec(0u32..100, 64),
+        prec in prop::collection::vec(prop::bool::weighted(0.25), 32),
+    ) {
+        let text = pcglns_text(sizes.len(), &sizes, &costs, &prec);
+        let inst = formats::parse_instance("rnd.pcglns", &text, Format::Pcglns).unwrap();
+        check_instance(&inst, Objective::Matrix);
+    }
+
+    #[test]
+    fn bounds_below_optimum_and_beam_exact_on_random_geometric(
+        n in 3usize..=8,
+        tools in 1usize..=2,
+        density in 0.0f64..0.4,
+        seed in 0u64..1000,
+    ) {
+        let mut p = BTreeMap::new();
+        p.insert("n".to_string(), n.to_string());
+        p.insert("tools".to_string(), tools.to_string());
+        p.insert("density".to_string(), density.to_string());
+        p.insert("closed".to_string(), "0.3".to_string());
+        p.insert("modes".to_string(), "2".to_string());
+        let inst = cellseq::generate::generate("uniform", &p, seed).unwrap();
+        check_instance(&inst, Objective::Time);
+        check_instance(&inst, Objective::Air);
+    }
+}
