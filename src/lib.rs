@@ -6,6 +6,7 @@
 //! and recomputes the [`check::Report`] from scratch.
 
 pub mod check;
+pub mod engine;
 pub mod cost;
 pub mod error;
 pub mod formats;

@@ -7,6 +7,10 @@
 pub mod as_given;
 pub mod exact;
 pub mod greedy;
+pub mod local_search;
+pub mod sa;
+pub mod start;
+pub mod two_opt;
 
 use crate::check::{check, Report};
 use crate::cost::CostModel;
@@ -181,7 +185,14 @@ pub struct SolverInfo {
 
 /// Every registered solver, in display order.
 pub fn registry() -> Vec<&'static SolverInfo> {
-    vec![&as_given::INFO, &greedy::INFO, &exact::INFO]
+    vec![
+        &as_given::INFO,
+        &greedy::INFO,
+        &exact::INFO,
+        &two_opt::INFO,
+        &local_search::INFO,
+        &sa::INFO,
+    ]
 }
 
 /// Name of the solver `cellseq solve` uses when none is named.
