@@ -4,12 +4,14 @@
 //! [`SolverInfo`] (name, summary, parameters with defaults, constructor) and list it in
 //! [`registry`]. The conformance tests in `tests/conformance.rs` then cover it automatically.
 
+pub mod aco;
 pub mod as_given;
 pub mod exact;
 pub mod greedy;
 pub mod local_search;
 pub mod sa;
 pub mod start;
+pub mod tabu;
 pub mod two_opt;
 
 use crate::check::{check, Report};
@@ -192,6 +194,8 @@ pub fn registry() -> Vec<&'static SolverInfo> {
         &two_opt::INFO,
         &local_search::INFO,
         &sa::INFO,
+        &tabu::INFO,
+        &aco::INFO,
     ]
 }
 
