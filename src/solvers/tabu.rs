@@ -76,15 +76,24 @@ pub struct Tabu {
     pub k: usize,
 }
 
+/// The tabu list: per cell, the iteration until which it may not move.
+#[derive(Debug, Clone)]
+pub struct TabuList {
+    /// `until[c]`: first iteration at which c may move again.
+    pub until: Vec<u64>,
+    /// Current iteration.
+    pub iter: u64,
+    /// Tenure.
+    pub tenure: u64,
+}
+
 /// One tabu iteration: finds the best admissible relocation (or mode swap) and applies it.
 /// Returns false when no admissible move exists.
 pub fn tabu_step(
     c: &Costs,
     search: &Search,
     s: &mut Solution,
-    tabu_until: &mut [u64],
-    iter: u64,
-    tenure: u64,
+    tabu: &mut TabuList,
     best_cost: f64,
     ctx: &mut Context,
 ) -> bool {
@@ -95,7 +104,7 @@ pub fn tabu_step(
     for x in 0..n {
         let i = s.pos[x] as usize;
         let ii = i as isize;
-        let is_tabu = tabu_until[x] > iter;
+        let is_tabu = tabu.until[x] > tabu.iter;
         let (lo, hi) = window(m, s, i, 1);
         let removal = s.link(c, ii - 1, ii + 1) - s.link(c, ii - 1, ii) - s.link(c, ii, ii + 1);
         let mut consider = |d: f64, p: isize, md: usize| {
@@ -144,7 +153,7 @@ pub fn tabu_step(
         s.mode[x] = md as u32;
         apply_segment(m, s, s.pos[x] as usize, 1, p, false, d);
     }
-    tabu_until[x] = iter + tenure;
+    tabu.until[x] = tabu.iter + tabu.tenure;
     true
 }
 
@@ -183,22 +192,18 @@ impl Solver for Tabu {
             };
             let mut s = Solution::new(&c, &seq);
             let mut local_best = s.clone();
-            let mut tabu_until = vec![0u64; n];
+            let mut tabu = TabuList {
+                until: vec![0u64; n],
+                iter: 0,
+                tenure,
+            };
             let mut last_improve = 0u64;
             for iter in 1..=self.iters {
                 if ctx.exhausted() || iter - last_improve > self.stall {
                     break;
                 }
-                if !tabu_step(
-                    &c,
-                    &search,
-                    &mut s,
-                    &mut tabu_until,
-                    iter,
-                    tenure,
-                    local_best.cost,
-                    ctx,
-                ) {
+                tabu.iter = iter;
+                if !tabu_step(&c, &search, &mut s, &mut tabu, local_best.cost, ctx) {
                     break;
                 }
                 if iter % 64 == 0 {
