@@ -9,6 +9,8 @@ pub mod as_given;
 pub mod exact;
 pub mod greedy;
 pub mod local_search;
+pub mod process;
+pub mod rules;
 pub mod sa;
 pub mod start;
 pub mod tabu;
@@ -196,6 +198,8 @@ pub fn registry() -> Vec<&'static SolverInfo> {
         &sa::INFO,
         &tabu::INFO,
         &aco::INFO,
+        &process::INFO,
+        &rules::INFO,
     ]
 }
 

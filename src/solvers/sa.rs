@@ -141,28 +141,28 @@ impl Anneal {
         }
         let m = c.m;
         let multi = (0..n).any(|x| m.modes(x) > 1);
-        // initial temperature from sampled worsening moves
-        let mut sum = 0.0;
-        let mut cnt = 0usize;
+        // initial temperature from the median of sampled worsening moves (robust to the huge
+        // "forbidden" arc costs of some matrix instances)
+        let mut ups: Vec<f64> = Vec::new();
         for _ in 0..200 {
             if let Some((d, _)) = self.propose(c, s, block, rng, multi)
                 && d > 0.0
             {
-                sum += d;
-                cnt += 1;
+                ups.push(d);
             }
         }
         ctx.count(200);
-        if cnt == 0 {
+        if ups.is_empty() {
             return;
         }
-        let t0 = -(sum / cnt as f64) / self.accept0.ln();
+        ups.sort_by(f64::total_cmp);
+        let t0 = -ups[ups.len() / 2] / self.accept0.ln();
         let len = ((self.chain * n as f64) as u64).max(1);
         let mut best = s.clone();
         let budgeted = ctx.budget.max_evals.is_some() || ctx.budget.time_limit.is_some();
         let mut run = 0u64;
         'runs: loop {
-            let mut t = if run == 0 { t0 } else { t0 * 0.2 };
+            let mut t = if run == 0 { t0 } else { t0 * 0.05 };
             let mut stall = 0u64;
             for _ in 0..self.max_chains {
                 let before = best.cost;
