@@ -30,6 +30,12 @@ pub static INFO: SolverInfo = SolverInfo {
 /// The rule-based solver.
 pub struct Rules;
 
+/// Rule-1 key of a tool group: larger diameter first, then index.
+type GroupKey = (Reverse<i64>, usize);
+
+/// Priority of a cell: tool rank, outer flag, step rank, −z, symmetry ring, offset, side, index.
+type CellKey = (u32, u32, u32, i64, i64, i64, bool, usize);
+
 /// Rule-4 rank of a step kind (smaller first).
 fn step_rank(k: StepKind) -> u32 {
     match k {
@@ -69,7 +75,7 @@ pub fn tool_rank(inst: &Instance, dag: &Dag) -> Vec<u32> {
         }
     }
     let key = |g: usize| (Reverse((dia(g) * 1000.0) as i64), g);
-    let mut heap: BinaryHeap<Reverse<((Reverse<i64>, usize), usize)>> = (0..t)
+    let mut heap: BinaryHeap<Reverse<(GroupKey, usize)>> = (0..t)
         .filter(|&g| indeg[g] == 0)
         .map(|g| Reverse((key(g), g)))
         .collect();
@@ -142,7 +148,7 @@ impl Solver for Rules {
             .map(|p| (p.0 - cx).abs().max((p.1 - cy).abs()))
             .fold(0.0, f64::max)
             .max(1e-9);
-        let key: Vec<(u32, u32, u32, i64, i64, i64, bool, usize)> = (0..n)
+        let key: Vec<CellKey> = (0..n)
             .map(|c| {
                 let cell = &inst.cells[c];
                 let outer = (cell.step != StepKind::OuterContour) as u32; // rule 2
