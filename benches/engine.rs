@@ -149,5 +149,10 @@ fn benches(cr: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(engine, benches);
+criterion_group! {
+    name = engine;
+    // no plots: the plotters backend needs system fonts
+    config = Criterion::default().without_plots();
+    targets = benches
+}
 criterion_main!(engine);
