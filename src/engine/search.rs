@@ -66,7 +66,7 @@ impl<'a> Search<'a> {
         Search {
             c,
             nb: Neighbours::new(c.m, k),
-            max_block: if n <= 1000 { n } else { 50 },
+            max_block: if n <= 120 { n } else { 64 },
             stamp: vec![0; n],
             label: 0,
             rev: Reversal::default(),

@@ -59,7 +59,7 @@ pub static INFO: SolverInfo = SolverInfo {
         },
         ParamSpec {
             name: "stall",
-            default: "40",
+            default: "25",
             kind: ParamKind::Int,
             help: "stop after this many iterations without a new best",
         },

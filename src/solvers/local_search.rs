@@ -25,7 +25,7 @@ pub static INFO: SolverInfo = SolverInfo {
         },
         ParamSpec {
             name: "kicks",
-            default: "100",
+            default: "30",
             kind: ParamKind::Int,
             help: "iterated VND: stop after this many non-improving kicks (runs until the budget when one is set; 0 = plain VND)",
         },
@@ -39,7 +39,7 @@ pub static INFO: SolverInfo = SolverInfo {
             name: "max-block",
             default: "0",
             kind: ParamKind::Int,
-            help: "longest block of SOP-3-exchange (0 = n up to 1000 cells, else 50)",
+            help: "longest block of SOP-3-exchange (0 = n up to 120 cells, else 64)",
         },
     ],
     make: |p: &Params| {
