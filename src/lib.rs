@@ -25,6 +25,7 @@
 pub mod bound;
 pub mod check;
 pub mod cost;
+pub mod engine;
 pub mod error;
 pub mod formats;
 pub mod generate;

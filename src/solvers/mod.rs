@@ -4,10 +4,18 @@
 //! [`SolverInfo`] (name, summary, parameters with defaults, constructor) and list it in
 //! [`registry`]. The conformance tests in `tests/conformance.rs` then cover it automatically.
 
+pub mod aco;
 pub mod as_given;
 pub mod beam;
 pub mod exact;
 pub mod greedy;
+pub mod local_search;
+pub mod process;
+pub mod rules;
+pub mod sa;
+pub mod start;
+pub mod tabu;
+pub mod two_opt;
 
 use crate::check::{Report, check};
 use crate::cost::CostModel;
@@ -182,7 +190,19 @@ pub struct SolverInfo {
 
 /// Every registered solver, in display order.
 pub fn registry() -> Vec<&'static SolverInfo> {
-    vec![&as_given::INFO, &greedy::INFO, &exact::INFO, &beam::INFO]
+    vec![
+        &as_given::INFO,
+        &greedy::INFO,
+        &exact::INFO,
+        &beam::INFO,
+        &two_opt::INFO,
+        &local_search::INFO,
+        &sa::INFO,
+        &tabu::INFO,
+        &aco::INFO,
+        &process::INFO,
+        &rules::INFO,
+    ]
 }
 
 /// Name of the solver `cellseq solve` uses when none is named.

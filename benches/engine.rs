@@ -1,0 +1,158 @@
+//! Engine benchmarks: delta evaluations per second, one local-search pass on 10k cells, one
+//! SA chain, one tabu iteration, one ant construction.
+
+use cellseq::cost::CostModel;
+use cellseq::engine::moves::sop3_delta;
+use cellseq::engine::search::Search;
+use cellseq::engine::{Costs, Solution};
+use cellseq::generate::generate;
+use cellseq::model::Instance;
+use cellseq::solvers::aco::{Aco, Pheromone};
+use cellseq::solvers::sa::Anneal;
+use cellseq::solvers::tabu::{TabuList, tabu_step};
+use cellseq::solvers::{Budget, Context, NoObserver, Params, greedy};
+use criterion::{Criterion, Throughput, criterion_group, criterion_main};
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use std::collections::BTreeMap;
+use std::hint::black_box;
+
+fn uniform(n: usize, extra: &[(&str, &str)]) -> Instance {
+    let mut kv: BTreeMap<String, String> = BTreeMap::new();
+    kv.insert("n".into(), n.to_string());
+    for (k, v) in extra {
+        kv.insert(k.to_string(), v.to_string());
+    }
+    generate("uniform", &kv, 1).unwrap()
+}
+
+fn benches(cr: &mut Criterion) {
+    let inst = uniform(
+        1000,
+        &[
+            ("tools", "3"),
+            ("modes", "2"),
+            ("closed", "0.3"),
+            ("preds", "1"),
+        ],
+    );
+    let m = CostModel::new(&inst, inst.default_objective());
+    let c = Costs::open(&m);
+    let seq = greedy::geometric(&m, &mut |_| {});
+    let s0 = Solution::new(&c, &seq);
+    let params = Params::default();
+
+    let mut g = cr.benchmark_group("engine");
+    let mut rng = ChaCha8Rng::seed_from_u64(1);
+    let triples: Vec<(isize, isize, isize)> = (0..1024)
+        .map(|_| {
+            let h = rng.random_range(-1..997i64) as isize;
+            let i = h + 1 + rng.random_range(0..(997 - h) as i64) as isize;
+            let j = i + 1 + rng.random_range(0..(998 - i) as i64) as isize;
+            (h, i, j)
+        })
+        .collect();
+    g.throughput(Throughput::Elements(triples.len() as u64));
+    g.bench_function("sop3 delta evaluations (1k cells)", |b| {
+        b.iter(|| {
+            triples
+                .iter()
+                .map(|&(h, i, j)| sop3_delta(&c, &s0, h, i, j))
+                .sum::<f64>()
+        })
+    });
+    g.throughput(Throughput::Elements(1));
+
+    let big = uniform(10_000, &[("tools", "2"), ("preds", "1")]);
+    let bm = CostModel::new(&big, big.default_objective());
+    let bc = Costs::open(&bm);
+    let bseq = greedy::geometric(&bm, &mut |_| {});
+    let bs = Solution::new(&bc, &bseq);
+    let mut bsearch = Search::new(bc, 8);
+    g.sample_size(10);
+    g.bench_function("local-search Or-opt pass (10k cells)", |b| {
+        b.iter(|| {
+            let mut s = bs.clone();
+            let mut obs = NoObserver;
+            let mut ctx = Context::new(&big, &bm, &params, 1, Budget::default(), &mut obs);
+            bsearch.or_opt(&mut s, &mut ctx);
+            black_box(s.cost)
+        })
+    });
+    g.bench_function("local-search 2-opt pass (10k cells)", |b| {
+        b.iter(|| {
+            let mut s = bs.clone();
+            let mut obs = NoObserver;
+            let mut ctx = Context::new(&big, &bm, &params, 1, Budget::default(), &mut obs);
+            bsearch.two_opt(&mut s, &mut ctx);
+            black_box(s.cost)
+        })
+    });
+
+    let anneal = Anneal {
+        chain: 1.0,
+        alpha: 0.95,
+        accept0: 0.3,
+        stall: 1,
+        max_chains: 1,
+        reheats: 0,
+        closed: false,
+    };
+    g.bench_function("SA chain (L = n = 1000)", |b| {
+        b.iter(|| {
+            let mut s = s0.clone();
+            let mut obs = NoObserver;
+            let mut ctx = Context::new(&inst, &m, &params, 1, Budget::default(), &mut obs);
+            let mut rng = ChaCha8Rng::seed_from_u64(3);
+            anneal.run(&mut ctx, &c, &mut s, None, &mut rng);
+            black_box(s.cost)
+        })
+    });
+
+    let search = Search::new(c, 10);
+    g.bench_function("tabu iteration (1000 cells, K = 10)", |b| {
+        let mut s = s0.clone();
+        let mut tabu = TabuList {
+            until: vec![0; 1000],
+            iter: 0,
+            tenure: 55,
+        };
+        b.iter(|| {
+            let mut obs = NoObserver;
+            let mut ctx = Context::new(&inst, &m, &params, 1, Budget::default(), &mut obs);
+            tabu.iter += 1;
+            tabu_step(&c, &search, &mut s, &mut tabu, f64::NEG_INFINITY, &mut ctx);
+            black_box(s.cost)
+        })
+    });
+
+    let aco = Aco {
+        ants: 1,
+        beta: 2.0,
+        s: 10.0,
+        rho: 0.1,
+        phi: 0.01,
+        iters: 1,
+        stall: 1,
+        ls: "none".into(),
+        k: 10,
+    };
+    let mut tau = Pheromone::new(1000, 1.0 / (1000.0 * s0.cost));
+    g.bench_function("ant construction (1000 cells)", |b| {
+        let mut rng = ChaCha8Rng::seed_from_u64(5);
+        b.iter(|| {
+            let mut obs = NoObserver;
+            let mut ctx = Context::new(&inst, &m, &params, 1, Budget::default(), &mut obs);
+            black_box(aco.construct(&mut ctx, &mut tau, 1e-6, &mut rng).len())
+        })
+    });
+    g.finish();
+}
+
+criterion_group! {
+    name = engine;
+    // no plots: the plotters backend needs system fonts
+    config = Criterion::default().without_plots();
+    targets = benches
+}
+criterion_main!(engine);

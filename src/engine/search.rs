@@ -1,0 +1,327 @@
+//! Local search passes with candidate lists and don't-look bits, and the VND over them.
+
+use super::modes::mode_dp;
+use super::moves::{
+    Reversal, apply_segment, mode_delta, reversible_segment, segment_delta, sop3_delta, window,
+};
+use super::{Costs, Neighbours, Solution};
+use crate::solvers::Context;
+use std::collections::VecDeque;
+
+/// Improvement threshold (relative) below which a delta does not count as an improvement.
+#[inline]
+fn improves(delta: f64, cost: f64) -> bool {
+    delta < -1e-9 * cost.abs().max(1.0)
+}
+
+/// A FIFO of cells with membership bits (the don't-look bits: a cell off the queue is
+/// not looked at until a move next to it puts it back).
+struct Queue {
+    q: VecDeque<u32>,
+    on: Vec<bool>,
+}
+
+impl Queue {
+    fn all(n: usize) -> Self {
+        Queue {
+            q: (0..n as u32).collect(),
+            on: vec![true; n],
+        }
+    }
+    fn push(&mut self, c: u32) {
+        if !self.on[c as usize] {
+            self.on[c as usize] = true;
+            self.q.push_back(c);
+        }
+    }
+    fn push_around(&mut self, s: &Solution, p: isize, r: isize) {
+        for q in (p - r).max(0)..=(p + r).min(s.n() as isize - 1) {
+            self.push(s.order[q as usize]);
+        }
+    }
+    fn pop(&mut self) -> Option<u32> {
+        let c = self.q.pop_front()?;
+        self.on[c as usize] = false;
+        Some(c)
+    }
+}
+
+/// The local search engine: costs, candidate lists, labelling scratch space.
+pub struct Search<'a> {
+    /// Link costs.
+    pub c: Costs<'a>,
+    /// Candidate lists.
+    pub nb: Neighbours,
+    /// Longest block considered by SOP-3-exchange (each side).
+    pub max_block: usize,
+    stamp: Vec<u32>,
+    label: u32,
+    rev: Reversal,
+}
+
+impl<'a> Search<'a> {
+    /// An engine with `k` neighbours per cell.
+    pub fn new(c: Costs<'a>, k: usize) -> Self {
+        let n = c.m.n();
+        Search {
+            c,
+            nb: Neighbours::new(c.m, k),
+            max_block: if n <= 120 { n } else { 64 },
+            stamp: vec![0; n],
+            label: 0,
+            rev: Reversal::default(),
+        }
+    }
+
+    /// Or-opt to a local optimum: segments of 1–3 cells starting at a looked-at cell move
+    /// next to a candidate neighbour (kept or reversed). Returns true on any improvement.
+    pub fn or_opt(&mut self, s: &mut Solution, ctx: &mut Context) -> bool {
+        let c = self.c;
+        let m = c.m;
+        let n = s.n();
+        let mut queue = Queue::all(n);
+        let mut improved = false;
+        while let Some(x) = queue.pop() {
+            if ctx.exhausted() {
+                break;
+            }
+            let i = s.pos[x as usize] as usize;
+            let mut best = (0.0, 0usize, 0isize, false);
+            let mut evals = 0u64;
+            for len in 1..=3usize.min(n - i) {
+                let (lo, hi) = window(m, s, i, len);
+                let rev_ok = len > 1 && reversible_segment(m, s, i, len);
+                let first = s.order[i];
+                let last = s.order[i + len - 1];
+                let cands = self.nb.inn[first as usize]
+                    .iter()
+                    .map(|&v| s.pos[v as usize] as isize)
+                    .chain(
+                        self.nb.out[last as usize]
+                            .iter()
+                            .map(|&w| s.pos[w as usize] as isize - 1),
+                    )
+                    .chain(
+                        self.nb.inn[last as usize]
+                            .iter()
+                            .map(|&v| s.pos[v as usize] as isize),
+                    )
+                    .chain(
+                        self.nb.out[first as usize]
+                            .iter()
+                            .map(|&w| s.pos[w as usize] as isize - 1),
+                    );
+                for p in cands {
+                    if p >= i as isize - 1 && p <= (i + len - 1) as isize || p < lo || p >= hi {
+                        continue;
+                    }
+                    for r in [false, true] {
+                        if r && !rev_ok {
+                            continue;
+                        }
+                        evals += 1;
+                        let d = segment_delta(&c, s, i, len, p, r);
+                        if d < best.0 {
+                            best = (d, len, p, r);
+                        }
+                    }
+                }
+            }
+            ctx.count(evals);
+            if improves(best.0, s.cost) {
+                let (d, len, p, r) = best;
+                apply_segment(m, s, i, len, p, r, d);
+                improved = true;
+                queue.push_around(s, i as isize, 1);
+                queue.push_around(s, s.pos[x as usize] as isize, len as isize);
+                queue.push(x);
+            }
+        }
+        improved
+    }
+
+    /// 2-opt with mode flip to a local optimum (segments without internal precedence pairs
+    /// whose cells all have a reversal mode). Returns true on any improvement.
+    pub fn two_opt(&mut self, s: &mut Solution, ctx: &mut Context) -> bool {
+        let c = self.c;
+        let n = s.n();
+        if n < 2 {
+            return false;
+        }
+        self.rev.refresh(&c, s);
+        let mut queue = Queue::all(n);
+        let mut improved = false;
+        while let Some(x) = queue.pop() {
+            if ctx.exhausted() {
+                break;
+            }
+            let q = s.pos[x as usize] as usize;
+            let mut best = (0.0, 0usize, 0usize);
+            let mut evals = 0u64;
+            // x just before the segment: new arc x -> reversed end
+            if q + 1 < n {
+                let i = q + 1;
+                let reach = self.rev.reach[i];
+                let ends = self.nb.out[x as usize]
+                    .iter()
+                    .map(|&w| s.pos[w as usize] as isize)
+                    .chain([n as isize - 1]);
+                for j in ends {
+                    if j > i as isize && j <= reach {
+                        evals += 1;
+                        let d = self.rev.delta(&c, s, i, j as usize);
+                        if d < best.0 {
+                            best = (d, i, j as usize);
+                        }
+                    }
+                }
+            }
+            // x first of the segment: new arc reversed x -> successor candidate
+            {
+                let i = q;
+                let reach = self.rev.reach[i];
+                for &w in &self.nb.out[x as usize] {
+                    let j = s.pos[w as usize] as isize - 1;
+                    if j > i as isize && j <= reach {
+                        evals += 1;
+                        let d = self.rev.delta(&c, s, i, j as usize);
+                        if d < best.0 {
+                            best = (d, i, j as usize);
+                        }
+                    }
+                }
+            }
+            ctx.count(evals);
+            if improves(best.0, s.cost) {
+                let (d, i, j) = best;
+                s.reverse(c.m, i, j, d);
+                self.rev.refresh(&c, s);
+                improved = true;
+                queue.push_around(s, i as isize, 1);
+                queue.push_around(s, j as isize, 1);
+            }
+        }
+        improved
+    }
+
+    /// SOP-3-exchange (forward lexicographic search with labelling and a don't-push stack) to
+    /// a local optimum. Returns true on any improvement.
+    pub fn sop3(&mut self, s: &mut Solution, ctx: &mut Context) -> bool {
+        let c = self.c;
+        let m = c.m;
+        let n = s.n();
+        let mut queue = Queue::all(n);
+        let mut improved = false;
+        while let Some(x) = queue.pop() {
+            if ctx.exhausted() {
+                break;
+            }
+            let px = s.pos[x as usize] as isize;
+            let mut found = None;
+            let mut evals = 0u64;
+            'hs: for h in [px - 1, px] {
+                if h + 2 >= n as isize {
+                    continue;
+                }
+                self.label = self.label.wrapping_add(1);
+                if self.label == 0 {
+                    self.stamp.iter_mut().for_each(|v| *v = 0);
+                    self.label = 1;
+                }
+                let label = self.label;
+                let imax = (h + self.max_block as isize).min(n as isize - 2);
+                for i in (h + 1)..=imax {
+                    let ci = s.order[i as usize] as usize;
+                    for &q in &m.dag.succs[ci] {
+                        self.stamp[q as usize] = label;
+                    }
+                    let jmax = (i + self.max_block as isize).min(n as isize - 1);
+                    let mut best = (0.0, 0isize);
+                    for j in (i + 1)..=jmax {
+                        if self.stamp[s.order[j as usize] as usize] == label {
+                            break;
+                        }
+                        evals += 1;
+                        let d = sop3_delta(&c, s, h, i, j);
+                        if d < best.0 {
+                            best = (d, j);
+                        }
+                    }
+                    if improves(best.0, s.cost) {
+                        found = Some((best.0, h, i, best.1));
+                        break 'hs;
+                    }
+                }
+            }
+            ctx.count(evals);
+            if let Some((d, h, i, j)) = found {
+                let ends = [h, h + 1, i, i + 1, j, j + 1];
+                let cells: Vec<u32> = ends
+                    .iter()
+                    .filter(|&&p| p >= 0 && p < n as isize)
+                    .map(|&p| s.order[p as usize])
+                    .collect();
+                s.swap_blocks(h, i as usize, j as usize, d);
+                improved = true;
+                for cell in cells {
+                    queue.push(cell);
+                }
+                queue.push(x);
+            }
+        }
+        improved
+    }
+
+    /// Single-cell mode change to a local optimum. Returns true on any improvement.
+    pub fn mode_change(&mut self, s: &mut Solution, ctx: &mut Context) -> bool {
+        let c = self.c;
+        let mut improved = false;
+        for p in 0..s.n() {
+            let cell = s.order[p] as usize;
+            let k = c.m.modes(cell);
+            if k < 2 {
+                continue;
+            }
+            ctx.count(k as u64);
+            let mut best = (0.0, 0usize);
+            for md in 0..k {
+                let d = mode_delta(&c, s, p, md);
+                if d < best.0 {
+                    best = (d, md);
+                }
+            }
+            if improves(best.0, s.cost) {
+                s.set_mode(cell, best.1, best.0);
+                improved = true;
+            }
+        }
+        improved
+    }
+
+    /// The mode pass (layered shortest path). Returns true on improvement.
+    pub fn modes(&mut self, s: &mut Solution, ctx: &mut Context) -> bool {
+        let before = s.cost;
+        let e = mode_dp(&self.c, s);
+        ctx.count(e);
+        improves(s.cost - before, before)
+    }
+
+    /// Variable neighbourhood descent: Or-opt, 2-opt, mode change, SOP-3-exchange, mode DP,
+    /// restarting from the first neighbourhood after every improvement.
+    pub fn vnd(&mut self, s: &mut Solution, ctx: &mut Context) {
+        loop {
+            if ctx.exhausted() {
+                return;
+            }
+            if self.or_opt(s, ctx) | self.two_opt(s, ctx) | self.mode_change(s, ctx) {
+                continue;
+            }
+            if self.sop3(s, ctx) {
+                continue;
+            }
+            if !self.modes(s, ctx) {
+                return;
+            }
+        }
+    }
+}

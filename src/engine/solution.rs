@@ -1,0 +1,140 @@
+//! The solution representation: order, positions, modes and cached cost.
+
+use super::{Costs, Slot};
+use crate::cost::CostModel;
+use crate::model::{Sequence, Visit};
+
+/// A complete sequence in array form with its inverse and cached cost.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Solution {
+    /// `order[p]`: the cell at position p.
+    pub order: Vec<u32>,
+    /// `pos[c]`: the position of cell c.
+    pub pos: Vec<u32>,
+    /// `mode[c]`: the mode of cell c.
+    pub mode: Vec<u32>,
+    /// Cost under the [`Costs`] it was last evaluated with (cutting constant excluded).
+    pub cost: f64,
+}
+
+impl Solution {
+    /// Builds a solution from a complete sequence and evaluates it.
+    pub fn new(c: &Costs, seq: &Sequence) -> Self {
+        let n = c.m.n();
+        let mut s = Solution {
+            order: seq.iter().map(|v| v.cell as u32).collect(),
+            pos: vec![0; n],
+            mode: vec![0; n],
+            cost: 0.0,
+        };
+        for (p, v) in seq.iter().enumerate() {
+            s.pos[v.cell] = p as u32;
+            s.mode[v.cell] = v.mode as u32;
+        }
+        s.cost = s.evaluate(c);
+        s
+    }
+    /// Number of cells.
+    #[inline]
+    pub fn n(&self) -> usize {
+        self.order.len()
+    }
+    /// The sequence.
+    pub fn sequence(&self) -> Sequence {
+        self.order
+            .iter()
+            .map(|&c| Visit::new(c as usize, self.mode[c as usize] as usize))
+            .collect()
+    }
+    /// The (cell, mode) at position `p`, `None` outside `0..n`.
+    #[inline]
+    pub fn at(&self, p: isize) -> Slot {
+        if p < 0 || p as usize >= self.order.len() {
+            None
+        } else {
+            let c = self.order[p as usize] as usize;
+            Some((c, self.mode[c] as usize))
+        }
+    }
+    /// Cost of the link from position `p` to position `q` (either may be out of range).
+    #[inline]
+    pub fn link(&self, c: &Costs, p: isize, q: isize) -> f64 {
+        c.link(self.at(p), self.at(q))
+    }
+    /// Full evaluation (without the order-independent constant), O(n).
+    pub fn evaluate(&self, c: &Costs) -> f64 {
+        let n = self.n() as isize;
+        (0..=n).map(|p| self.link(c, p - 1, p)).sum()
+    }
+    /// Position of the latest predecessor of `cell` (−1 if none).
+    #[inline]
+    pub fn last_pred(&self, m: &CostModel, cell: usize) -> isize {
+        m.dag.preds[cell]
+            .iter()
+            .map(|&p| self.pos[p as usize] as isize)
+            .max()
+            .unwrap_or(-1)
+    }
+    /// Position of the earliest successor of `cell` (n if none).
+    #[inline]
+    pub fn first_succ(&self, m: &CostModel, cell: usize) -> isize {
+        m.dag.succs[cell]
+            .iter()
+            .map(|&p| self.pos[p as usize] as isize)
+            .min()
+            .unwrap_or(self.n() as isize)
+    }
+    /// True when every precedence pair is respected (O(n + edges), for assertions and tests).
+    pub fn feasible(&self, m: &CostModel) -> bool {
+        (0..self.n()).all(|c| {
+            m.dag.succs[c]
+                .iter()
+                .all(|&s| self.pos[c] < self.pos[s as usize])
+        })
+    }
+    fn renumber(&mut self, from: usize, to: usize) {
+        for p in from..to {
+            self.pos[self.order[p] as usize] = p as u32;
+        }
+    }
+    /// Swaps the adjacent blocks `[h+1..=i]` and `[i+1..=j]` (SOP-3-exchange), adding `delta`.
+    pub fn swap_blocks(&mut self, h: isize, i: usize, j: usize, delta: f64) {
+        let a = (h + 1) as usize;
+        self.order[a..=j].rotate_left(i + 1 - a);
+        self.renumber(a, j + 1);
+        self.cost += delta;
+    }
+    /// Reverses positions `i..=j` and gives each cell its `flip` mode, adding `delta`.
+    pub fn reverse(&mut self, m: &CostModel, i: usize, j: usize, delta: f64) {
+        self.order[i..=j].reverse();
+        for p in i..=j {
+            let c = self.order[p] as usize;
+            self.mode[c] =
+                flip_mode(m, c, self.mode[c] as usize).unwrap_or(self.mode[c] as usize) as u32;
+        }
+        self.renumber(i, j + 1);
+        self.cost += delta;
+    }
+    /// Sets the mode of a cell, adding `delta`.
+    pub fn set_mode(&mut self, cell: usize, mode: usize, delta: f64) {
+        self.mode[cell] = mode as u32;
+        self.cost += delta;
+    }
+}
+
+/// The mode that cuts `cell` in the opposite direction when the cell sits in a reversed
+/// segment: its flipped mode when it is reversible, the same mode when the mode has no
+/// direction (entry = exit, or a matrix instance whose nodes carry no geometry), else `None`.
+#[inline]
+pub fn flip_mode(m: &CostModel, cell: usize, mode: usize) -> Option<usize> {
+    if m.reversible(cell)
+        && let Some(f) = m.flipped(cell, mode)
+    {
+        return Some(f);
+    }
+    if !m.is_geometric() {
+        return Some(mode);
+    }
+    let nd = m.node(cell, mode);
+    (m.entry(nd) == m.exit(nd)).then_some(mode)
+}

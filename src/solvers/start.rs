@@ -1,0 +1,84 @@
+//! Shared pieces of the improvement solvers: start solutions and result reporting.
+
+use super::{Context, Outcome, greedy, outcome_of};
+use crate::cost::CostModel;
+use crate::engine::{Costs, Solution};
+use crate::model::{Sequence, Visit};
+use rand::RngExt;
+use rand_chacha::ChaCha8Rng;
+
+/// The deterministic greedy start (the `greedy` solver's sequence).
+pub fn greedy_start(ctx: &mut Context) -> Sequence {
+    let m = ctx.model;
+    if m.is_geometric() {
+        greedy::geometric(m, &mut |k| ctx.count(k))
+    } else {
+        greedy::matrix(m, &mut |k| ctx.count(k))
+    }
+}
+
+/// A randomized fringe construction, O(n²): at each step the cheapest ready (cell, mode) is
+/// taken with probability `1 − noise`, otherwise one of the three cheapest at random. With
+/// `first` set, that ready cell starts the path.
+pub fn random_start(
+    ctx: &mut Context,
+    rng: &mut ChaCha8Rng,
+    noise: f64,
+    first: Option<(usize, usize)>,
+) -> Sequence {
+    let m = ctx.model;
+    let n = m.n();
+    let mut missing: Vec<u32> = m.dag.preds.iter().map(|p| p.len() as u32).collect();
+    let mut ready: Vec<usize> = (0..n).filter(|&c| missing[c] == 0).collect();
+    let mut seq: Sequence = Vec::with_capacity(n);
+    while !ready.is_empty() {
+        let mut top: Vec<(f64, usize, usize, usize)> = Vec::with_capacity(4);
+        for (idx, &c) in ready.iter().enumerate() {
+            for md in 0..m.modes(c) {
+                let cost = match seq.last() {
+                    None => m.start(c, md),
+                    Some(p) => m.arc(p.cell, p.mode, c, md),
+                };
+                top.push((cost, c, md, idx));
+                top.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+                top.truncate(3);
+            }
+        }
+        ctx.count(ready.len() as u64);
+        let mut pick = if rng.random_bool(noise.clamp(0.0, 1.0)) {
+            top[rng.random_range(0..top.len())]
+        } else {
+            top[0]
+        };
+        if seq.is_empty()
+            && let Some((c, md)) = first
+            && let Some(idx) = ready.iter().position(|&r| r == c)
+        {
+            pick = (0.0, c, md, idx);
+        }
+        let (_, c, md, idx) = pick;
+        ready.swap_remove(idx);
+        seq.push(Visit::new(c, md));
+        for &s in &m.dag.succs[c] {
+            missing[s as usize] -= 1;
+            if missing[s as usize] == 0 {
+                ready.push(s as usize);
+            }
+        }
+    }
+    seq
+}
+
+/// The outcome of a solution, scored by the true (open-loop) objective.
+pub fn outcome(m: &CostModel, s: &Solution) -> Outcome {
+    outcome_of(m, s.sequence())
+}
+
+/// True cost (with the order-independent constant) of a solution evaluated with `c`.
+pub fn true_cost(c: &Costs, s: &Solution) -> f64 {
+    if c.closed {
+        c.m.evaluate(&s.sequence())
+    } else {
+        s.cost + c.m.constant()
+    }
+}

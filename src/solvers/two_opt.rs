@@ -1,0 +1,45 @@
+//! `two-opt`: greedy start, then 2-opt with mode flip to a local optimum.
+
+use super::start::{greedy_start, outcome};
+use super::{Context, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo};
+use crate::engine::search::Search;
+use crate::engine::{Costs, Solution};
+use crate::error::Result;
+
+/// Registry entry.
+pub static INFO: SolverInfo = SolverInfo {
+    name: "two-opt",
+    summary: "greedy, then 2-opt with mode flip (reversal of precedence-free reversible segments) to a local optimum",
+    params: &[ParamSpec {
+        name: "k",
+        default: "10",
+        kind: ParamKind::Int,
+        help: "candidate neighbours per cell",
+    }],
+    make: |p: &Params| {
+        Box::new(TwoOpt {
+            k: p.int("k").max(1) as usize,
+        })
+    },
+};
+
+/// The 2-opt solver.
+pub struct TwoOpt {
+    /// Candidate neighbours per cell.
+    pub k: usize,
+}
+
+impl Solver for TwoOpt {
+    fn solve(&self, ctx: &mut Context) -> Result<Outcome> {
+        let m = ctx.model;
+        let c = Costs::open(m);
+        let seq = greedy_start(ctx);
+        let mut s = Solution::new(&c, &seq);
+        ctx.report(s.cost + m.constant());
+        let mut search = Search::new(c, self.k);
+        while search.two_opt(&mut s, ctx) {
+            ctx.report(s.cost + m.constant());
+        }
+        Ok(outcome(m, &s))
+    }
+}

@@ -1,0 +1,117 @@
+//! Property tests: every move's O(1) delta equals a full re-evaluation, and the O(1)
+//! precedence tests accept only feasible results.
+
+use cellseq::cost::CostModel;
+use cellseq::engine::moves::{
+    Reversal, apply_segment, mode_delta, reverse_delta_direct, reversible_segment, segment_delta,
+    sop3_delta, window,
+};
+use cellseq::engine::{Costs, Solution, modes::mode_dp};
+use cellseq::generate::generate;
+use cellseq::solvers::greedy;
+use proptest::prelude::*;
+use std::collections::BTreeMap;
+
+fn model(
+    seed: u64,
+    n: usize,
+    modes: usize,
+    tools: usize,
+    density: f64,
+    return_home: bool,
+) -> CostModel {
+    let kv: BTreeMap<String, String> = [
+        ("n", n.to_string()),
+        ("modes", modes.to_string()),
+        ("closed", "0.3".to_string()),
+        ("tools", tools.to_string()),
+        ("layers", "2".to_string()),
+        ("density", density.to_string()),
+    ]
+    .into_iter()
+    .map(|(k, v)| (k.to_string(), v))
+    .collect();
+    let mut inst = generate("uniform", &kv, seed).unwrap();
+    inst.machine.return_home = return_home;
+    CostModel::new(&inst, inst.default_objective())
+}
+
+fn close(a: f64, b: f64) -> bool {
+    (a - b).abs() <= 1e-7 * a.abs().max(b.abs()).max(1.0)
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(40))]
+    #[test]
+    fn deltas_match_full_evaluation(seed in 0u64..1000, n in 4usize..40, modes in 1usize..4, tools in 1usize..3,
+                                    density in 0.0f64..0.2, closed in any::<bool>(), rh in any::<bool>(), picks in prop::collection::vec(any::<u64>(), 60)) {
+        let m = model(seed, n, modes, tools, density, rh);
+        let c = Costs { m: &m, closed };
+        let seq = greedy::geometric(&m, &mut |_| {});
+        let mut s = Solution::new(&c, &seq);
+        prop_assert!(s.feasible(&m));
+        let mut it = picks.into_iter();
+        let mut next = |k: usize| (it.next().unwrap_or(7) % k as u64) as usize;
+        for round in 0..10 {
+            let kind = round % 5;
+            match kind {
+                0 => {
+                    // SOP-3-exchange
+                    let h = next(n - 2) as isize - 1;
+                    let i = h + 1 + next((n as isize - 2 - h) as usize) as isize;
+                    let j = i + 1 + next((n as isize - 1 - i) as usize) as isize;
+                    let d = sop3_delta(&c, &s, h, i, j);
+                    let mut t = s.clone();
+                    t.swap_blocks(h, i as usize, j as usize, d);
+                    prop_assert!(close(t.cost, t.evaluate(&c)));
+                    if t.feasible(&m) { s = t; }
+                }
+                1 => {
+                    let len = 1 + next(3.min(n - 1));
+                    let i = next(n - len + 1);
+                    let (lo, hi) = window(&m, &s, i, len);
+                    let p = lo + next((hi - lo) as usize) as isize;
+                    if p >= i as isize - 1 && p < (i + len) as isize { continue; }
+                    let rev = len > 1 && reversible_segment(&m, &s, i, len);
+                    for r in [false, rev] {
+                        let d = segment_delta(&c, &s, i, len, p, r);
+                        let mut t = s.clone();
+                        apply_segment(&m, &mut t, i, len, p, r, d);
+                        prop_assert!(t.feasible(&m), "window admitted an infeasible move");
+                        prop_assert!(close(t.cost, t.evaluate(&c)));
+                    }
+                    let d = segment_delta(&c, &s, i, len, p, rev);
+                    apply_segment(&m, &mut s, i, len, p, rev, d);
+                }
+                2 => {
+                    let mut rv = Reversal::default();
+                    rv.refresh(&c, &s);
+                    let i = next(n);
+                    let reach = rv.reach[i];
+                    if reach < i as isize { continue; }
+                    let j = i + next((reach - i as isize + 1) as usize);
+                    prop_assert!(reversible_segment(&m, &s, i, j - i + 1));
+                    let d = rv.delta(&c, &s, i, j);
+                    prop_assert!(close(d, reverse_delta_direct(&c, &s, i, j)));
+                    s.reverse(&m, i, j, d);
+                    prop_assert!(s.feasible(&m));
+                    prop_assert!(close(s.cost, s.evaluate(&c)));
+                }
+                3 => {
+                    let p = next(n);
+                    let cell = s.order[p] as usize;
+                    let md = next(m.modes(cell));
+                    let d = mode_delta(&c, &s, p, md);
+                    s.set_mode(cell, md, d);
+                    prop_assert!(close(s.cost, s.evaluate(&c)));
+                }
+                _ => {
+                    let before = s.cost;
+                    mode_dp(&c, &mut s);
+                    prop_assert!(s.cost <= before + 1e-9 * before.abs().max(1.0));
+                    prop_assert!(close(s.cost, s.evaluate(&c)));
+                }
+            }
+        }
+    }
+}
