@@ -7,6 +7,7 @@
 pub mod as_given;
 pub mod exact;
 pub mod greedy;
+pub mod ils;
 pub mod local_search;
 pub mod sa;
 pub mod start;
@@ -188,6 +189,7 @@ pub fn registry() -> Vec<&'static SolverInfo> {
     vec![
         &as_given::INFO,
         &greedy::INFO,
+        &ils::INFO,
         &exact::INFO,
         &two_opt::INFO,
         &local_search::INFO,
