@@ -35,6 +35,12 @@ pub static INFO: SolverInfo = SolverInfo {
             help: "random segment swaps per perturbation",
         },
         ParamSpec {
+            name: "perturb",
+            default: "shuffle",
+            kind: ParamKind::Choice(&["shuffle", "swap"]),
+            help: "kick: random feasible reorder of a window, or random segment swaps",
+        },
+        ParamSpec {
             name: "max-seg",
             default: "0",
             kind: ParamKind::Int,
@@ -63,6 +69,7 @@ pub static INFO: SolverInfo = SolverInfo {
         Box::new(Ils {
             k: p.int("k").max(1) as usize,
             kicks: p.int("kicks").max(1) as usize,
+            shuffle: p.word("perturb") == "shuffle",
             max_seg: p.int("max-seg") as usize,
             accept: p.float("accept").max(0.0),
             restart: p.int("restart").max(1),
@@ -77,6 +84,8 @@ pub struct Ils {
     pub k: usize,
     /// Segment swaps per kick.
     pub kicks: usize,
+    /// Window shuffles (true) or segment swaps (false).
+    pub shuffle: bool,
     /// Longest segment in a kick (0 = automatic).
     pub max_seg: usize,
     /// Record-to-record band.
@@ -141,6 +150,87 @@ fn kick(
     false
 }
 
+/// Perturbation that an exchange move cannot simply undo: the cells of a random window of
+/// positions are put in a random order that respects the precedence among them (a random
+/// topological order; constraints with cells outside the window hold whatever the order).
+fn shuffle(
+    c: &Costs,
+    s: &mut Solution,
+    rng: &mut ChaCha8Rng,
+    max_seg: usize,
+    scratch: &mut Shuffle,
+    seeds: &mut Vec<u32>,
+) -> bool {
+    let n = s.n();
+    if n < 3 {
+        return false;
+    }
+    let m = c.m;
+    let w = rng.random_range(3..=max_seg.clamp(3, n));
+    let a = rng.random_range(0..=(n - w));
+    let cells: Vec<u32> = s.order[a..a + w].to_vec();
+    scratch.missing.clear();
+    scratch.ready.clear();
+    scratch.out.clear();
+    for (k, &x) in cells.iter().enumerate() {
+        let inside = m.dag.preds[x as usize]
+            .iter()
+            .filter(|&&p| {
+                let pp = s.pos[p as usize] as usize;
+                pp >= a && pp < a + w
+            })
+            .count();
+        scratch.missing.push(inside as u32);
+        if inside == 0 {
+            scratch.ready.push(k);
+        }
+    }
+    while !scratch.ready.is_empty() {
+        let r = rng.random_range(0..scratch.ready.len());
+        let k = scratch.ready.swap_remove(r);
+        let x = cells[k];
+        scratch.out.push(x);
+        for &q in &m.dag.succs[x as usize] {
+            let pq = s.pos[q as usize] as usize;
+            if pq >= a && pq < a + w {
+                let kk = pq - a;
+                scratch.missing[kk] -= 1;
+                if scratch.missing[kk] == 0 {
+                    scratch.ready.push(kk);
+                }
+            }
+        }
+    }
+    if scratch.out == cells {
+        return false;
+    }
+    let (lo, hi) = (a as isize - 1, (a + w) as isize);
+    let old: f64 = (lo..hi).map(|p| s.link(c, p, p + 1)).sum();
+    let slot = |x: u32| Some((x as usize, s.mode[x as usize] as usize));
+    let mut new = c.link(s.at(lo), slot(scratch.out[0])) + c.link(slot(scratch.out[w - 1]), s.at(hi));
+    for k in 0..w - 1 {
+        new += c.link(slot(scratch.out[k]), slot(scratch.out[k + 1]));
+    }
+    seeds.extend_from_slice(&scratch.out);
+    for p in [lo, hi] {
+        if p >= 0 && p < n as isize {
+            seeds.push(s.order[p as usize]);
+        }
+    }
+    let out = std::mem::take(&mut scratch.out);
+    s.rewrite(a, &out, new - old);
+    scratch.out = out;
+    true
+}
+
+/// Scratch space of [`shuffle`].
+#[derive(Default)]
+struct Shuffle {
+    missing: Vec<u32>,
+    ready: Vec<usize>,
+    out: Vec<u32>,
+}
+
 impl Solver for Ils {
     fn solve(&self, ctx: &mut Context) -> Result<Outcome> {
         let m = ctx.model;
@@ -163,6 +253,7 @@ impl Solver for Ils {
         let mut stamp = vec![0u32; n];
         let mut label = 0u32;
         let mut seeds: Vec<u32> = Vec::new();
+        let mut scratch = Shuffle::default();
         let bounded = ctx.budget.max_evals.is_some() || ctx.budget.time_limit.is_some();
         let mut since_best = 0u64;
         let mut since_restart = 0u64;
@@ -175,7 +266,11 @@ impl Solver for Ils {
             seeds.clear();
             let mut kicked = false;
             for _ in 0..self.kicks {
-                kicked |= kick(&c, &mut trial, &mut rng, max_seg, &mut stamp, &mut label, &mut seeds);
+                kicked |= if self.shuffle {
+                    shuffle(&c, &mut trial, &mut rng, max_seg, &mut scratch, &mut seeds)
+                } else {
+                    kick(&c, &mut trial, &mut rng, max_seg, &mut stamp, &mut label, &mut seeds)
+                };
             }
             ctx.count(seeds.len() as u64 + 1);
             if !kicked {
