@@ -28,6 +28,16 @@ impl Queue {
             on: vec![true; n],
         }
     }
+    fn seeded(n: usize, seeds: &[u32]) -> Self {
+        let mut q = Queue {
+            q: VecDeque::with_capacity(seeds.len()),
+            on: vec![false; n],
+        };
+        for &c in seeds {
+            q.push(c);
+        }
+        q
+    }
     fn push(&mut self, c: u32) {
         if !self.on[c as usize] {
             self.on[c as usize] = true;
@@ -76,10 +86,20 @@ impl<'a> Search<'a> {
     /// Or-opt to a local optimum: segments of 1–3 cells starting at a looked-at cell move
     /// next to a candidate neighbour (kept or reversed). Returns true on any improvement.
     pub fn or_opt(&mut self, s: &mut Solution, ctx: &mut Context) -> bool {
+        let queue = Queue::all(s.n());
+        self.or_opt_from(s, ctx, queue)
+    }
+
+    /// Or-opt that starts by looking only at `seeds` (and what their moves disturb).
+    pub fn or_opt_seeded(&mut self, s: &mut Solution, ctx: &mut Context, seeds: &[u32]) -> bool {
+        let queue = Queue::seeded(s.n(), seeds);
+        self.or_opt_from(s, ctx, queue)
+    }
+
+    fn or_opt_from(&mut self, s: &mut Solution, ctx: &mut Context, mut queue: Queue) -> bool {
         let c = self.c;
         let m = c.m;
         let n = s.n();
-        let mut queue = Queue::all(n);
         let mut improved = false;
         while let Some(x) = queue.pop() {
             if ctx.exhausted() {
@@ -207,10 +227,20 @@ impl<'a> Search<'a> {
     /// SOP-3-exchange (forward lexicographic search with labelling and a don't-push stack) to
     /// a local optimum. Returns true on any improvement.
     pub fn sop3(&mut self, s: &mut Solution, ctx: &mut Context) -> bool {
+        let queue = Queue::all(s.n());
+        self.sop3_from(s, ctx, queue)
+    }
+
+    /// SOP-3-exchange that starts by looking only at `seeds` (and what their moves disturb).
+    pub fn sop3_seeded(&mut self, s: &mut Solution, ctx: &mut Context, seeds: &[u32]) -> bool {
+        let queue = Queue::seeded(s.n(), seeds);
+        self.sop3_from(s, ctx, queue)
+    }
+
+    fn sop3_from(&mut self, s: &mut Solution, ctx: &mut Context, mut queue: Queue) -> bool {
         let c = self.c;
         let m = c.m;
         let n = s.n();
-        let mut queue = Queue::all(n);
         let mut improved = false;
         while let Some(x) = queue.pop() {
             if ctx.exhausted() {

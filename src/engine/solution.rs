@@ -92,6 +92,13 @@ impl Solution {
                 .all(|&s| self.pos[c] < self.pos[s as usize])
         })
     }
+    /// Replaces the cells at positions `from..from + cells.len()` by `cells` (a permutation
+    /// of the cells there; the caller keeps precedence), adding `delta`.
+    pub fn rewrite(&mut self, from: usize, cells: &[u32], delta: f64) {
+        self.order[from..from + cells.len()].copy_from_slice(cells);
+        self.renumber(from, from + cells.len());
+        self.cost += delta;
+    }
     fn renumber(&mut self, from: usize, to: usize) {
         for p in from..to {
             self.pos[self.order[p] as usize] = p as u32;

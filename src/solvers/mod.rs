@@ -9,6 +9,7 @@ pub mod as_given;
 pub mod beam;
 pub mod exact;
 pub mod greedy;
+pub mod ils;
 pub mod local_search;
 pub mod process;
 pub mod rules;
@@ -193,6 +194,7 @@ pub fn registry() -> Vec<&'static SolverInfo> {
     vec![
         &as_given::INFO,
         &greedy::INFO,
+        &ils::INFO,
         &exact::INFO,
         &beam::INFO,
         &two_opt::INFO,

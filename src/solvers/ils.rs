@@ -1,0 +1,310 @@
+//! `ils`: iterated local search over the shared engine — cellseq's strongest general solver.
+//!
+//! Start from the greedy sequence and descend with the full VND. Then repeat: kick the
+//! current solution with random feasible segment swaps (SOP-3-exchange moves chosen at random,
+//! feasibility by labelling), repair with Or-opt and SOP-3-exchange started only from the cells
+//! the kick disturbed (don't-look bits everywhere else), re-choose modes, and accept the result
+//! when it lies within a record-to-record band above the best (`accept`, relative). After
+//! `restart` kicks without a new best the walk restarts from the best solution. Without a
+//! budget it stops after `stall` kicks without a new best.
+
+use super::start::{greedy_start, outcome};
+use super::{Context, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo};
+use crate::engine::moves::sop3_delta;
+use crate::engine::search::Search;
+use crate::engine::{Costs, Solution};
+use crate::error::Result;
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+/// Registry entry.
+pub static INFO: SolverInfo = SolverInfo {
+    name: "ils",
+    summary: "iterated local search: segment-swap kicks, focused SOP-3-exchange/Or-opt repair, mode DP, record-to-record acceptance",
+    params: &[
+        ParamSpec {
+            name: "k",
+            default: "12",
+            kind: ParamKind::Int,
+            help: "candidate neighbours per cell",
+        },
+        ParamSpec {
+            name: "kicks",
+            default: "1",
+            kind: ParamKind::Int,
+            help: "random segment swaps per perturbation",
+        },
+        ParamSpec {
+            name: "perturb",
+            default: "shuffle",
+            kind: ParamKind::Choice(&["shuffle", "swap"]),
+            help: "kick: random feasible reorder of a window, or random segment swaps",
+        },
+        ParamSpec {
+            name: "max-seg",
+            default: "0",
+            kind: ParamKind::Int,
+            help: "longest swapped segment in a kick (0 = automatic: min(n/4, 30))",
+        },
+        ParamSpec {
+            name: "accept",
+            default: "0.001",
+            kind: ParamKind::Float,
+            help: "accept a kicked solution within this relative band above the best",
+        },
+        ParamSpec {
+            name: "restart",
+            default: "2000",
+            kind: ParamKind::Int,
+            help: "kicks without a new best before the walk restarts from the best",
+        },
+        ParamSpec {
+            name: "stall",
+            default: "20000",
+            kind: ParamKind::Int,
+            help: "stop after this many kicks without a new best when no budget is set",
+        },
+    ],
+    make: |p: &Params| {
+        Box::new(Ils {
+            k: p.int("k").max(1) as usize,
+            kicks: p.int("kicks").max(1) as usize,
+            shuffle: p.word("perturb") == "shuffle",
+            max_seg: p.int("max-seg") as usize,
+            accept: p.float("accept").max(0.0),
+            restart: p.int("restart").max(1),
+            stall: p.int("stall").max(1),
+        })
+    },
+};
+
+/// The iterated local search.
+pub struct Ils {
+    /// Candidate neighbours per cell.
+    pub k: usize,
+    /// Segment swaps per kick.
+    pub kicks: usize,
+    /// Window shuffles (true) or segment swaps (false).
+    pub shuffle: bool,
+    /// Longest segment in a kick (0 = automatic).
+    pub max_seg: usize,
+    /// Record-to-record band.
+    pub accept: f64,
+    /// Kicks without improvement before restarting from the best.
+    pub restart: u64,
+    /// Kicks without improvement before stopping (no budget).
+    pub stall: u64,
+}
+
+/// One random feasible segment swap on `s`: blocks `[h+1..=i]` and `[i+1..=j]` trade places.
+/// Returns the cells at the six positions around the cut points (to seed the repair).
+fn kick(
+    c: &Costs,
+    s: &mut Solution,
+    rng: &mut ChaCha8Rng,
+    max_seg: usize,
+    stamp: &mut [u32],
+    label: &mut u32,
+    seeds: &mut Vec<u32>,
+) -> bool {
+    let n = s.n();
+    if n < 3 {
+        return false;
+    }
+    let m = c.m;
+    for _ in 0..200 {
+        let h = rng.random_range(0..(n as i64 - 1)) as isize - 1;
+        let lmax = max_seg.min((n as isize - 2 - h) as usize).max(1);
+        let len = rng.random_range(1..=lmax);
+        let i = h + len as isize;
+        if i > n as isize - 2 {
+            continue;
+        }
+        *label = label.wrapping_add(1).max(1);
+        for p in (h + 1)..=i {
+            for &q in &m.dag.succs[s.order[p as usize] as usize] {
+                stamp[q as usize] = *label;
+            }
+        }
+        // the right block may grow while it holds no successor of the left block
+        let mut jmax = i;
+        while jmax + 1 < n as isize
+            && jmax - i < max_seg as isize
+            && stamp[s.order[(jmax + 1) as usize] as usize] != *label
+        {
+            jmax += 1;
+        }
+        if jmax == i {
+            continue;
+        }
+        let j = rng.random_range((i + 1) as i64..=jmax as i64) as isize;
+        for p in [h, h + 1, i, i + 1, j, j + 1] {
+            if p >= 0 && p < n as isize {
+                seeds.push(s.order[p as usize]);
+            }
+        }
+        let d = sop3_delta(c, s, h, i, j);
+        s.swap_blocks(h, i as usize, j as usize, d);
+        return true;
+    }
+    false
+}
+
+/// Perturbation that an exchange move cannot simply undo: the cells of a random window of
+/// positions are put in a random order that respects the precedence among them (a random
+/// topological order; constraints with cells outside the window hold whatever the order).
+fn shuffle(
+    c: &Costs,
+    s: &mut Solution,
+    rng: &mut ChaCha8Rng,
+    max_seg: usize,
+    scratch: &mut Shuffle,
+    seeds: &mut Vec<u32>,
+) -> bool {
+    let n = s.n();
+    if n < 3 {
+        return false;
+    }
+    let m = c.m;
+    let w = rng.random_range(3..=max_seg.clamp(3, n));
+    let a = rng.random_range(0..=(n - w));
+    let cells: Vec<u32> = s.order[a..a + w].to_vec();
+    scratch.missing.clear();
+    scratch.ready.clear();
+    scratch.out.clear();
+    for (k, &x) in cells.iter().enumerate() {
+        let inside = m.dag.preds[x as usize]
+            .iter()
+            .filter(|&&p| {
+                let pp = s.pos[p as usize] as usize;
+                pp >= a && pp < a + w
+            })
+            .count();
+        scratch.missing.push(inside as u32);
+        if inside == 0 {
+            scratch.ready.push(k);
+        }
+    }
+    while !scratch.ready.is_empty() {
+        let r = rng.random_range(0..scratch.ready.len());
+        let k = scratch.ready.swap_remove(r);
+        let x = cells[k];
+        scratch.out.push(x);
+        for &q in &m.dag.succs[x as usize] {
+            let pq = s.pos[q as usize] as usize;
+            if pq >= a && pq < a + w {
+                let kk = pq - a;
+                scratch.missing[kk] -= 1;
+                if scratch.missing[kk] == 0 {
+                    scratch.ready.push(kk);
+                }
+            }
+        }
+    }
+    if scratch.out == cells {
+        return false;
+    }
+    let (lo, hi) = (a as isize - 1, (a + w) as isize);
+    let old: f64 = (lo..hi).map(|p| s.link(c, p, p + 1)).sum();
+    let slot = |x: u32| Some((x as usize, s.mode[x as usize] as usize));
+    let mut new = c.link(s.at(lo), slot(scratch.out[0])) + c.link(slot(scratch.out[w - 1]), s.at(hi));
+    for k in 0..w - 1 {
+        new += c.link(slot(scratch.out[k]), slot(scratch.out[k + 1]));
+    }
+    seeds.extend_from_slice(&scratch.out);
+    for p in [lo, hi] {
+        if p >= 0 && p < n as isize {
+            seeds.push(s.order[p as usize]);
+        }
+    }
+    let out = std::mem::take(&mut scratch.out);
+    s.rewrite(a, &out, new - old);
+    scratch.out = out;
+    true
+}
+
+/// Scratch space of [`shuffle`].
+#[derive(Default)]
+struct Shuffle {
+    missing: Vec<u32>,
+    ready: Vec<usize>,
+    out: Vec<u32>,
+}
+
+impl Solver for Ils {
+    fn solve(&self, ctx: &mut Context) -> Result<Outcome> {
+        let m = ctx.model;
+        let n = m.n();
+        let c = Costs::open(m);
+        let seq = greedy_start(ctx);
+        let mut cur = Solution::new(&c, &seq);
+        ctx.report(cur.cost + m.constant());
+        let mut search = Search::new(c, self.k);
+        search.vnd(&mut cur, ctx);
+        let mut best = cur.clone();
+        ctx.report(best.cost + m.constant());
+        let multimode = (0..n).any(|x| m.modes(x) > 1);
+        let max_seg = if self.max_seg > 0 {
+            self.max_seg
+        } else {
+            (n / 4).clamp(1, 30)
+        };
+        let mut rng = ChaCha8Rng::seed_from_u64(ctx.seed ^ 0x11_5eed);
+        let mut stamp = vec![0u32; n];
+        let mut label = 0u32;
+        let mut seeds: Vec<u32> = Vec::new();
+        let mut scratch = Shuffle::default();
+        let bounded = ctx.budget.max_evals.is_some() || ctx.budget.time_limit.is_some();
+        let mut since_best = 0u64;
+        let mut since_restart = 0u64;
+        let mut trial = cur.clone();
+        while !ctx.exhausted() {
+            if !bounded && since_best >= self.stall {
+                break;
+            }
+            trial.clone_from(&cur);
+            seeds.clear();
+            let mut kicked = false;
+            for _ in 0..self.kicks {
+                kicked |= if self.shuffle {
+                    shuffle(&c, &mut trial, &mut rng, max_seg, &mut scratch, &mut seeds)
+                } else {
+                    kick(&c, &mut trial, &mut rng, max_seg, &mut stamp, &mut label, &mut seeds)
+                };
+            }
+            ctx.count(seeds.len() as u64 + 1);
+            if !kicked {
+                since_best += 1;
+                continue;
+            }
+            loop {
+                let a = search.or_opt_seeded(&mut trial, ctx, &seeds);
+                let b = search.sop3_seeded(&mut trial, ctx, &seeds);
+                if !(a || b) || ctx.exhausted() {
+                    break;
+                }
+            }
+            if multimode {
+                search.modes(&mut trial, ctx);
+            }
+            since_best += 1;
+            since_restart += 1;
+            if trial.cost < best.cost - 1e-9 * best.cost.abs().max(1.0) {
+                // polish a new best with the full descent before keeping it
+                search.vnd(&mut trial, ctx);
+                best.clone_from(&trial);
+                ctx.report(best.cost + m.constant());
+                since_best = 0;
+                since_restart = 0;
+            }
+            if trial.cost <= best.cost + self.accept * best.cost.abs() {
+                std::mem::swap(&mut cur, &mut trial);
+            }
+            if since_restart >= self.restart {
+                cur.clone_from(&best);
+                since_restart = 0;
+            }
+        }
+        Ok(outcome(m, &best))
+    }
+}
