@@ -203,3 +203,17 @@ fn json_round_trip_is_lossless() {
     let back = json::parse_instance("mem.json", &json::instance_to_json(&sop)).unwrap();
     assert_eq!(sop, back);
 }
+
+#[test]
+fn greedy_handles_many_coincident_points() {
+    // 300 cells whose entries coincide in groups of 100 (more than a k-d tree bucket holds),
+    // reversible so exits coincide too: greedy must stay feasible and visit every cell once.
+    let mut inst = line_instance(300, true);
+    for (i, c) in inst.cells.iter_mut().enumerate() {
+        let p = cellseq::geom::Point3::new((i % 3) as f64 * 50.0, 0.0, -1.0);
+        let q = cellseq::geom::Point3::new((i % 3) as f64 * 50.0 + 5.0, 0.0, -1.0);
+        c.modes = vec![cellseq::Mode::new(p, q), cellseq::Mode::new(q, p)];
+    }
+    let r = solve("greedy", &inst);
+    assert_eq!(r.outcome.sequence.len(), 300);
+}

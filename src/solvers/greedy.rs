@@ -102,65 +102,94 @@ pub fn matrix(m: &CostModel, count: &mut dyn FnMut(u64)) -> Sequence {
 
 type Tree = MutableKdTree<f64, 2>;
 
-/// One k-d tree per tool over the entry points of ready, unvisited cells. kiddo's mutable
-/// tree does not prune emptied leaves, so a tree is rebuilt from its live points once more
-/// points have been removed from it than remain.
-struct ToolTrees<'a> {
-    m: &'a CostModel,
+/// One k-d tree per tool over the distinct entry points ("sites") of ready, unvisited cells.
+/// Coincident entry points share one site (a k-d tree bucket cannot split identical points),
+/// and each site lists its live nodes. kiddo's mutable tree does not prune emptied leaves, so
+/// a tree is rebuilt from its live sites once more sites have left it than remain.
+struct ToolTrees {
     trees: Vec<Tree>,
+    /// live sites per tool tree
     live: Vec<u32>,
     removed: Vec<u32>,
-    cells_of_tool: Vec<Vec<u32>>,
+    site_of_node: Vec<u32>,
+    site_xy: Vec<[f64; 2]>,
+    site_tool: Vec<u32>,
+    sites_of_tool: Vec<Vec<u32>>,
+    /// live nodes at each site
+    nodes_at: Vec<Vec<u32>>,
 }
 
-impl<'a> ToolTrees<'a> {
-    fn new(m: &'a CostModel) -> Self {
+impl ToolTrees {
+    fn new(m: &CostModel) -> Self {
         let n = m.n();
         let ntools = (0..n).map(|c| m.tool(c) as usize + 1).max().unwrap_or(1);
-        let mut cells_of_tool = vec![Vec::new(); ntools];
+        let mut index: std::collections::HashMap<(u32, u64, u64), u32> = Default::default();
+        let mut site_of_node = vec![0u32; m.nodes()];
+        let mut site_xy = Vec::new();
+        let mut site_tool = Vec::new();
+        let mut sites_of_tool = vec![Vec::new(); ntools];
         for c in 0..n {
-            cells_of_tool[m.tool(c) as usize].push(c as u32);
+            let t = m.tool(c);
+            for md in 0..m.modes(c) {
+                let nd = m.node(c, md);
+                let p = m.entry(nd);
+                let key = (t, p.x.to_bits(), p.y.to_bits());
+                let id = *index.entry(key).or_insert_with(|| {
+                    site_xy.push([p.x, p.y]);
+                    site_tool.push(t);
+                    sites_of_tool[t as usize].push(site_xy.len() as u32 - 1);
+                    site_xy.len() as u32 - 1
+                });
+                site_of_node[nd] = id;
+            }
         }
+        let nsites = site_xy.len();
         ToolTrees {
-            m,
             trees: (0..ntools).map(|_| Tree::default()).collect(),
             live: vec![0; ntools],
             removed: vec![0; ntools],
-            cells_of_tool,
+            site_of_node,
+            site_xy,
+            site_tool,
+            sites_of_tool,
+            nodes_at: vec![Vec::new(); nsites],
         }
     }
-    fn add(&mut self, c: usize) {
-        let t = self.m.tool(c) as usize;
-        for md in 0..self.m.modes(c) {
-            let nd = self.m.node(c, md);
-            let p = self.m.entry(nd);
-            self.trees[t]
-                .add(&[p.x, p.y], nd as u32)
-                .expect("k-d tree insert");
-            self.live[t] += 1;
+    fn add(&mut self, m: &CostModel, c: usize) {
+        for md in 0..m.modes(c) {
+            let nd = m.node(c, md);
+            let site = self.site_of_node[nd] as usize;
+            if self.nodes_at[site].is_empty() {
+                let t = self.site_tool[site] as usize;
+                self.trees[t]
+                    .add(&self.site_xy[site], site as u32)
+                    .expect("k-d tree insert of a distinct point");
+                self.live[t] += 1;
+            }
+            self.nodes_at[site].push(nd as u32);
         }
     }
-    fn remove(&mut self, c: usize, in_tree: impl Fn(usize) -> bool) {
-        let t = self.m.tool(c) as usize;
-        for md in 0..self.m.modes(c) {
-            let nd = self.m.node(c, md);
-            let p = self.m.entry(nd);
-            self.trees[t].remove(&[p.x, p.y], nd as u32);
-            self.live[t] -= 1;
-            self.removed[t] += 1;
+    fn remove(&mut self, m: &CostModel, c: usize) {
+        let t = m.tool(c) as usize;
+        for md in 0..m.modes(c) {
+            let nd = m.node(c, md) as u32;
+            let site = self.site_of_node[nd as usize] as usize;
+            let list = &mut self.nodes_at[site];
+            if let Some(k) = list.iter().position(|&x| x == nd) {
+                list.swap_remove(k);
+            }
+            if list.is_empty() {
+                self.trees[t].remove(&self.site_xy[site], site as u32);
+                self.live[t] -= 1;
+                self.removed[t] += 1;
+            }
         }
         if self.removed[t] > self.live[t].max(64) {
-            let mut entries = Vec::with_capacity(self.live[t] as usize);
-            for &cc in &self.cells_of_tool[t] {
-                let cc = cc as usize;
-                if in_tree(cc) {
-                    for md in 0..self.m.modes(cc) {
-                        let nd = self.m.node(cc, md);
-                        let p = self.m.entry(nd);
-                        entries.push((nd as u32, [p.x, p.y]));
-                    }
-                }
-            }
+            let entries: Vec<(u32, [f64; 2])> = self.sites_of_tool[t]
+                .iter()
+                .filter(|&&site| !self.nodes_at[site as usize].is_empty())
+                .map(|&site| (site, self.site_xy[site as usize]))
+                .collect();
             self.trees[t] = if entries.is_empty() {
                 Tree::default()
             } else {
@@ -180,7 +209,7 @@ pub fn geometric(m: &CostModel, count: &mut dyn FnMut(u64)) -> Sequence {
     let mut fringe = Fringe::new(m);
     for c in 0..n {
         if fringe.missing[c] == 0 {
-            trees.add(c);
+            trees.add(m, c);
         }
     }
     // lower bound on any move cost given its planar length d
@@ -248,10 +277,12 @@ pub fn geometric(m: &CostModel, count: &mut dyn FnMut(u64)) -> Sequence {
                     .execute();
                 count(res.len() as u64);
                 for r in &res {
-                    let nd = r.item as usize;
-                    let c = cost_to(nd);
-                    if c < best.0 || (c == best.0 && nd < best.1) {
-                        best = (c, nd);
+                    for &nd in &trees.nodes_at[r.item as usize] {
+                        let nd = nd as usize;
+                        let c = cost_to(nd);
+                        if c < best.0 || (c == best.0 && nd < best.1) {
+                            best = (c, nd);
+                        }
                     }
                 }
                 let exhausted = res.len() < kk || kk == trees.live[t] as usize;
@@ -267,10 +298,9 @@ pub fn geometric(m: &CostModel, count: &mut dyn FnMut(u64)) -> Sequence {
         done[c] = true;
         let mut newly = Vec::new();
         fringe.done(m, c, |s| newly.push(s));
-        let missing = &fringe.missing;
-        trees.remove(c, |x| !done[x] && missing[x] == 0);
+        trees.remove(m, c);
         for s in newly {
-            trees.add(s);
+            trees.add(m, s);
         }
     }
     seq

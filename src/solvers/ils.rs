@@ -207,7 +207,8 @@ fn shuffle(
     let (lo, hi) = (a as isize - 1, (a + w) as isize);
     let old: f64 = (lo..hi).map(|p| s.link(c, p, p + 1)).sum();
     let slot = |x: u32| Some((x as usize, s.mode[x as usize] as usize));
-    let mut new = c.link(s.at(lo), slot(scratch.out[0])) + c.link(slot(scratch.out[w - 1]), s.at(hi));
+    let mut new =
+        c.link(s.at(lo), slot(scratch.out[0])) + c.link(slot(scratch.out[w - 1]), s.at(hi));
     for k in 0..w - 1 {
         new += c.link(slot(scratch.out[k]), slot(scratch.out[k + 1]));
     }
@@ -269,7 +270,9 @@ impl Solver for Ils {
                 kicked |= if self.shuffle {
                     shuffle(&c, &mut trial, &mut rng, max_seg, &mut scratch, &mut seeds)
                 } else {
-                    kick(&c, &mut trial, &mut rng, max_seg, &mut stamp, &mut label, &mut seeds)
+                    kick(
+                        &c, &mut trial, &mut rng, max_seg, &mut stamp, &mut label, &mut seeds,
+                    )
                 };
             }
             ctx.count(seeds.len() as u64 + 1);

@@ -6,6 +6,7 @@
 
 pub mod aco;
 pub mod as_given;
+pub mod auto;
 pub mod beam;
 pub mod exact;
 pub mod greedy;
@@ -192,6 +193,7 @@ pub struct SolverInfo {
 /// Every registered solver, in display order.
 pub fn registry() -> Vec<&'static SolverInfo> {
     vec![
+        &auto::INFO,
         &as_given::INFO,
         &greedy::INFO,
         &ils::INFO,
@@ -208,7 +210,7 @@ pub fn registry() -> Vec<&'static SolverInfo> {
 }
 
 /// Name of the solver `cellseq solve` uses when none is named.
-pub const DEFAULT_SOLVER: &str = "greedy";
+pub const DEFAULT_SOLVER: &str = "auto";
 
 /// Looks a solver up by name.
 pub fn find(name: &str) -> Result<&'static SolverInfo> {

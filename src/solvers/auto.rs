@@ -1,0 +1,129 @@
+//! `auto`: the default solver — a portfolio chosen by measurement on TSPLIB SOP.
+//!
+//! 1. `beam` (iterative beam search with dominance and bounds) for a small share of the
+//!    budget on instances of at most `beam-max-cells` cells: it proves small and densely
+//!    constrained instances optimal in milliseconds, and then `auto` stops.
+//! 2. `local-search` (iterated VND) for half of what remains — strongest on small and
+//!    medium instances.
+//! 3. `ils` (window-shuffle kicks with focused SOP-3-exchange repair) for the rest —
+//!    strongest on the large, densely constrained ones.
+//!
+//! The best sequence wins. Budgets are split by fraction, evaluations as well as time, so a
+//! run with an evaluation budget stays deterministic. Without any budget `auto` gives itself
+//! `seconds` of wall-clock time.
+
+use super::{
+    Budget, Context, NoObserver, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo,
+};
+use crate::error::Result;
+use std::collections::BTreeMap;
+use std::time::Duration;
+
+/// Registry entry.
+pub static INFO: SolverInfo = SolverInfo {
+    name: "auto",
+    summary: "portfolio (default): beam proof attempt on small instances, then local-search and ils; best wins",
+    params: &[
+        ParamSpec {
+            name: "seconds",
+            default: "10",
+            kind: ParamKind::Float,
+            help: "wall-clock budget used when neither --time-limit nor --max-evals is given",
+        },
+        ParamSpec {
+            name: "beam-share",
+            default: "0.1",
+            kind: ParamKind::Float,
+            help: "share of the budget given to the beam proof attempt",
+        },
+        ParamSpec {
+            name: "beam-max-cells",
+            default: "400",
+            kind: ParamKind::Int,
+            help: "skip the beam phase on larger instances",
+        },
+    ],
+    make: |p: &Params| {
+        Box::new(Auto {
+            seconds: p.float("seconds").max(0.001),
+            beam_share: p.float("beam-share").clamp(0.0, 1.0),
+            beam_max_cells: p.int("beam-max-cells") as usize,
+        })
+    },
+};
+
+/// The portfolio.
+pub struct Auto {
+    /// Default wall-clock budget.
+    pub seconds: f64,
+    /// Share of the budget for the beam phase.
+    pub beam_share: f64,
+    /// Largest instance for the beam phase.
+    pub beam_max_cells: usize,
+}
+
+/// A share of `b` (what is left of it after `used_evals` and `used_s`).
+fn share(b: Budget, used_evals: u64, used_s: f64, frac: f64) -> Budget {
+    Budget {
+        time_limit: b
+            .time_limit
+            .map(|t| Duration::from_secs_f64((t.as_secs_f64() - used_s).max(0.0) * frac)),
+        max_evals: b
+            .max_evals
+            .map(|m| ((m.saturating_sub(used_evals)) as f64 * frac) as u64),
+    }
+}
+
+impl Auto {
+    fn phase(&self, ctx: &mut Context, name: &str, budget: Budget) -> Result<Outcome> {
+        let info = super::find(name)?;
+        let params = Params::new(name, info.params, &BTreeMap::new())?;
+        let solver = (info.make)(&params);
+        let mut quiet = NoObserver;
+        let mut sub = Context::new(
+            ctx.instance,
+            ctx.model,
+            &params,
+            ctx.seed,
+            budget,
+            &mut quiet,
+        );
+        let out = solver.solve(&mut sub)?;
+        ctx.count(sub.evaluations());
+        ctx.report(out.cost);
+        Ok(out)
+    }
+}
+
+impl Solver for Auto {
+    fn solve(&self, ctx: &mut Context) -> Result<Outcome> {
+        let mut budget = ctx.budget;
+        if budget.time_limit.is_none() && budget.max_evals.is_none() {
+            budget.time_limit = Some(Duration::from_secs_f64(self.seconds));
+        }
+        let mut best: Option<Outcome> = None;
+        let keep = |best: &mut Option<Outcome>, o: Outcome| {
+            if best.as_ref().is_none_or(|b| o.cost < b.cost) {
+                *best = Some(o);
+            }
+        };
+        if ctx.model.n() <= self.beam_max_cells && self.beam_share > 0.0 {
+            let b = share(budget, 0, 0.0, self.beam_share);
+            if let Ok(o) = self.phase(ctx, "beam", b) {
+                if o.proven_optimal {
+                    return Ok(o);
+                }
+                keep(&mut best, o);
+            }
+        }
+        let b = share(budget, ctx.evaluations(), ctx.elapsed(), 0.5);
+        let o = self.phase(ctx, "local-search", b)?;
+        keep(&mut best, o);
+        let b = share(budget, ctx.evaluations(), ctx.elapsed(), 1.0);
+        let o = self.phase(ctx, "ils", b)?;
+        keep(&mut best, o);
+        let mut out = best.expect("at least one phase ran");
+        out.proven_optimal = false;
+        Ok(out)
+    }
+}
