@@ -3,6 +3,7 @@
 use anyhow::{Context as _, bail};
 use cellseq::formats::{read_text, save_instance, write_atomic};
 use cellseq::io::gcode::{self, Figures, Options};
+use cellseq::io::svg;
 use clap::Args;
 use std::path::{Path, PathBuf};
 
@@ -14,9 +15,10 @@ pub struct OptimizeArgs {
     /// Output file (default: report only).
     #[arg(short = 'o', long)]
     pub output: Option<PathBuf>,
-    /// Solver from the registry.
-    #[arg(long, default_value = cellseq::solvers::DEFAULT_SOLVER)]
-    pub solver: String,
+    /// Solver from the registry (default: greedy for G-code; for SVG/DXF the built-in
+    /// `drawing` sequencer: grid greedy + 2-opt with reversal).
+    #[arg(long)]
+    pub solver: Option<String>,
     /// Time limit in seconds (shared among tool blocks).
     #[arg(long, value_name = "S")]
     pub time_limit: Option<f64>,
@@ -44,6 +46,31 @@ pub struct OptimizeArgs {
     /// XY margin (mm) added to cell footprints for the overlap rule.
     #[arg(long, default_value_t = 0.5)]
     pub margin: f64,
+    #[command(flatten)]
+    pub drawing: DrawingArgs,
+}
+
+/// Options of SVG and DXF input.
+#[derive(Args, Debug, Clone)]
+pub struct DrawingArgs {
+    /// Curve flattening tolerance (mm).
+    #[arg(long, default_value_t = 0.01)]
+    pub tolerance: f64,
+    /// Sequence the whole drawing at once instead of layer by layer / colour by colour.
+    #[arg(long)]
+    pub no_scopes: bool,
+    /// Cut mode: strokes inside a closed stroke are drawn/cut before it.
+    #[arg(long)]
+    pub cut: bool,
+    /// Containment tolerance of cut mode (mm).
+    #[arg(long, default_value_t = 0.01)]
+    pub contain_tol: f64,
+    /// Start-vertex candidates per closed stroke when reversible.
+    #[arg(long, default_value_t = 8)]
+    pub max_starts: usize,
+    /// Skip unsupported elements (SVG text, images, …) instead of refusing the file.
+    #[arg(long)]
+    pub skip_unsupported: bool,
 }
 
 /// Arguments of `import`.
@@ -60,6 +87,14 @@ pub struct ImportArgs {
     /// XY margin (mm) added to cell footprints for the overlap rule.
     #[arg(long, default_value_t = 0.5)]
     pub margin: f64,
+    /// Input format (default: from the extension).
+    #[arg(long, value_name = "gcode|svg|dxf")]
+    pub format: Option<String>,
+    /// Never reverse cells (drawings).
+    #[arg(long)]
+    pub no_reversible: bool,
+    #[command(flatten)]
+    pub drawing: DrawingArgs,
 }
 
 /// Arguments of `verify-gcode`.
@@ -125,17 +160,24 @@ fn print_figures(before: &Figures, after: &Figures) {
 /// Runs `optimize`.
 pub fn optimize(a: OptimizeArgs) -> anyhow::Result<()> {
     let fmt = format_of(&a.input, a.format.as_deref())?;
+    if fmt == "svg" {
+        return optimize_svg(&a);
+    }
     if fmt != "gcode" {
         bail!(
-            "{}: {fmt} input is not supported yet (only G-code)",
+            "{}: {fmt} input is not supported yet (only G-code and SVG)",
             a.input.display()
         );
     }
     let file = a.input.display().to_string();
     let text = read_text(&a.input)?;
     let parsed = gcode::parse(&file, &text)?;
+    let solver = a
+        .solver
+        .clone()
+        .unwrap_or_else(|| cellseq::solvers::DEFAULT_SOLVER.to_string());
     let opts = Options {
-        solver: a.solver.clone(),
+        solver: solver.clone(),
         time_limit: a.time_limit,
         seed: a.seed,
         merge: a.merge_tool_blocks,
@@ -150,7 +192,7 @@ pub fn optimize(a: OptimizeArgs) -> anyhow::Result<()> {
         let v = serde_json::json!({
             "input": file,
             "output": a.output.as_ref().map(|p| p.display().to_string()),
-            "solver": a.solver,
+            "solver": solver,
             "cells": parsed.layout.cells.len(),
             "tool_blocks": parsed.layout.blocks.len(),
             "verified_cutting_moves": out.cuts,
@@ -166,7 +208,7 @@ pub fn optimize(a: OptimizeArgs) -> anyhow::Result<()> {
             "{file}: {} cells in {} tool blocks; solver {} ({:.3} s); {} cutting moves verified identical",
             parsed.layout.cells.len(),
             parsed.layout.blocks.len(),
-            a.solver,
+            solver,
             out.solve_s,
             out.cuts
         );
@@ -191,7 +233,23 @@ pub fn optimize(a: OptimizeArgs) -> anyhow::Result<()> {
 
 /// Runs `import`.
 pub fn import(a: ImportArgs) -> anyhow::Result<()> {
-    let fmt = format_of(&a.input, None)?;
+    let fmt = format_of(&a.input, a.format.as_deref())?;
+    if fmt == "svg" {
+        let file = a.input.display().to_string();
+        let d = read_svg(&a.input, &a.drawing)?;
+        let opts = svg_options(&d, &a.drawing, !a.no_reversible, "greedy", None, 1);
+        let inst = svg::import(&d, &opts)?;
+        cellseq::validate::validate(&inst, &file)?;
+        save_instance(&a.output, &inst)?;
+        println!(
+            "{}: {} strokes, {} precedence edges -> {}",
+            file,
+            inst.n(),
+            inst.precedence.len(),
+            a.output.display()
+        );
+        return Ok(());
+    }
     if fmt != "gcode" {
         bail!(
             "{}: {fmt} input is not supported yet (only G-code)",
@@ -231,6 +289,129 @@ pub fn verify(a: VerifyArgs) -> anyhow::Result<()> {
             v.cuts
         );
         print_figures(&v.before, &v.after);
+    }
+    Ok(())
+}
+
+fn read_svg(path: &Path, d: &DrawingArgs) -> anyhow::Result<svg::Drawing> {
+    let file = path.display().to_string();
+    let text = read_text(path)?;
+    // the tolerance is given in mm; the reader works in user units
+    let probe = svg::read(
+        &file,
+        &text,
+        svg::ReadOptions {
+            tolerance: 1e9,
+            skip_unsupported: true,
+        },
+    )?;
+    let tol = d.tolerance / probe.mm_per_unit;
+    Ok(svg::read(
+        &file,
+        &text,
+        svg::ReadOptions {
+            tolerance: tol,
+            skip_unsupported: d.skip_unsupported,
+        },
+    )?)
+}
+
+fn svg_options(
+    d: &svg::Drawing,
+    a: &DrawingArgs,
+    reversible: bool,
+    solver: &str,
+    time_limit: Option<f64>,
+    seed: u64,
+) -> svg::Options {
+    svg::Options {
+        solver: solver.to_string(),
+        time_limit,
+        seed,
+        reversible,
+        scopes: !a.no_scopes,
+        cut: a.cut,
+        contain_tol: a.contain_tol / d.mm_per_unit,
+        max_starts: a.max_starts,
+    }
+}
+
+fn optimize_svg(a: &OptimizeArgs) -> anyhow::Result<()> {
+    let file = a.input.display().to_string();
+    let t0 = std::time::Instant::now();
+    let d = read_svg(&a.input, &a.drawing)?;
+    let read_s = t0.elapsed().as_secs_f64();
+    // reversible by default for drawings
+    let reversible = !a.no_reversible;
+    let solver = a
+        .solver
+        .clone()
+        .unwrap_or_else(|| svg::DRAWING_SOLVER.to_string());
+    let opts = svg_options(&d, &a.drawing, reversible, &solver, a.time_limit, a.seed);
+    let out = svg::optimize(&d, &opts)?;
+    let text = svg::write(&d, &out.strokes);
+    let segments = svg::verify(&d, "<optimized>", &text)?;
+    if let Some(o) = &a.output {
+        write_atomic(o, text.as_bytes()).with_context(|| format!("writing {}", o.display()))?;
+    }
+    let total_s = t0.elapsed().as_secs_f64();
+    if a.json {
+        let v = serde_json::json!({
+            "input": file,
+            "output": a.output.as_ref().map(|p| p.display().to_string()),
+            "solver": solver,
+            "strokes": d.strokes.len(),
+            "scopes": out.scopes,
+            "precedence_edges": out.edges,
+            "reversible": reversible,
+            "verified_segments": segments,
+            "skipped": d.skipped,
+            "read_s": read_s,
+            "solve_s": out.solve_s,
+            "total_s": total_s,
+            "kept_original_scopes": out.kept_original,
+            "before": out.before,
+            "after": out.after,
+        });
+        println!("{}", serde_json::to_string_pretty(&v)?);
+    } else {
+        println!(
+            "{file}: {} strokes in {} scope(s); solver {} ({:.3} s, total {:.3} s); {} segments verified identical",
+            d.strokes.len(),
+            out.scopes,
+            solver,
+            out.solve_s,
+            total_s,
+            segments
+        );
+        for s in &d.skipped {
+            println!("skipped: {s}");
+        }
+        let pct = |x: f64, y: f64| if x > 0.0 { 100.0 * (x - y) / x } else { 0.0 };
+        let (b, f) = (&out.before, &out.after);
+        println!("{:<20} {:>14} {:>14} {:>8}", "", "before", "after", "saved");
+        println!(
+            "{:<20} {:>14.1} {:>14.1} {:>7.1}%",
+            "pen-up mm (layer)",
+            b.pen_up_mm,
+            f.pen_up_mm,
+            pct(b.pen_up_mm, f.pen_up_mm)
+        );
+        println!(
+            "{:<20} {:>14.1} {:>14.1} {:>7.1}%",
+            "pen-up mm (total)",
+            b.pen_up_total_mm,
+            f.pen_up_total_mm,
+            pct(b.pen_up_total_mm, f.pen_up_total_mm)
+        );
+        println!("{:<20} {:>14} {:>14}", "pen lifts", b.lifts, f.lifts);
+        println!(
+            "{:<20} {:>14.1} {:>14.1}",
+            "pen-down mm", b.draw_mm, f.draw_mm
+        );
+        if let Some(o) = &a.output {
+            println!("wrote {}", o.display());
+        }
     }
     Ok(())
 }

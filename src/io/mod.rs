@@ -4,3 +4,4 @@
 //! [`crate::model::Instance`] from them and write the program back in a new order.
 
 pub mod gcode;
+pub mod svg;
