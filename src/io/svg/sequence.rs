@@ -304,48 +304,126 @@ fn two_opt(
         nb_of[nd] = i;
         nb_of[flip[nd]] = i;
     }
+    // gain of reversing (and flipping) the block i..=j
+    let gain_of = |tour: &[usize], i: usize, j: usize| -> f64 {
+        let a = if i == 0 { home } else { exit[tour[i - 1]] };
+        let b_start = entry[tour[i]];
+        let c_end = exit[tour[j]];
+        let (old_cd, new_bd) = if j + 1 < n {
+            let d = entry[tour[j + 1]];
+            (d2(c_end, d), d2(b_start, d))
+        } else {
+            (0.0, 0.0)
+        };
+        d2(a, b_start) + old_cd - d2(a, c_end) - new_bd
+    };
+    let apply = |tour: &mut Vec<usize>, pos: &mut Vec<usize>, i: usize, j: usize| {
+        tour[i..=j].reverse();
+        for k in i..=j {
+            tour[k] = flip[tour[k]];
+            pos[tour[k]] = k;
+            pos[flip[tour[k]]] = k;
+        }
+    };
+    let ex = |tour: &[usize], k: usize| -> [f64; 2] {
+        if k == usize::MAX { home } else { exit[tour[k]] }
+    };
+    let or_move =
+        |tour: &mut Vec<usize>, pos: &mut Vec<usize>, k: usize, cands: &[usize]| -> bool {
+            let s = tour[k];
+            let prev = if k == 0 { usize::MAX } else { k - 1 };
+            let pe = ex(tour, prev);
+            let removed = d2(pe, entry[s])
+                + if k + 1 < n {
+                    d2(exit[s], entry[tour[k + 1]]) - d2(pe, entry[tour[k + 1]])
+                } else {
+                    0.0
+                };
+            // best insertion between positions q-1 and q (q != k, k+1), orientation o
+            let mut best = (1e-9, usize::MAX, 0usize);
+            for &m in cands {
+                let qm = pos[m];
+                if qm == usize::MAX {
+                    continue;
+                }
+                for q in [qm, qm + 1] {
+                    if q == k || q == k + 1 || q > n {
+                        continue;
+                    }
+                    let u = ex(tour, if q == 0 { usize::MAX } else { q - 1 });
+                    for o in [s, flip[s]] {
+                        let add = d2(u, entry[o])
+                            + if q < n {
+                                d2(exit[o], entry[tour[q]]) - d2(u, entry[tour[q]])
+                            } else {
+                                0.0
+                            };
+                        let g = removed - add;
+                        if g > best.0 {
+                            best = (g, q, o);
+                        }
+                    }
+                }
+            }
+            if best.1 == usize::MAX {
+                return false;
+            }
+            let (_, q, o) = best;
+            if q < k {
+                tour[q..=k].rotate_right(1);
+                tour[q] = o;
+                for (i, &nd) in tour.iter().enumerate().take(k + 1).skip(q) {
+                    pos[nd] = i;
+                    pos[flip[nd]] = i;
+                }
+            } else {
+                tour[k..q].rotate_left(1);
+                tour[q - 1] = o;
+                for (i, &nd) in tour.iter().enumerate().take(q).skip(k) {
+                    pos[nd] = i;
+                    pos[flip[nd]] = i;
+                }
+            }
+            true
+        };
     let mut improved = true;
     while improved && t0.elapsed().as_secs_f64() < limit {
         improved = false;
-        for i in 0..n {
-            // move into position i: predecessor end a (home for i = 0), b = tour[i]
-            let a = if i == 0 { home } else { exit[tour[i - 1]] };
-            let b_start = entry[tour[i]];
-            let cur_ab = d2(a, b_start);
-            if cur_ab == 0.0 {
-                continue;
-            }
-            let around = if i == 0 { tour[0] } else { tour[i - 1] };
+        for p in 0..n {
+            // blocks starting at p: the new first stroke ends near the predecessor's exit
+            let around = if p == 0 { tour[0] } else { tour[p - 1] };
+            let mut best = (1e-9, usize::MAX, usize::MAX);
             for &m in &neighbours[nb_of[around]] {
                 let j = pos[m];
-                if j == usize::MAX || j < i {
-                    continue;
-                }
-                // reverse block i..=j: new move a -> end(tour[j]) reversed start = exit[tour[j]]
-                let c_end = exit[tour[j]];
-                let new_ac = d2(a, c_end);
-                if new_ac >= cur_ab {
-                    continue;
-                }
-                let (old_cd, new_bd) = if j + 1 < n {
-                    let d = entry[tour[j + 1]];
-                    (d2(c_end, d), d2(b_start, d))
-                } else {
-                    (0.0, 0.0)
-                };
-                let gain = cur_ab + old_cd - new_ac - new_bd;
-                if gain > 1e-9 {
-                    tour[i..=j].reverse();
-                    for k in i..=j {
-                        tour[k] = flip[tour[k]];
-                        pos[tour[k]] = k;
-                        pos[flip[tour[k]]] = k;
+                if j != usize::MAX && j >= p {
+                    let g = gain_of(&tour, p, j);
+                    if g > best.0 {
+                        best = (g, p, j);
                     }
-                    improved = true;
-                    break;
                 }
             }
-            if i % 1024 == 0 && t0.elapsed().as_secs_f64() >= limit {
+            // blocks ending at p: the new last stroke starts near the successor's entry
+            if p + 1 < n {
+                for &m in &neighbours[nb_of[tour[p + 1]]] {
+                    let i = pos[m];
+                    if i != usize::MAX && i <= p {
+                        let g = gain_of(&tour, i, p);
+                        if g > best.0 {
+                            best = (g, i, p);
+                        }
+                    }
+                }
+            }
+            if best.1 != usize::MAX {
+                apply(&mut tour, &mut pos, best.1, best.2);
+                improved = true;
+            }
+            // or-opt: move the stroke at p (either way round) next to a neighbour
+            let nbi = nb_of[tour[p]];
+            if or_move(&mut tour, &mut pos, p, &neighbours[nbi]) {
+                improved = true;
+            }
+            if p % 1024 == 0 && t0.elapsed().as_secs_f64() >= limit {
                 break;
             }
         }
