@@ -143,6 +143,8 @@ pub struct Drawing {
     pub strokes: Vec<Stroke>,
     /// Unsupported elements skipped (with `skip_unsupported`).
     pub skipped: Vec<String>,
+    /// Coordinates are y-up (DXF): the SVG writer mirrors them with `scale(1,-1)`.
+    pub flip_y: bool,
 }
 
 impl Drawing {
@@ -363,6 +365,42 @@ pub fn containment(d: &Drawing, scope: &[usize], tol: f64) -> Vec<(usize, usize)
     edges
 }
 
+/// Cut mode: reorders scopes so that a scope whose closed strokes enclose strokes of another
+/// scope comes after it (stable topological order; file order kept where containment is
+/// cyclic or absent).
+pub fn inner_scopes_first(d: &Drawing, sc: Vec<Vec<usize>>, tol: f64) -> Vec<Vec<usize>> {
+    let all: Vec<usize> = sc.iter().flatten().copied().collect();
+    let mut scope_of = vec![0usize; d.strokes.len()];
+    for (k, s) in sc.iter().enumerate() {
+        for &i in s {
+            scope_of[i] = k;
+        }
+    }
+    let m = sc.len();
+    let mut before = vec![vec![false; m]; m]; // before[a][b]: a must precede b
+    for (a, b) in containment(d, &all, tol) {
+        let (sa, sb) = (scope_of[all[a]], scope_of[all[b]]);
+        if sa != sb {
+            before[sa][sb] = true;
+        }
+    }
+    let mut placed = vec![false; m];
+    let mut order = Vec::with_capacity(m);
+    while order.len() < m {
+        // the first unplaced scope with no unplaced predecessor; file order on a cycle
+        let next = (0..m)
+            .find(|&b| !placed[b] && (0..m).all(|a| placed[a] || a == b || !before[a][b]))
+            .unwrap_or_else(|| (0..m).find(|&b| !placed[b]).expect("unplaced scope"));
+        placed[next] = true;
+        order.push(next);
+    }
+    let mut sc = sc;
+    order
+        .into_iter()
+        .map(|k| std::mem::take(&mut sc[k]))
+        .collect()
+}
+
 /// The instance of one scope, starting at `home`; also the (reverse, start vertex) of each
 /// mode of each cell.
 pub fn scope_instance(
@@ -511,7 +549,10 @@ fn layer_label(d: &Drawing) -> impl Fn(&Stroke) -> String + '_ {
 /// Sequences each scope with a registry solver (air-travel objective, start at the previous
 /// scope's exit, the first at the origin).
 pub fn optimize(d: &Drawing, opts: &Options) -> Result<Optimized> {
-    let sc = scopes(d, opts.scopes);
+    let mut sc = scopes(d, opts.scopes);
+    if opts.cut && sc.len() > 1 {
+        sc = inner_scopes_first(d, sc, opts.contain_tol);
+    }
     let total = d.strokes.len().max(1);
     let mut home = [0.0, 0.0];
     let mut out: Vec<Stroke> = Vec::with_capacity(d.strokes.len());
@@ -611,7 +652,37 @@ pub fn write(d: &Drawing, strokes: &[Stroke]) -> String {
     for (k, v) in &d.root_attrs {
         let _ = write!(o, " {k}=\"{}\"", esc(v));
     }
+    if d.root_attrs.is_empty() {
+        // a page around the drawing, in mm
+        let mut b = [
+            f64::INFINITY,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::NEG_INFINITY,
+        ];
+        for p in strokes.iter().flat_map(|s| &s.points) {
+            let y = if d.flip_y { -p[1] } else { p[1] };
+            b = [b[0].min(p[0]), b[1].min(y), b[2].max(p[0]), b[3].max(y)];
+        }
+        if !b[0].is_finite() {
+            b = [0.0, 0.0, 1.0, 1.0];
+        }
+        let (w, h) = ((b[2] - b[0]).max(1e-9), (b[3] - b[1]).max(1e-9));
+        let _ = write!(
+            o,
+            " width=\"{}mm\" height=\"{}mm\" viewBox=\"{} {} {} {}\"",
+            num(w * d.mm_per_unit),
+            num(h * d.mm_per_unit),
+            num(b[0]),
+            num(b[1]),
+            num(w),
+            num(h)
+        );
+    }
     o.push_str(">\n");
+    if d.flip_y {
+        o.push_str("<g transform=\"scale(1,-1)\">\n");
+    }
     let mut cur: Option<usize> = None;
     for s in strokes {
         if cur != Some(s.layer) {
@@ -653,18 +724,37 @@ pub fn write(d: &Drawing, strokes: &[Stroke]) -> String {
     if cur.is_some() {
         o.push_str("</g>\n");
     }
+    if d.flip_y {
+        o.push_str("</g>\n");
+    }
     o.push_str("</svg>\n");
     o
 }
 
-type SegKey = (String, String, u64, [u64; 4]);
+type SegKey = (u32, [u64; 4]);
+type Interner = std::collections::HashMap<(String, String, u64), u32>;
 
-fn seg_keys(d: &Drawing, strokes: &[Stroke]) -> Vec<SegKey> {
-    let r = |v: f64| num(v).parse::<f64>().unwrap_or(v);
+/// Segment keys, sorted: (layer label, colour, width) interned, endpoints ordered.
+/// `round` applies the writer's 6-decimal rounding (idempotent on written files).
+fn seg_keys(d: &Drawing, strokes: &[Stroke], intern: &mut Interner, round: bool) -> Vec<SegKey> {
+    let r = |v: f64| {
+        // + 0.0 turns -0 into +0, so that keys compare by value
+        if round {
+            num(v).parse::<f64>().unwrap_or(v) + 0.0
+        } else {
+            v + 0.0
+        }
+    };
     let mut v = Vec::new();
     for s in strokes {
         let st = &d.styles[s.style];
-        let w = r(st.width).to_bits();
+        let k = (
+            d.layers[s.layer].label.clone(),
+            st.stroke.clone(),
+            num(st.width).parse::<f64>().unwrap_or(st.width).to_bits(),
+        );
+        let next = intern.len() as u32;
+        let id = *intern.entry(k).or_insert(next);
         for (a, b) in s.segments() {
             let (a, b) = ([r(a[0]), r(a[1])], [r(b[0]), r(b[1])]);
             let (a, b) = if (a[0], a[1]) <= (b[0], b[1]) {
@@ -673,9 +763,7 @@ fn seg_keys(d: &Drawing, strokes: &[Stroke]) -> Vec<SegKey> {
                 (b, a)
             };
             v.push((
-                d.layers[s.layer].label.clone(),
-                st.stroke.clone(),
-                w,
+                id,
                 [
                     a[0].to_bits(),
                     a[1].to_bits(),
@@ -693,9 +781,25 @@ fn seg_keys(d: &Drawing, strokes: &[Stroke]) -> Vec<SegKey> {
 /// (direction-insensitive; per layer label, colour and width; coordinates compared after the
 /// writer's 6-decimal rounding). Returns the number of segments.
 pub fn verify(orig: &Drawing, written_name: &str, written: &str) -> Result<usize> {
-    let w = read(written_name, written, ReadOptions::default())?;
-    let a = seg_keys(orig, &orig.strokes);
-    let b = seg_keys(&w, &w.strokes);
+    let mut w = read(written_name, written, ReadOptions::default())?;
+    if orig.flip_y {
+        // the writer mirrors y-up drawings with scale(1,-1); mirror back (exact)
+        for s in &mut w.strokes {
+            for p in &mut s.points {
+                p[1] = -p[1] + 0.0;
+            }
+        }
+    }
+    let mut intern = Interner::default();
+    let a = seg_keys(orig, &orig.strokes, &mut intern, true);
+    let b = seg_keys(&w, &w.strokes, &mut intern, false);
+    let names: Vec<String> = {
+        let mut v = vec![String::new(); intern.len()];
+        for ((l, c, _), &i) in &intern {
+            v[i as usize] = format!("layer '{l}' {c}");
+        }
+        v
+    };
     if a.len() != b.len() {
         return Err(Error::invalid(
             written_name,
@@ -710,13 +814,12 @@ pub fn verify(orig: &Drawing, written_name: &str, written: &str) -> Result<usize
     if let Some(i) = (0..a.len()).find(|&i| a[i] != b[i]) {
         let f = |k: &SegKey| {
             format!(
-                "layer '{}' {} ({},{})-({},{})",
-                k.0,
-                k.1,
-                f64::from_bits(k.3[0]),
-                f64::from_bits(k.3[1]),
-                f64::from_bits(k.3[2]),
-                f64::from_bits(k.3[3])
+                "{} ({},{})-({},{})",
+                names[k.0 as usize],
+                f64::from_bits(k.1[0]),
+                f64::from_bits(k.1[1]),
+                f64::from_bits(k.1[2]),
+                f64::from_bits(k.1[3])
             )
         };
         return Err(Error::invalid(

@@ -98,6 +98,7 @@ pub fn read(file: &str, text: &str, opts: ReadOptions) -> Result<Drawing> {
             styles: Vec::new(),
             strokes: Vec::new(),
             skipped: Vec::new(),
+            flip_y: false,
         },
     };
     let inh = Inherit {
