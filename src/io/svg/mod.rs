@@ -482,7 +482,10 @@ pub fn scope_instance(
 
 /// The whole drawing as one instance (scopes chained by precedence), for `cellseq import`.
 pub fn import(d: &Drawing, opts: &Options) -> Result<Instance> {
-    let sc = scopes(d, opts.scopes);
+    let mut sc = scopes(d, opts.scopes);
+    if opts.cut && sc.len() > 1 {
+        sc = inner_scopes_first(d, sc, opts.contain_tol);
+    }
     let all: Vec<usize> = sc.iter().flatten().copied().collect();
     let (mut inst, _) = scope_instance(
         d,
