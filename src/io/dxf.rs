@@ -47,7 +47,12 @@ struct Ctx<'a> {
     layers: Vec<String>,
     pieces: Vec<Piece>,
     skipped: Vec<String>,
+    /// Points produced so far (bounded: nested arrays of inserts can explode).
+    points: usize,
 }
+
+/// Most points a drawing may expand to (inserts and flattening included).
+pub const MAX_POINTS: usize = 20_000_000;
 
 /// Reads a DXF file's bytes.
 pub fn read(file: &str, bytes: &[u8], opts: ReadOptions) -> Result<Drawing> {
@@ -71,6 +76,7 @@ pub fn read(file: &str, bytes: &[u8], opts: ReadOptions) -> Result<Drawing> {
         layers: Vec::new(),
         pieces: Vec::new(),
         skipped: Vec::new(),
+        points: 0,
     };
     for e in dwg.entities() {
         entity(&mut ctx, e, Affine::IDENTITY, None, 0)?;
@@ -119,6 +125,13 @@ fn layer_index(ctx: &mut Ctx, name: &str) -> usize {
             ctx.layers.len() - 1
         }
     }
+}
+
+/// Counter-clockwise sweep from angle `s` to `t` in (0, 2π] (2π when they coincide).
+fn sweep_of(s: f64, t: f64) -> f64 {
+    let tau = 2.0 * std::f64::consts::PI;
+    let d = (t - s).rem_euclid(tau);
+    if d > 0.0 && d.is_finite() { d } else { tau }
 }
 
 fn arc_points(c: [f64; 2], r: f64, a0: f64, sweep: f64, tol: f64) -> Vec<[f64; 2]> {
@@ -228,7 +241,8 @@ fn spline_points(s: &dxf::entities::Spline, tol: f64) -> Option<Vec<[f64; 2]>> {
         .windows(2)
         .map(|c| ((c[1][0] - c[0][0]).powi(2) + (c[1][1] - c[0][1]).powi(2)).sqrt())
         .sum();
-    let n = ((poly / tol.sqrt().max(1e-6)).ceil() as usize).clamp(8 * cps.len(), 200_000);
+    let n = ((poly / tol.sqrt().max(1e-6)).ceil() as usize)
+        .clamp((8 * cps.len()).min(200_000), 200_000);
     let pts: Vec<[f64; 2]> = (0..=n)
         .map(|i| eval(t0 + (t1 - t0) * i as f64 / n as f64))
         .collect();
@@ -248,24 +262,38 @@ fn entity(
     };
     let tol = ctx.opts.tolerance;
     let handle = format!("{:X}", e.common.handle.0);
-    let add = |ctx: &mut Ctx, pts: Vec<[f64; 2]>, closed: bool| {
+    let add = |ctx: &mut Ctx, pts: Vec<[f64; 2]>, closed: bool| -> Result<()> {
+        ctx.points += pts.len();
+        if ctx.points > MAX_POINTS {
+            return Err(Error::invalid(
+                ctx.file,
+                format!("the drawing expands to more than {MAX_POINTS} points (entity {handle})"),
+            ));
+        }
         let li = layer_index(ctx, &layer_name);
-        let pts = pts
+        let pts: Vec<[f64; 2]> = pts
             .into_iter()
             .map(|p| {
                 let q = tf * kurbo::Point::new(p[0], p[1]);
                 [q.x, q.y]
             })
             .collect();
+        if !pts.iter().flatten().all(|v| v.is_finite()) {
+            return Err(Error::invalid(
+                ctx.file,
+                format!("entity {handle}: non-finite coordinate"),
+            ));
+        }
         ctx.pieces.push(Piece {
             layer: li,
             pts,
             closed,
         });
+        Ok(())
     };
     let deg = std::f64::consts::PI / 180.0;
     match &e.specific {
-        EntityType::Line(l) => add(ctx, vec![[l.p1.x, l.p1.y], [l.p2.x, l.p2.y]], false),
+        EntityType::Line(l) => add(ctx, vec![[l.p1.x, l.p1.y], [l.p2.x, l.p2.y]], false)?,
         EntityType::Circle(c) => {
             let mut p = arc_points(
                 [c.center.x, c.center.y],
@@ -275,27 +303,23 @@ fn entity(
                 tol,
             );
             p.pop();
-            add(ctx, p, true)
+            add(ctx, p, true)?
         }
         EntityType::Arc(a) => {
-            let (s, mut t) = (a.start_angle * deg, a.end_angle * deg);
-            while t <= s {
-                t += 2.0 * std::f64::consts::PI;
-            }
+            let s = a.start_angle * deg;
+            let t = s + sweep_of(s, a.end_angle * deg);
             add(
                 ctx,
                 arc_points([a.center.x, a.center.y], a.radius, s, t - s, tol),
                 false,
-            )
+            )?
         }
         EntityType::Ellipse(el) => {
             let (mx, my) = (el.major_axis.x, el.major_axis.y);
             let r = (mx * mx + my * my).sqrt();
             let rot = my.atan2(mx);
-            let (s, mut t) = (el.start_parameter, el.end_parameter);
-            while t <= s {
-                t += 2.0 * std::f64::consts::PI;
-            }
+            let s = el.start_parameter;
+            let t = s + sweep_of(s, el.end_parameter);
             let full = (t - s - 2.0 * std::f64::consts::PI).abs() < 1e-9;
             let unit = arc_points([0.0, 0.0], 1.0, s, t - s, tol / r.max(1e-9));
             let m = Affine::translate((el.center.x, el.center.y))
@@ -311,13 +335,13 @@ fn entity(
             if full {
                 p.pop();
             }
-            add(ctx, p, full)
+            add(ctx, p, full)?
         }
         EntityType::LwPolyline(pl) => {
             let v: Vec<([f64; 2], f64)> =
                 pl.vertices.iter().map(|v| ([v.x, v.y], v.bulge)).collect();
             let closed = pl.is_closed();
-            add(ctx, bulged(&v, closed, tol), closed)
+            add(ctx, bulged(&v, closed, tol), closed)?
         }
         EntityType::Polyline(pl) => {
             let v: Vec<([f64; 2], f64)> = pl
@@ -325,12 +349,12 @@ fn entity(
                 .map(|v| ([v.location.x, v.location.y], v.bulge))
                 .collect();
             let closed = pl.is_closed();
-            add(ctx, bulged(&v, closed, tol), closed)
+            add(ctx, bulged(&v, closed, tol), closed)?
         }
         EntityType::Spline(s) => match spline_points(s, tol) {
             Some(p) => {
                 let closed = s.is_closed();
-                add(ctx, p, closed)
+                add(ctx, p, closed)?
             }
             None => {
                 return unsupported(

@@ -111,6 +111,18 @@ pub fn read(file: &str, text: &str, opts: ReadOptions) -> Result<Drawing> {
     for ch in root.children().filter(|n| n.is_element()) {
         walk(&mut ctx, ch, &inh)?;
     }
+    if let Some(s) = ctx
+        .out
+        .strokes
+        .iter()
+        .find(|s| !s.points.iter().flatten().all(|v| v.is_finite()))
+    {
+        return Err(Error::parse(
+            file,
+            s.line,
+            "coordinates overflow after the transforms",
+        ));
+    }
     Ok(ctx.out)
 }
 
