@@ -1,0 +1,677 @@
+//! DXF drawings (2-D cutting) through the `dxf` crate: LINE, ARC, CIRCLE, ELLIPSE, LWPOLYLINE
+//! and POLYLINE (with bulges), SPLINE (flattened), INSERT (blocks, nested, with scale, rotation,
+//! arrays). Loose pieces are chained into contours per layer (endpoints within a tolerance are
+//! snapped together). The result is an [`svg::Drawing`] (one layer per DXF layer, y up), so
+//! sequencing, the SVG preview and verification are shared with SVG; [`write_gcode`] is a
+//! simple configurable post.
+
+use crate::error::{Error, Result};
+use crate::io::gcode::interp::{self, CutKind};
+use crate::io::svg::{self, Drawing, Layer, Stroke, Style};
+use dxf::entities::EntityType;
+use kurbo::Affine;
+use std::collections::HashMap;
+use std::fmt::Write as _;
+
+/// Reader options.
+#[derive(Debug, Clone, Copy)]
+pub struct ReadOptions {
+    /// Flattening tolerance (drawing units).
+    pub tolerance: f64,
+    /// Endpoints closer than this are chained (drawing units).
+    pub join: f64,
+    /// Skip unsupported entities (text, hatches, dimensions, …) instead of refusing the file.
+    pub skip_unsupported: bool,
+}
+
+impl Default for ReadOptions {
+    fn default() -> Self {
+        ReadOptions {
+            tolerance: 0.01,
+            join: 1e-3,
+            skip_unsupported: false,
+        }
+    }
+}
+
+struct Piece {
+    layer: usize,
+    pts: Vec<[f64; 2]>,
+    closed: bool,
+}
+
+struct Ctx<'a> {
+    file: &'a str,
+    opts: ReadOptions,
+    blocks: HashMap<String, &'a dxf::Block>,
+    layers: Vec<String>,
+    pieces: Vec<Piece>,
+    skipped: Vec<String>,
+    /// Points produced so far (bounded: nested arrays of inserts can explode).
+    points: usize,
+}
+
+/// Most points a drawing may expand to (inserts and flattening included).
+pub const MAX_POINTS: usize = 20_000_000;
+
+/// Reads a DXF file's bytes.
+pub fn read(file: &str, bytes: &[u8], opts: ReadOptions) -> Result<Drawing> {
+    if !(opts.tolerance > 0.0 && opts.tolerance.is_finite() && opts.join >= 0.0) {
+        return Err(Error::invalid(file, "tolerances must be positive"));
+    }
+    let mut cur = std::io::Cursor::new(bytes);
+    let dwg =
+        dxf::Drawing::load(&mut cur).map_err(|e| Error::invalid(file, format!("DXF: {e}")))?;
+    let mm = match dwg.header.default_drawing_units {
+        dxf::enums::Units::Inches => 25.4,
+        dxf::enums::Units::Feet => 304.8,
+        dxf::enums::Units::Centimeters => 10.0,
+        dxf::enums::Units::Meters => 1000.0,
+        _ => 1.0,
+    };
+    let mut ctx = Ctx {
+        file,
+        opts,
+        blocks: dwg.blocks().map(|b| (b.name.clone(), b)).collect(),
+        layers: Vec::new(),
+        pieces: Vec::new(),
+        skipped: Vec::new(),
+        points: 0,
+    };
+    for e in dwg.entities() {
+        entity(&mut ctx, e, Affine::IDENTITY, None, 0)?;
+    }
+    let Ctx {
+        layers,
+        pieces,
+        skipped,
+        ..
+    } = ctx;
+    let mut d = Drawing {
+        file: file.to_string(),
+        root_attrs: Vec::new(),
+        mm_per_unit: mm,
+        layers: std::iter::once(Layer {
+            label: String::new(),
+            id: None,
+        })
+        .chain(layers.iter().map(|l| Layer {
+            label: l.clone(),
+            id: None,
+        }))
+        .collect(),
+        styles: vec![Style {
+            stroke: "#000000".into(),
+            width: 0.1 / mm,
+        }],
+        strokes: Vec::new(),
+        skipped,
+        flip_y: true,
+    };
+    for (li, _) in layers.iter().enumerate() {
+        let mine: Vec<&Piece> = pieces.iter().filter(|p| p.layer == li).collect();
+        for s in chain(&mine, opts.join) {
+            d.strokes.push(Stroke::new(s.0, s.1, li + 1, 0, 0));
+        }
+    }
+    Ok(d)
+}
+
+fn layer_index(ctx: &mut Ctx, name: &str) -> usize {
+    match ctx.layers.iter().position(|l| l == name) {
+        Some(i) => i,
+        None => {
+            ctx.layers.push(name.to_string());
+            ctx.layers.len() - 1
+        }
+    }
+}
+
+/// Counter-clockwise sweep from angle `s` to `t` in (0, 2π] (2π when they coincide).
+fn sweep_of(s: f64, t: f64) -> f64 {
+    let tau = 2.0 * std::f64::consts::PI;
+    let d = (t - s).rem_euclid(tau);
+    if d > 0.0 && d.is_finite() { d } else { tau }
+}
+
+fn arc_points(c: [f64; 2], r: f64, a0: f64, sweep: f64, tol: f64) -> Vec<[f64; 2]> {
+    // chord error r(1 - cos(θ/2)) <= tol
+    let step = if r > tol {
+        2.0 * (1.0 - tol / r).acos()
+    } else {
+        std::f64::consts::PI / 2.0
+    };
+    let n = ((sweep.abs() / step.max(1e-6)).ceil() as usize).clamp(1, 100_000);
+    (0..=n)
+        .map(|i| {
+            let a = a0 + sweep * i as f64 / n as f64;
+            [c[0] + r * a.cos(), c[1] + r * a.sin()]
+        })
+        .collect()
+}
+
+/// Points of a polyline with bulges (vertex i's bulge curves segment i → i+1).
+fn bulged(v: &[([f64; 2], f64)], closed: bool, tol: f64) -> Vec<[f64; 2]> {
+    let mut out = Vec::new();
+    let n = v.len();
+    let segs = if closed { n } else { n.saturating_sub(1) };
+    if n > 0 {
+        out.push(v[0].0);
+    }
+    for i in 0..segs {
+        let (p, b) = v[i];
+        let q = v[(i + 1) % n].0;
+        if b.abs() < 1e-12 || p == q {
+            out.push(q);
+            continue;
+        }
+        let theta = 4.0 * b.atan(); // signed sweep
+        let chord = ((q[0] - p[0]).powi(2) + (q[1] - p[1]).powi(2)).sqrt();
+        let r = chord / (2.0 * (theta / 2.0).sin().abs());
+        // centre: from the chord midpoint along the normal
+        let m = [(p[0] + q[0]) / 2.0, (p[1] + q[1]) / 2.0];
+        let h = r * (theta / 2.0).cos();
+        let (ux, uy) = ((q[0] - p[0]) / chord, (q[1] - p[1]) / chord);
+        let sgn = if theta > 0.0 { 1.0 } else { -1.0 };
+        let c = [m[0] - sgn * uy * h, m[1] + sgn * ux * h];
+        let a0 = (p[1] - c[1]).atan2(p[0] - c[0]);
+        let mut pts = arc_points(c, r, a0, theta, tol);
+        *pts.last_mut().expect("arc has points") = q;
+        out.extend(pts.into_iter().skip(1));
+    }
+    if closed && out.len() > 1 {
+        out.pop(); // back at the start
+    }
+    out
+}
+
+/// De Boor evaluation of a (rational) B-spline, sampled finely enough for `tol`.
+fn spline_points(s: &dxf::entities::Spline, tol: f64) -> Option<Vec<[f64; 2]>> {
+    let p = s.degree_of_curve.max(1) as usize;
+    let cps: Vec<[f64; 2]> = s.control_points.iter().map(|c| [c.x, c.y]).collect();
+    if cps.is_empty() {
+        let fit: Vec<[f64; 2]> = s.fit_points.iter().map(|c| [c.x, c.y]).collect();
+        return (!fit.is_empty()).then_some(fit);
+    }
+    let k = &s.knot_values;
+    if k.len() != cps.len() + p + 1 {
+        return None;
+    }
+    let w: Vec<f64> = if s.weight_values.len() == cps.len() {
+        s.weight_values.clone()
+    } else {
+        vec![1.0; cps.len()]
+    };
+    let (t0, t1) = (k[p], k[cps.len()]);
+    if t1.is_nan() || t0.is_nan() || t1 <= t0 {
+        return None;
+    }
+    let eval = |t: f64| -> [f64; 2] {
+        let mut span = p;
+        while span + 1 < cps.len() && k[span + 1] <= t {
+            span += 1;
+        }
+        let mut d: Vec<[f64; 3]> = (0..=p)
+            .map(|j| {
+                let c = cps[span - p + j];
+                let wj = w[span - p + j];
+                [c[0] * wj, c[1] * wj, wj]
+            })
+            .collect();
+        for r in 1..=p {
+            for j in (r..=p).rev() {
+                let i = span - p + j;
+                let den = k[i + p + 1 - r] - k[i];
+                let a = if den > 0.0 { (t - k[i]) / den } else { 0.0 };
+                let prev = d[j - 1];
+                for (x, p) in d[j].iter_mut().zip(prev) {
+                    *x = (1.0 - a) * p + a * *x;
+                }
+            }
+        }
+        let q = d[p];
+        if q[2] != 0.0 {
+            [q[0] / q[2], q[1] / q[2]]
+        } else {
+            [q[0], q[1]]
+        }
+    };
+    // control polygon length bounds the curve length; sample densely, then thin by tolerance
+    let poly: f64 = cps
+        .windows(2)
+        .map(|c| ((c[1][0] - c[0][0]).powi(2) + (c[1][1] - c[0][1]).powi(2)).sqrt())
+        .sum();
+    let n = ((poly / tol.sqrt().max(1e-6)).ceil() as usize)
+        .clamp((8 * cps.len()).min(200_000), 200_000);
+    let pts: Vec<[f64; 2]> = (0..=n)
+        .map(|i| eval(t0 + (t1 - t0) * i as f64 / n as f64))
+        .collect();
+    Some(pts)
+}
+
+fn entity(
+    ctx: &mut Ctx,
+    e: &dxf::entities::Entity,
+    tf: Affine,
+    block_layer: Option<&str>,
+    depth: usize,
+) -> Result<()> {
+    let layer_name = match (e.common.layer.as_str(), block_layer) {
+        ("0", Some(b)) => b.to_string(),
+        (l, _) => l.to_string(),
+    };
+    let tol = ctx.opts.tolerance;
+    let handle = format!("{:X}", e.common.handle.0);
+    let add = |ctx: &mut Ctx, pts: Vec<[f64; 2]>, closed: bool| -> Result<()> {
+        ctx.points += pts.len();
+        if ctx.points > MAX_POINTS {
+            return Err(Error::invalid(
+                ctx.file,
+                format!("the drawing expands to more than {MAX_POINTS} points (entity {handle})"),
+            ));
+        }
+        let li = layer_index(ctx, &layer_name);
+        let pts: Vec<[f64; 2]> = pts
+            .into_iter()
+            .map(|p| {
+                let q = tf * kurbo::Point::new(p[0], p[1]);
+                [q.x, q.y]
+            })
+            .collect();
+        if !pts.iter().flatten().all(|v| v.is_finite()) {
+            return Err(Error::invalid(
+                ctx.file,
+                format!("entity {handle}: non-finite coordinate"),
+            ));
+        }
+        ctx.pieces.push(Piece {
+            layer: li,
+            pts,
+            closed,
+        });
+        Ok(())
+    };
+    let deg = std::f64::consts::PI / 180.0;
+    match &e.specific {
+        EntityType::Line(l) => add(ctx, vec![[l.p1.x, l.p1.y], [l.p2.x, l.p2.y]], false)?,
+        EntityType::Circle(c) => {
+            let mut p = arc_points(
+                [c.center.x, c.center.y],
+                c.radius,
+                0.0,
+                2.0 * std::f64::consts::PI,
+                tol,
+            );
+            p.pop();
+            add(ctx, p, true)?
+        }
+        EntityType::Arc(a) => {
+            let s = a.start_angle * deg;
+            let t = s + sweep_of(s, a.end_angle * deg);
+            add(
+                ctx,
+                arc_points([a.center.x, a.center.y], a.radius, s, t - s, tol),
+                false,
+            )?
+        }
+        EntityType::Ellipse(el) => {
+            let (mx, my) = (el.major_axis.x, el.major_axis.y);
+            let r = (mx * mx + my * my).sqrt();
+            let rot = my.atan2(mx);
+            let s = el.start_parameter;
+            let t = s + sweep_of(s, el.end_parameter);
+            let full = (t - s - 2.0 * std::f64::consts::PI).abs() < 1e-9;
+            let unit = arc_points([0.0, 0.0], 1.0, s, t - s, tol / r.max(1e-9));
+            let m = Affine::translate((el.center.x, el.center.y))
+                * Affine::rotate(rot)
+                * Affine::scale_non_uniform(r, r * el.minor_axis_ratio);
+            let mut p: Vec<[f64; 2]> = unit
+                .into_iter()
+                .map(|q| {
+                    let q = m * kurbo::Point::new(q[0], q[1]);
+                    [q.x, q.y]
+                })
+                .collect();
+            if full {
+                p.pop();
+            }
+            add(ctx, p, full)?
+        }
+        EntityType::LwPolyline(pl) => {
+            let v: Vec<([f64; 2], f64)> =
+                pl.vertices.iter().map(|v| ([v.x, v.y], v.bulge)).collect();
+            let closed = pl.is_closed();
+            add(ctx, bulged(&v, closed, tol), closed)?
+        }
+        EntityType::Polyline(pl) => {
+            let v: Vec<([f64; 2], f64)> = pl
+                .vertices()
+                .map(|v| ([v.location.x, v.location.y], v.bulge))
+                .collect();
+            let closed = pl.is_closed();
+            add(ctx, bulged(&v, closed, tol), closed)?
+        }
+        EntityType::Spline(s) => match spline_points(s, tol) {
+            Some(p) => {
+                let closed = s.is_closed();
+                add(ctx, p, closed)?
+            }
+            None => {
+                return unsupported(
+                    ctx,
+                    &handle,
+                    "SPLINE with inconsistent knots/control points",
+                );
+            }
+        },
+        EntityType::Insert(ins) => {
+            if depth > 16 {
+                return Err(Error::invalid(
+                    ctx.file,
+                    format!("INSERT (handle {handle}): blocks nested deeper than 16 (recursive?)"),
+                ));
+            }
+            let Some(b) = ctx.blocks.get(&ins.name).copied() else {
+                return Err(Error::invalid(
+                    ctx.file,
+                    format!("INSERT (handle {handle}): unknown block '{}'", ins.name),
+                ));
+            };
+            let (cols, rows) = (
+                ins.column_count.max(1) as usize,
+                ins.row_count.max(1) as usize,
+            );
+            if cols * rows > 100_000 {
+                return Err(Error::invalid(
+                    ctx.file,
+                    format!("INSERT (handle {handle}): array too large"),
+                ));
+            }
+            let bl = if layer_name == "0" {
+                block_layer.map(str::to_string)
+            } else {
+                Some(layer_name.clone())
+            };
+            for r in 0..rows {
+                for c in 0..cols {
+                    let t = tf
+                        * Affine::translate((ins.location.x, ins.location.y))
+                        * Affine::rotate(ins.rotation * deg)
+                        * Affine::translate((
+                            c as f64 * ins.column_spacing,
+                            r as f64 * ins.row_spacing,
+                        ))
+                        * Affine::scale_non_uniform(ins.x_scale_factor, ins.y_scale_factor)
+                        * Affine::translate((-b.base_point.x, -b.base_point.y));
+                    for be in &b.entities {
+                        entity(ctx, be, t, bl.as_deref(), depth + 1)?;
+                    }
+                }
+            }
+        }
+        other => {
+            return unsupported(
+                ctx,
+                &handle,
+                &format!("{} is not supported", entity_name(other)),
+            );
+        }
+    }
+    Ok(())
+}
+
+fn entity_name(e: &EntityType) -> String {
+    let s = format!("{e:?}");
+    s.split(['(', ' ', '{'])
+        .next()
+        .unwrap_or("entity")
+        .to_uppercase()
+}
+
+fn unsupported(ctx: &mut Ctx, handle: &str, why: &str) -> Result<()> {
+    if ctx.opts.skip_unsupported {
+        ctx.skipped.push(format!("handle {handle}: {why}"));
+        Ok(())
+    } else {
+        Err(Error::invalid(
+            ctx.file,
+            format!("entity with handle {handle}: {why} (--skip-unsupported skips it)"),
+        ))
+    }
+}
+
+/// Chains open pieces whose endpoints lie within `tol` (the joined vertex is the first
+/// piece's); closed pieces pass through. Deterministic: pieces in file order.
+fn chain(pieces: &[&Piece], tol: f64) -> Vec<(Vec<[f64; 2]>, bool)> {
+    let mut out = Vec::new();
+    let cell = tol.max(1e-12) * 2.0;
+    let key = |p: [f64; 2]| ((p[0] / cell).floor() as i64, (p[1] / cell).floor() as i64);
+    let mut index: HashMap<(i64, i64), Vec<(usize, bool)>> = HashMap::new();
+    let open: Vec<usize> = (0..pieces.len())
+        .filter(|&i| !pieces[i].closed && !pieces[i].pts.is_empty())
+        .collect();
+    for &i in &open {
+        let p = &pieces[i].pts;
+        index.entry(key(p[0])).or_default().push((i, false));
+        index
+            .entry(key(*p.last().expect("non-empty")))
+            .or_default()
+            .push((i, true));
+    }
+    let mut used = vec![false; pieces.len()];
+    let near = |index: &HashMap<(i64, i64), Vec<(usize, bool)>>,
+                used: &[bool],
+                p: [f64; 2]|
+     -> Option<(usize, bool)> {
+        let (kx, ky) = key(p);
+        let mut best: Option<(f64, usize, bool)> = None;
+        for dx in -1..=1 {
+            for dy in -1..=1 {
+                if let Some(v) = index.get(&(kx + dx, ky + dy)) {
+                    for &(i, at_end) in v {
+                        if used[i] {
+                            continue;
+                        }
+                        let q = if at_end {
+                            *pieces[i].pts.last().expect("non-empty")
+                        } else {
+                            pieces[i].pts[0]
+                        };
+                        let d = ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2)).sqrt();
+                        if d <= tol && best.is_none_or(|b| (d, i) < (b.0, b.1)) {
+                            best = Some((d, i, at_end));
+                        }
+                    }
+                }
+            }
+        }
+        best.map(|b| (b.1, b.2))
+    };
+    for (i, p) in pieces.iter().enumerate() {
+        if p.closed {
+            out.push((p.pts.clone(), true));
+            continue;
+        }
+        if used[i] || p.pts.is_empty() {
+            continue;
+        }
+        used[i] = true;
+        let mut pts = p.pts.clone();
+        // forward
+        while let Some((j, at_end)) = near(&index, &used, *pts.last().expect("non-empty")) {
+            used[j] = true;
+            let mut q = pieces[j].pts.clone();
+            if at_end {
+                q.reverse();
+            }
+            pts.extend(q.into_iter().skip(1));
+        }
+        // backward
+        while let Some((j, at_end)) = near(&index, &used, pts[0]) {
+            used[j] = true;
+            let mut q = pieces[j].pts.clone();
+            if !at_end {
+                q.reverse();
+            }
+            q.pop();
+            q.extend(pts);
+            pts = q;
+        }
+        let closed = pts.len() >= 3 && {
+            let (a, b) = (pts[0], *pts.last().expect("non-empty"));
+            ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2)).sqrt() <= tol
+        };
+        if closed {
+            pts.pop();
+        }
+        out.push((pts, closed));
+    }
+    out
+}
+
+/// Parameters of the G-code post.
+#[derive(Debug, Clone, Copy)]
+pub struct Post {
+    /// Safe (travel) height, mm.
+    pub safe_height: f64,
+    /// Cutting depth (Z = -depth), mm.
+    pub depth: f64,
+    /// Cutting feed, mm/min.
+    pub feed: f64,
+    /// Plunge feed, mm/min.
+    pub plunge_feed: f64,
+    /// Spindle speed / laser power (S word with M3); 0 = no spindle words.
+    pub spindle: f64,
+}
+
+impl Default for Post {
+    fn default() -> Self {
+        Post {
+            safe_height: 5.0,
+            depth: 1.0,
+            feed: 1000.0,
+            plunge_feed: 300.0,
+            spindle: 0.0,
+        }
+    }
+}
+
+/// Writes strokes (drawing units, converted to mm) as G-code: per stroke a rapid at the safe
+/// height, a plunge, the feed moves, a retract.
+pub fn write_gcode(d: &Drawing, strokes: &[Stroke], post: &Post) -> String {
+    let k = d.mm_per_unit;
+    let f = |v: f64| svg::num(v * k);
+    let mut o = String::new();
+    let _ = writeln!(
+        o,
+        "(cellseq: {} strokes from {})",
+        strokes.len(),
+        d.file.replace(['(', ')'], "")
+    );
+    o.push_str("G21 G90 G17 G94\n");
+    let _ = writeln!(o, "G0 Z{}", svg::num(post.safe_height));
+    if post.spindle > 0.0 {
+        let _ = writeln!(o, "M3 S{}", svg::num(post.spindle));
+    }
+    let mut layer = usize::MAX;
+    for s in strokes {
+        if s.layer != layer {
+            let _ = writeln!(
+                o,
+                "(layer {})",
+                d.layers[s.layer].label.replace(['(', ')'], "")
+            );
+            layer = s.layer;
+        }
+        let p0 = s.points[0];
+        let _ = writeln!(o, "G0 X{} Y{}", f(p0[0]), f(p0[1]));
+        let _ = writeln!(
+            o,
+            "G1 Z{} F{}",
+            svg::num(-post.depth),
+            svg::num(post.plunge_feed)
+        );
+        if s.is_dot() {
+            let _ = writeln!(o, "G1 X{} Y{} F{}", f(p0[0]), f(p0[1]), svg::num(post.feed));
+        }
+        for (i, p) in s.points[1..].iter().enumerate() {
+            if i == 0 {
+                let _ = writeln!(o, "G1 X{} Y{} F{}", f(p[0]), f(p[1]), svg::num(post.feed));
+            } else {
+                let _ = writeln!(o, "X{} Y{}", f(p[0]), f(p[1]));
+            }
+        }
+        if s.closed && s.points.len() > 1 {
+            let _ = writeln!(o, "X{} Y{}", f(p0[0]), f(p0[1]));
+        }
+        let _ = writeln!(o, "G0 Z{}", svg::num(post.safe_height));
+    }
+    if post.spindle > 0.0 {
+        o.push_str("M5\n");
+    }
+    o.push_str("M2\n");
+    o
+}
+
+/// Checks that a G-code text written by [`write_gcode`] cuts exactly the drawing's segments
+/// (direction-insensitive multiset, mm, 6-decimal rounding) at the cutting depth; dots are
+/// the zero-length feed move after the plunge. Returns the number of segments.
+pub fn verify_gcode(d: &Drawing, name: &str, text: &str, post: &Post) -> Result<usize> {
+    let prog = interp::interpret(text).map_err(|(l, m)| Error::parse(name, l, m))?;
+    let r = |v: f64| svg::num(v).parse::<f64>().unwrap_or(v);
+    let norm = |a: [f64; 2], b: [f64; 2]| {
+        let (a, b) = if (a[0], a[1]) <= (b[0], b[1]) {
+            (a, b)
+        } else {
+            (b, a)
+        };
+        [
+            a[0].to_bits(),
+            a[1].to_bits(),
+            b[0].to_bits(),
+            b[1].to_bits(),
+        ]
+    };
+    let mut got = Vec::new();
+    for li in &prog.lines {
+        for c in &li.cuts {
+            if !matches!(c.kind, CutKind::Line) {
+                return Err(Error::invalid(
+                    name,
+                    format!("line {}: unexpected arc", li.line),
+                ));
+            }
+            if (c.from[2] - c.to[2]).abs() > 1e-9 {
+                continue; // plunge
+            }
+            if (c.from[2] + post.depth).abs() > 1e-6 {
+                return Err(Error::invalid(
+                    name,
+                    format!("line {}: feed move off the cutting depth", li.line),
+                ));
+            }
+            got.push(norm([r(c.from[0]), r(c.from[1])], [r(c.to[0]), r(c.to[1])]));
+        }
+    }
+    let k = d.mm_per_unit;
+    let mut want = Vec::new();
+    for s in &d.strokes {
+        for (a, b) in s.segments() {
+            want.push(norm([r(a[0] * k), r(a[1] * k)], [r(b[0] * k), r(b[1] * k)]));
+        }
+    }
+    got.sort_unstable();
+    want.sort_unstable();
+    if got != want {
+        return Err(Error::invalid(
+            name,
+            format!(
+                "not equivalent to {}: {} cutting segments vs {}",
+                d.file,
+                got.len(),
+                want.len()
+            ),
+        ));
+    }
+    Ok(want.len())
+}
