@@ -32,7 +32,7 @@ pub static INFO: SolverInfo = SolverInfo {
         },
         ParamSpec {
             name: "beam-share",
-            default: "0.1",
+            default: "0.3",
             kind: ParamKind::Float,
             help: "share of the budget given to the beam proof attempt",
         },
