@@ -216,4 +216,26 @@ fn greedy_handles_many_coincident_points() {
     }
     let r = solve("greedy", &inst);
     assert_eq!(r.outcome.sequence.len(), 300);
+    // and collinear: every entry on the line y = 0 (a bucket cannot split equal y values)
+    for (i, c) in inst.cells.iter_mut().enumerate() {
+        let p = cellseq::geom::Point3::new(i as f64, 0.0, -1.0);
+        let q = cellseq::geom::Point3::new(i as f64 + 0.5, 0.0, -1.0);
+        c.modes = vec![cellseq::Mode::new(p, q), cellseq::Mode::new(q, p)];
+    }
+    for name in ["greedy", "local-search", "auto"] {
+        let r = solvers::run(
+            name,
+            &inst,
+            Objective::Time,
+            &BTreeMap::new(),
+            1,
+            Budget {
+                time_limit: None,
+                max_evals: Some(200_000),
+            },
+            &mut NoObserver,
+        )
+        .unwrap_or_else(|e| panic!("{name}: {e}"));
+        assert_eq!(r.outcome.sequence.len(), 300);
+    }
 }

@@ -8,7 +8,7 @@
 
 use crate::cost::CostModel;
 use crate::model::Objective;
-use kiddo::{MutableKdTree, SquaredEuclidean};
+use kiddo::{ImmutableKdTree, SquaredEuclidean};
 use std::num::NonZero;
 
 /// Σ over cells of a lower bound on the cheapest way into the cell, plus a lower bound on
@@ -19,11 +19,15 @@ pub fn knn_in_bound(m: &CostModel, k: usize) -> f64 {
     if n == 0 {
         return 0.0;
     }
-    let mut tree: MutableKdTree<f64, 2> = MutableKdTree::default();
-    for nd in 0..nodes {
-        let p = m.exit(nd);
-        tree.add(&[p.x, p.y], nd as u32).expect("k-d tree insert");
-    }
+    // immutable tree: robust to many coincident or collinear points
+    let pts: Vec<(u32, [f64; 2])> = (0..nodes)
+        .map(|nd| {
+            let p = m.exit(nd);
+            (nd as u32, [p.x, p.y])
+        })
+        .collect();
+    let tree: ImmutableKdTree<f64, 2> =
+        ImmutableKdTree::new_from_entries(&pts).expect("k-d tree build");
     let max_modes = (0..n).map(|c| m.modes(c)).max().unwrap_or(1);
     let want = (k + max_modes).min(nodes).max(1);
     let rate = |cell: usize| match m.objective() {

@@ -4,7 +4,7 @@
 //! matrix instances rank the cheapest arcs of the matrix.
 
 use crate::cost::CostModel;
-use kiddo::{MutableKdTree, SquaredEuclidean};
+use kiddo::{ImmutableKdTree, SquaredEuclidean};
 use std::num::NonZero;
 
 /// Candidate lists of at most K cells per cell.
@@ -69,16 +69,19 @@ fn matrix(m: &CostModel, k: usize) -> Neighbours {
 
 fn geometric(m: &CostModel, k: usize) -> Neighbours {
     let n = m.n();
-    let mut entries: MutableKdTree<f64, 2> = MutableKdTree::default();
-    let mut exits: MutableKdTree<f64, 2> = MutableKdTree::default();
-    for nd in 0..m.nodes() {
-        let (e, x) = (m.entry(nd), m.exit(nd));
-        entries
-            .add(&[e.x, e.y], nd as u32)
-            .expect("k-d tree insert");
-        exits.add(&[x.x, x.y], nd as u32).expect("k-d tree insert");
-    }
-    let query = |tree: &MutableKdTree<f64, 2>, c: usize, use_exit: bool| -> Vec<u32> {
+    // immutable trees: built once, and robust to many coincident or collinear points
+    let build = |exit: bool| -> ImmutableKdTree<f64, 2> {
+        let pts: Vec<(u32, [f64; 2])> = (0..m.nodes())
+            .map(|nd| {
+                let p = if exit { m.exit(nd) } else { m.entry(nd) };
+                (nd as u32, [p.x, p.y])
+            })
+            .collect();
+        ImmutableKdTree::new_from_entries(&pts).expect("k-d tree build")
+    };
+    let entries = build(false);
+    let exits = build(true);
+    let query = |tree: &ImmutableKdTree<f64, 2>, c: usize, use_exit: bool| -> Vec<u32> {
         let mut want = k * 2 + 1;
         loop {
             let mut best: Vec<(f64, u32)> = Vec::new();

@@ -247,7 +247,15 @@ impl Beam {
                 proven = true;
                 break;
             }
-            if width == 1 && self.root_bound && best.is_some() {
+            // the Lagrangian root bound costs O(iterations · n²) arc evaluations: worth it on
+            // matrix instances and small geometric ones, not when the budget is already spent
+            let bound_affordable = !m.is_geometric() || n <= 100;
+            if width == 1
+                && self.root_bound
+                && bound_affordable
+                && !ctx.exhausted()
+                && best.is_some()
+            {
                 let opts = BoundOptions {
                     assignment_max_cells: 0,
                     lagrangian_iterations: 150,

@@ -108,11 +108,18 @@ type Tree = MutableKdTree<f64, 2>;
 /// a tree is rebuilt from its live sites once more sites have left it than remain.
 struct ToolTrees {
     trees: Vec<Tree>,
+    /// sites the tree refused (never expected with jittered points; scanned linearly)
+    overflow: Vec<Vec<u32>>,
+    /// tree coordinates: the site's point moved by a tiny deterministic jitter, so that no
+    /// two sites share a coordinate (kiddo's mutable tree cannot split a bucket of points
+    /// equal along its split axis)
+    tree_xy: Vec<[f64; 2]>,
+    /// bound on |tree_xy - site_xy| per axis, for the exact stopping rule
+    jitter: f64,
     /// live sites per tool tree
     live: Vec<u32>,
     removed: Vec<u32>,
     site_of_node: Vec<u32>,
-    site_xy: Vec<[f64; 2]>,
     site_tool: Vec<u32>,
     sites_of_tool: Vec<Vec<u32>>,
     /// live nodes at each site
@@ -144,12 +151,31 @@ impl ToolTrees {
             }
         }
         let nsites = site_xy.len();
+        let scale = site_xy
+            .iter()
+            .map(|p| p[0].abs().max(p[1].abs()))
+            .fold(1.0f64, f64::max);
+        let jitter = scale * 1e-9;
+        let tree_xy = site_xy
+            .iter()
+            .enumerate()
+            .map(|(i, p)| {
+                let h = (i as u64 + 1).wrapping_mul(0x9E37_79B9_7F4A_7C15);
+                let u = |v: u64| ((v >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0;
+                [
+                    p[0] + jitter * u(h),
+                    p[1] + jitter * u(h.rotate_left(29) ^ 0xD1B5_4A32_D192_ED03),
+                ]
+            })
+            .collect();
         ToolTrees {
+            overflow: vec![Vec::new(); ntools],
+            tree_xy,
+            jitter,
             trees: (0..ntools).map(|_| Tree::default()).collect(),
             live: vec![0; ntools],
             removed: vec![0; ntools],
             site_of_node,
-            site_xy,
             site_tool,
             sites_of_tool,
             nodes_at: vec![Vec::new(); nsites],
@@ -161,10 +187,11 @@ impl ToolTrees {
             let site = self.site_of_node[nd] as usize;
             if self.nodes_at[site].is_empty() {
                 let t = self.site_tool[site] as usize;
-                self.trees[t]
-                    .add(&self.site_xy[site], site as u32)
-                    .expect("k-d tree insert of a distinct point");
-                self.live[t] += 1;
+                if self.trees[t].add(&self.tree_xy[site], site as u32).is_ok() {
+                    self.live[t] += 1;
+                } else {
+                    self.overflow[t].push(site as u32);
+                }
             }
             self.nodes_at[site].push(nd as u32);
         }
@@ -179,16 +206,21 @@ impl ToolTrees {
                 list.swap_remove(k);
             }
             if list.is_empty() {
-                self.trees[t].remove(&self.site_xy[site], site as u32);
-                self.live[t] -= 1;
-                self.removed[t] += 1;
+                if let Some(k) = self.overflow[t].iter().position(|&x| x as usize == site) {
+                    self.overflow[t].swap_remove(k);
+                } else {
+                    self.trees[t].remove(&self.tree_xy[site], site as u32);
+                    self.live[t] -= 1;
+                    self.removed[t] += 1;
+                }
             }
         }
         if self.removed[t] > self.live[t].max(64) {
+            self.overflow[t].clear();
             let entries: Vec<(u32, [f64; 2])> = self.sites_of_tool[t]
                 .iter()
                 .filter(|&&site| !self.nodes_at[site as usize].is_empty())
-                .map(|&site| (site, self.site_xy[site as usize]))
+                .map(|&site| (site, self.tree_xy[site as usize]))
                 .collect();
             self.trees[t] = if entries.is_empty() {
                 Tree::default()
@@ -252,7 +284,7 @@ pub fn geometric(m: &CostModel, count: &mut dyn FnMut(u64)) -> Sequence {
             }
         };
         order.clear();
-        order.extend((0..ntools).filter(|&t| trees.live[t] > 0));
+        order.extend((0..ntools).filter(|&t| trees.live[t] > 0 || !trees.overflow[t].is_empty()));
         if let Some(ct) = cur_tool {
             order.sort_by_key(|&t| (t != ct, t));
         }
@@ -268,8 +300,17 @@ pub fn geometric(m: &CostModel, count: &mut dyn FnMut(u64)) -> Sequence {
             if best.0 <= lower(0.0) {
                 continue;
             }
+            for &site in &trees.overflow[t] {
+                for &nd in &trees.nodes_at[site as usize] {
+                    let nd = nd as usize;
+                    let c = cost_to(nd);
+                    if c < best.0 || (c == best.0 && nd < best.1) {
+                        best = (c, nd);
+                    }
+                }
+            }
             let mut k = 8usize;
-            loop {
+            while trees.live[t] > 0 {
                 let kk = k.min(trees.live[t] as usize);
                 let res = trees.trees[t]
                     .query(&q)
@@ -286,7 +327,9 @@ pub fn geometric(m: &CostModel, count: &mut dyn FnMut(u64)) -> Sequence {
                     }
                 }
                 let exhausted = res.len() < kk || kk == trees.live[t] as usize;
+                // tree points sit within `jitter` of the true points on each axis
                 let far = res.last().map(|r| r.distance.sqrt()).unwrap_or(0.0);
+                let far = (far - 3.0 * trees.jitter).max(0.0);
                 if exhausted || best.0 <= lower(far) {
                     break;
                 }
