@@ -310,8 +310,9 @@ pub fn geometric(m: &CostModel, count: &mut dyn FnMut(u64)) -> Sequence {
                 }
             }
             let mut k = 8usize;
-            while trees.live[t] > 0 {
-                let kk = k.min(trees.live[t] as usize);
+            let live = trees.live[t] as usize;
+            while live > 0 {
+                let kk = k.min(live);
                 let res = trees.trees[t]
                     .query(&q)
                     .nearest_n::<SquaredEuclidean<f64>>(NonZero::new(kk).expect("k > 0"))
@@ -326,7 +327,7 @@ pub fn geometric(m: &CostModel, count: &mut dyn FnMut(u64)) -> Sequence {
                         }
                     }
                 }
-                let exhausted = res.len() < kk || kk == trees.live[t] as usize;
+                let exhausted = res.len() < kk || kk == live;
                 // tree points sit within `jitter` of the true points on each axis
                 let far = res.last().map(|r| r.distance.sqrt()).unwrap_or(0.0);
                 let far = (far - 3.0 * trees.jitter).max(0.0);
