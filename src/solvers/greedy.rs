@@ -311,7 +311,10 @@ pub fn geometric(m: &CostModel, count: &mut dyn FnMut(u64)) -> Sequence {
             }
             let mut k = 8usize;
             let live = trees.live[t] as usize;
-            while live > 0 {
+            if live == 0 {
+                continue;
+            }
+            loop {
                 let kk = k.min(live);
                 let res = trees.trees[t]
                     .query(&q)
