@@ -5,6 +5,8 @@
 use cellseq::io::gcode::{self, Options};
 use std::process::Command;
 
+static RS274: std::sync::Mutex<()> = std::sync::Mutex::new(());
+
 fn rs274_available() -> bool {
     Command::new("sh")
         .args(["-c", "command -v rs274"])
@@ -44,7 +46,17 @@ fn canonical(kind: f64, s: [f64; 3], e: [f64; 3], arc: Option<[f64; 3]>) -> Vec<
 fn feeds(dir: &std::path::Path, name: &str, text: &str) -> Vec<Vec<f64>> {
     let path = dir.join(name);
     std::fs::write(&path, text).unwrap();
-    let out = Command::new("rs274").arg("-g").arg(&path).output().unwrap();
+    // rs274 runs are serialized and run in the temp dir: concurrent runs from one working
+    // directory interfere (its parameter file)
+    let out = {
+        let _guard = RS274.lock().unwrap_or_else(|e| e.into_inner());
+        Command::new("rs274")
+            .arg("-g")
+            .arg(&path)
+            .current_dir(dir)
+            .output()
+            .unwrap()
+    };
     let stdout = String::from_utf8_lossy(&out.stdout);
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(
