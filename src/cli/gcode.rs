@@ -338,7 +338,7 @@ pub fn verify(a: VerifyArgs) -> anyhow::Result<()> {
         println!("{}", serde_json::to_string_pretty(&v)?);
     } else {
         println!(
-            "equivalent: {} cutting moves match (per tool, feed, speed, offset)",
+            "equivalent: {} cutting moves match (per tool, feed, speed, offset; in either direction)",
             v.cuts
         );
         print_figures(&v.before, &v.after);
