@@ -188,3 +188,65 @@ fn instance_cells_get_two_modes() {
             .all(|c| !c.reversible && c.modes.len() == 1)
     );
 }
+
+mod props {
+    use super::*;
+    use proptest::prelude::*;
+
+    /// A 2-D program of `cells` runs of lines and arcs (IJ or R, both directions).
+    fn program(moves: &[(u8, f64, f64, f64)]) -> String {
+        let mut s = String::from("G21 G90\nF600\n");
+        let (mut x, mut y) = (0.0f64, 0.0f64);
+        for (k, &(kind, a, b, c)) in moves.iter().enumerate() {
+            if k % 3 == 0 {
+                x = a * 3.0;
+                y = b * 3.0;
+                s.push_str(&format!("M5\nG0 X{x:.4} Y{y:.4}\nM3 S{}\n", 100 + k));
+            }
+            match kind % 3 {
+                0 => {
+                    x += a;
+                    y += b;
+                    s.push_str(&format!("G1 X{x:.4} Y{y:.4} F{}\n", 500 + 10 * (k % 4)));
+                }
+                _ => {
+                    // centre at (x + a, y); end on the circle at angle c from the start
+                    let (cx, cy) = (x + a.abs().max(0.5), y);
+                    let r = cx - x;
+                    let t = std::f64::consts::PI + c;
+                    let (ex, ey) = (cx + r * t.cos(), cy + r * t.sin());
+                    let g = if kind % 2 == 0 { 2 } else { 3 };
+                    if kind % 3 == 1 {
+                        s.push_str(&format!("G{g} X{ex:.4} Y{ey:.4} I{:.4} J0\n", cx - x));
+                    } else {
+                        s.push_str(&format!("G{g} X{ex:.4} Y{ey:.4} R{:.4}\n", r));
+                    }
+                    x = (ex * 1e4).round() / 1e4;
+                    y = (ey * 1e4).round() / 1e4;
+                }
+            }
+        }
+        s.push_str("M5\nM2\n");
+        s
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig { cases: 64, .. ProptestConfig::default() })]
+        #[test]
+        fn reversed_programs_verify(moves in proptest::collection::vec(
+            (0u8..6, -20.0f64..20.0, -20.0f64..20.0, 0.3f64..2.5), 1..12)) {
+            let text = program(&moves);
+            let p = gcode::parse("p.gcode", &text).unwrap();
+            let rev = all_reversed(&p);
+            gcode::verify_with("p", &p.program, "rev", &rev, None, true)
+                .map_err(|e| TestCaseError::fail(format!("{e}\n{text}\n{rev}")))?;
+            let q = gcode::parse("rev", &rev).unwrap();
+            let back = all_reversed(&q);
+            gcode::verify_with("p", &p.program, "back", &back, None, false)
+                .map_err(|e| TestCaseError::fail(format!("{e}\n{text}\n{back}")))?;
+            let out = gcode::optimize(&p, &opts(None)).unwrap();
+            let off = gcode::optimize(&p, &opts(Some(false))).unwrap();
+            prop_assert_eq!(out.cuts, off.cuts);
+        }
+    }
+}
