@@ -119,7 +119,7 @@ fn merge_tool_blocks_reduces_changes() {
 #[test]
 fn import_gives_valid_instance() {
     let p = gcode::parse("mill.ngc", &fixture("mill.ngc")).unwrap();
-    let inst = gcode::import(&p, false, 0.5).unwrap();
+    let inst = gcode::import(&p, false, 0.5, None).unwrap();
     cellseq::validate::validate(&inst, "mill.ngc").unwrap();
     assert_eq!(inst.n(), 12);
     // tool block order: 7 T1 cells × 5 T2 holes

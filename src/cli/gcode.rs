@@ -25,10 +25,12 @@ pub struct OptimizeArgs {
     /// Seed.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
-    /// Allow cutting cells in the opposite direction.
+    /// Allow cutting cells in the opposite direction (default for drawings and 2-D G-code:
+    /// laser, plasma, plotter; off by default for milling, where it swaps climb and
+    /// conventional milling).
     #[arg(long, conflicts_with = "no_reversible")]
     pub reversible: bool,
-    /// Never reverse cells (default for G-code).
+    /// Never reverse cells (default for G-code with Z moves).
     #[arg(long)]
     pub no_reversible: bool,
     /// Keep tool blocks in their original order (default).
@@ -111,7 +113,7 @@ pub struct ImportArgs {
     /// Input format (default: from the extension).
     #[arg(long, value_name = "gcode|svg|dxf")]
     pub format: Option<String>,
-    /// Never reverse cells (drawings).
+    /// Never reverse cells (drawings; 2-D G-code).
     #[arg(long)]
     pub no_reversible: bool,
     #[command(flatten)]
@@ -206,7 +208,13 @@ pub fn optimize(a: OptimizeArgs) -> anyhow::Result<()> {
         seed: a.seed,
         merge: a.merge_tool_blocks,
         margin: a.margin,
-        reversible: a.reversible && !a.no_reversible,
+        reversible: if a.reversible {
+            Some(true)
+        } else if a.no_reversible {
+            Some(false)
+        } else {
+            None
+        },
     };
     let out = gcode::optimize(&parsed, &opts)?;
     if let Some(o) = &a.output {
@@ -223,6 +231,8 @@ pub fn optimize(a: OptimizeArgs) -> anyhow::Result<()> {
             "inner_first_dropped_groups": out.inner_first_dropped,
             "solve_s": out.solve_s,
             "kept_original_order": out.kept_original,
+            "reversible_cells": out.reversible_cells,
+            "reversed_cells": out.reversed.iter().filter(|&&r| r).count(),
             "before": out.before,
             "after": out.after,
         });
@@ -236,6 +246,13 @@ pub fn optimize(a: OptimizeArgs) -> anyhow::Result<()> {
             out.solve_s,
             out.cuts
         );
+        if out.reversible_cells > 0 {
+            println!(
+                "reversal: {} of {} reversible cells cut backwards",
+                out.reversed.iter().filter(|&&r| r).count(),
+                out.reversible_cells
+            );
+        }
         if out.kept_original {
             println!(
                 "note: the solver's order had more air travel than the original order; original order kept"
@@ -290,7 +307,12 @@ pub fn import(a: ImportArgs) -> anyhow::Result<()> {
     let file = a.input.display().to_string();
     let text = read_text(&a.input)?;
     let parsed = gcode::parse(&file, &text)?;
-    let inst = gcode::import(&parsed, a.merge_tool_blocks, a.margin)?;
+    let inst = gcode::import(
+        &parsed,
+        a.merge_tool_blocks,
+        a.margin,
+        a.no_reversible.then_some(false),
+    )?;
     cellseq::validate::validate(&inst, &file)?;
     save_instance(&a.output, &inst)?;
     println!(
@@ -316,7 +338,7 @@ pub fn verify(a: VerifyArgs) -> anyhow::Result<()> {
         println!("{}", serde_json::to_string_pretty(&v)?);
     } else {
         println!(
-            "equivalent: {} cutting moves match (per tool, feed, speed, offset)",
+            "equivalent: {} cutting moves match (per tool, feed, speed, offset; in either direction)",
             v.cuts
         );
         print_figures(&v.before, &v.after);

@@ -9,6 +9,7 @@
 pub mod cells;
 pub mod interp;
 pub mod lex;
+pub mod reverse;
 pub mod verify;
 pub mod write;
 
@@ -91,8 +92,10 @@ pub struct Options {
     pub merge: bool,
     /// XY margin (mm) added to footprints for the overlap rule.
     pub margin: f64,
-    /// Allow reversal (not supported for G-code: refused).
-    pub reversible: bool,
+    /// Allow cutting reversible cells backwards: `Some(true)` (`--reversible`), `Some(false)`
+    /// (`--no-reversible`), or `None`: on for 2-D programs (laser, plasma, plotter), off for
+    /// programs with Z (milling, where reversal swaps climb and conventional milling).
+    pub reversible: Option<bool>,
 }
 
 impl Default for Options {
@@ -103,7 +106,7 @@ impl Default for Options {
             seed: 1,
             merge: false,
             margin: 0.5,
-            reversible: false,
+            reversible: None,
         }
     }
 }
@@ -112,13 +115,39 @@ fn p3(a: [f64; 3]) -> Point3 {
     Point3::new(a[0], a[1], a[2])
 }
 
-/// The instance of a group of cells (indices into the layout), starting at `home`.
+/// Whether reversal is on for `p` given the option (`None`: on for 2-D programs only).
+pub fn reversal_on(p: &Parsed, reversible: Option<bool>) -> bool {
+    reversible.unwrap_or(p.layout.split == Split::Flat)
+}
+
+/// The reversal plan of every layout cell (`None`: one-mode), when reversal is `on`. Cells
+/// whose entry and exit coincide gain nothing from a second mode and stay one-mode.
+pub fn plans(p: &Parsed, on: bool) -> Vec<Option<reverse::Plan>> {
+    p.layout
+        .cells
+        .iter()
+        .map(|c| {
+            if !on {
+                return None;
+            }
+            let pl = reverse::plan(&p.program, p.layout.split, c).ok()?;
+            let d = (0..3)
+                .map(|k| (pl.entry[k] - c.entry[k]).abs())
+                .fold(0.0, f64::max);
+            (d > 1e-9).then_some(pl)
+        })
+        .collect()
+}
+
+/// The instance of a group of cells (indices into the layout), starting at `home`; cells with
+/// a reversal plan in `plans` (indexed like the layout's cells) get a second, reversed mode.
 /// Also returns whether the inner-first rule was dropped (it contradicted the overlap rule).
 pub fn group_instance(
     p: &Parsed,
     cells: &[usize],
     home: [f64; 3],
     margin: f64,
+    plans: &[Option<reverse::Plan>],
 ) -> (Instance, bool) {
     let l = &p.layout;
     let (precedence, dropped) = cells::precedence(l, cells, margin);
@@ -144,11 +173,12 @@ pub fn group_instance(
                     feed: None,
                 });
             }
-            let mut cell = Cell::new(
-                format!("c{}", ci + 1),
-                tid,
-                vec![Mode::new(p3(c.entry), p3(c.exit))],
-            );
+            let mut modes = vec![Mode::new(p3(c.entry), p3(c.exit))];
+            if let Some(pl) = plans.get(ci).copied().flatten() {
+                modes.push(Mode::new(p3(pl.entry), p3(pl.exit)));
+            }
+            let mut cell = Cell::new(format!("c{}", ci + 1), tid, modes);
+            cell.reversible = cell.modes.len() == 2;
             cell.step = if c.cycle {
                 StepKind::Hole
             } else {
@@ -188,12 +218,14 @@ pub fn group_instance(
     (inst, dropped)
 }
 
-/// The whole program as one instance (groups chained by precedence), for `cellseq import`.
-pub fn import(p: &Parsed, merge: bool, margin: f64) -> Result<Instance> {
+/// The whole program as one instance (groups chained by precedence), for `cellseq import`;
+/// `reversible` as in [`Options::reversible`].
+pub fn import(p: &Parsed, merge: bool, margin: f64, reversible: Option<bool>) -> Result<Instance> {
     let gs = groups(&p.layout, merge);
     let all: Vec<usize> = gs.iter().flatten().copied().collect();
     let home = p.layout.start.unwrap_or(p.layout.cells[0].entry);
-    let (mut inst, _) = group_instance(p, &all, home, margin);
+    let pl = plans(p, reversal_on(p, reversible));
+    let (mut inst, _) = group_instance(p, &all, home, margin, &pl);
     // overlap edges only within a group; groups in order
     let mut pos = 0;
     let mut starts = Vec::new();
@@ -230,6 +262,10 @@ pub fn import(p: &Parsed, merge: bool, margin: f64) -> Result<Instance> {
 pub struct Optimized {
     /// The new order (indices into the layout's cells).
     pub order: Vec<usize>,
+    /// Parallel to `order`: true where the cell is cut backwards.
+    pub reversed: Vec<bool>,
+    /// Cells that could have been reversed (reversal on and the cell qualifies).
+    pub reversible_cells: usize,
     /// The new program text.
     pub text: String,
     /// Figures of the original.
@@ -252,21 +288,18 @@ pub const TOLERANCE: f64 = 1e-3;
 /// Sequences the cells group by group with a registry solver, writes the program and
 /// verifies it against the original (an error if any cutting move differs).
 pub fn optimize(p: &Parsed, opts: &Options) -> Result<Optimized> {
-    if opts.reversible {
-        return Err(Error::invalid(
-            &p.file,
-            "reversing G-code cells is not supported yet; run without --reversible",
-        ));
-    }
     let l = &p.layout;
+    let on = reversal_on(p, opts.reversible);
+    let pl = plans(p, on);
     let gs = groups(l, opts.merge);
     let total: usize = l.cells.len();
     let mut order = Vec::with_capacity(total);
+    let mut rev: Vec<Option<reverse::Plan>> = Vec::with_capacity(total);
     let mut home = l.start.unwrap_or(l.cells[0].entry);
     let mut dropped = 0;
     let mut solve_s = 0.0;
     for g in &gs {
-        let (inst, d) = group_instance(p, g, home, opts.margin);
+        let (inst, d) = group_instance(p, g, home, opts.margin, &pl);
         dropped += d as usize;
         crate::validate::validate(&inst, &p.file)?;
         let budget = Budget {
@@ -287,28 +320,51 @@ pub fn optimize(p: &Parsed, opts: &Options) -> Result<Optimized> {
         solve_s += r.elapsed_s;
         for v in &r.outcome.sequence {
             order.push(g[v.cell]);
+            rev.push(if v.mode == 1 { pl[g[v.cell]] } else { None });
         }
         if let Some(v) = r.outcome.sequence.last() {
-            home = l.cells[g[v.cell]].exit;
+            home = match rev.last().copied().flatten() {
+                Some(x) => x.exit,
+                None => l.cells[g[v.cell]].exit,
+            };
         }
     }
-    let mut text = write::write(&p.program, l, &order, opts.merge);
-    let mut check = verify_texts(&p.file, &p.program, "<optimized>", &text, safe_height(p))?;
+    let mut text = write::write(&p.program, l, &order, &rev, opts.merge);
+    let mut check = verify_with(
+        &p.file,
+        &p.program,
+        "<optimized>",
+        &text,
+        safe_height(p),
+        on,
+    )?;
     // never worse than the program's own order (regenerated the same way)
     let given: Vec<usize> = gs.iter().flatten().copied().collect();
     let mut kept_original = false;
     if given != order {
-        let t2 = write::write(&p.program, l, &given, opts.merge);
-        let c2 = verify_texts(&p.file, &p.program, "<optimized>", &t2, safe_height(p))?;
+        let t2 = write::write(&p.program, l, &given, &[], opts.merge);
+        let c2 = verify_with(
+            &p.file,
+            &p.program,
+            "<optimized>",
+            &t2,
+            safe_height(p),
+            false,
+        )?;
         if c2.after.air_length < check.after.air_length - 1e-9 {
             text = t2;
             check = c2;
             order = given;
+            rev.clear();
             kept_original = true;
         }
     }
+    let mut reversed: Vec<bool> = rev.iter().map(Option::is_some).collect();
+    reversed.resize(order.len(), false);
     Ok(Optimized {
         kept_original,
+        reversible_cells: pl.iter().filter(|x| x.is_some()).count(),
+        reversed,
         order,
         text,
         before: check.before,
@@ -332,7 +388,9 @@ pub struct Verification {
 
 use serde::Serialize;
 
-/// Interprets `new_text` and checks its cutting moves against the original's.
+/// Interprets `new_text` and checks its cutting moves against the original's, in either
+/// direction (a move cut backwards, arc direction swapped around the same centre, counts as
+/// the same move): what `verify-gcode` does, since an optimized program may reverse cells.
 pub fn verify_texts(
     orig_file: &str,
     orig: &Program,
@@ -340,8 +398,21 @@ pub fn verify_texts(
     new_text: &str,
     safe: Option<f64>,
 ) -> Result<Verification> {
+    verify_with(orig_file, orig, new_file, new_text, safe, true)
+}
+
+/// [`verify_texts`] with the direction rule chosen: `undirected` false demands every move in
+/// its original direction (what `optimize` checks when reversal is off).
+pub fn verify_with(
+    orig_file: &str,
+    orig: &Program,
+    new_file: &str,
+    new_text: &str,
+    safe: Option<f64>,
+    undirected: bool,
+) -> Result<Verification> {
     let np = interp::interpret(new_text).map_err(|(l, m)| Error::parse(new_file, l, m))?;
-    let cuts = verify::same_cuts(orig, &np, TOLERANCE)
+    let cuts = verify::same_cuts(orig, &np, TOLERANCE, undirected)
         .map_err(|m| Error::invalid(new_file, format!("not equivalent to {orig_file}: {m}")))?;
     Ok(Verification {
         cuts,

@@ -154,16 +154,54 @@ fn describe(c: &Cut) -> String {
     )
 }
 
+/// The move in a direction-free form: straight moves and arcs run from their smaller end
+/// (lexicographic on the `tol` grid) to the larger one, an arc flipped this way has its
+/// direction swapped (same centre, same points cut); a full circle counts as counter-clockwise.
+/// Canned-cycle holes are unchanged.
+pub fn undirected(c: &Cut, tol: f64) -> Cut {
+    if matches!(c.kind, CutKind::Cycle { .. }) {
+        return *c;
+    }
+    let q = |p: &[f64; 3]| p.map(|v| (v / tol).round() as i64);
+    let (f, t) = (q(&c.from), q(&c.to));
+    let mut out = *c;
+    if f > t {
+        out.from = c.to;
+        out.to = c.from;
+        if let CutKind::Arc { cw, .. } = &mut out.kind {
+            *cw = !*cw;
+        }
+    } else if f == t
+        && let CutKind::Arc { cw, .. } = &mut out.kind
+    {
+        *cw = false;
+    }
+    out
+}
+
 /// Checks that both programs make the same multiset of cutting moves (per tool, with feed,
-/// speed and work offset), within `tol` mm. Zero-length moves are ignored.
-pub fn same_cuts(a: &Program, b: &Program, tol: f64) -> Result<usize, String> {
+/// speed and work offset), within `tol` mm. Zero-length moves are ignored. With `undirected`,
+/// a move cut backwards (see [`undirected`]) counts as the same move.
+pub fn same_cuts(
+    a: &Program,
+    b: &Program,
+    tol: f64,
+    undirected_match: bool,
+) -> Result<usize, String> {
     let collect = |p: &Program| {
         let mut v: Vec<(Vec<i64>, Cut)> = p
             .lines
             .iter()
             .flat_map(|l| l.cuts.iter())
             .filter(|c| !matches!(c.kind, CutKind::Line) || c.length() > 1e-9)
-            .map(|c| (key(c, tol), *c))
+            .map(|c| {
+                if undirected_match {
+                    undirected(c, tol)
+                } else {
+                    *c
+                }
+            })
+            .map(|c| (key(&c, tol), c))
             .collect();
         v.sort_by(|x, y| x.0.cmp(&y.0));
         v

@@ -2,6 +2,7 @@
 
 use super::cells::{Layout, Split, is_motion_g};
 use super::interp::{CutKind, Motion, Program, State};
+use super::reverse::{Plan, write_reversed};
 use std::fmt::Write as _;
 
 /// Formats a number for G-code (no exponent, at most `dec` decimals, trailing zeros trimmed).
@@ -122,8 +123,15 @@ fn gap_line(p: &Program, i: usize, out: &mut String) {
     }
 }
 
-/// Writes the program with cells in `order` (indices into `layout.cells`).
-pub fn write(p: &Program, l: &Layout, order: &[usize], merge: bool) -> String {
+/// Writes the program with cells in `order` (indices into `layout.cells`); `rev[k]` holds the
+/// reversal plan when `order[k]` is cut backwards (or is empty: nothing reversed).
+pub fn write(
+    p: &Program,
+    l: &Layout,
+    order: &[usize],
+    rev: &[Option<Plan>],
+    merge: bool,
+) -> String {
     let mut out =
         String::with_capacity(p.text.iter().map(|t| t.len() + 1).sum::<usize>() + order.len() * 80);
     for t in &p.text[..l.header_end] {
@@ -139,8 +147,10 @@ pub fn write(p: &Program, l: &Layout, order: &[usize], merge: bool) -> String {
         .get(order.first().copied().unwrap_or(0))
         .map(|c| c.block)
         .unwrap_or(0);
-    for &ci in order {
+    for (k, &ci) in order.iter().enumerate() {
         let c = &l.cells[ci];
+        let plan = rev.get(k).copied().flatten();
+        let entry = plan.map(|pl| pl.entry).unwrap_or(c.entry);
         let st = &c.state;
         if c.block != block
             && (!merge
@@ -176,20 +186,21 @@ pub fn write(p: &Program, l: &Layout, order: &[usize], merge: bool) -> String {
         block = c.block;
         let _ = writeln!(
             out,
-            "(cellseq: cell {} from line {})",
+            "(cellseq: cell {} from line {}{})",
             ci + 1,
-            p.lines[c.start].line
+            p.lines[c.start].line,
+            if plan.is_some() { ", reversed" } else { "" }
         );
         out.push_str(&part_a(st));
         out.push('\n');
-        let (x, y) = (units(st, c.entry[0]), units(st, c.entry[1]));
+        let (x, y) = (units(st, entry[0]), units(st, entry[1]));
         match travel {
             Some(h) => {
-                let top = h.max(c.entry[2]);
+                let top = h.max(entry[2]);
                 let _ = writeln!(out, "G0 Z{}", units(st, top));
                 let _ = writeln!(out, "G0 X{x} Y{y}");
-                if !c.cycle && (top - c.entry[2]).abs() > 1e-9 {
-                    let _ = writeln!(out, "G0 Z{}", units(st, c.entry[2]));
+                if !c.cycle && (top - entry[2]).abs() > 1e-9 {
+                    let _ = writeln!(out, "G0 Z{}", units(st, entry[2]));
                 }
             }
             None => {
@@ -234,7 +245,10 @@ pub fn write(p: &Program, l: &Layout, order: &[usize], merge: bool) -> String {
             out.push_str("G80\n");
             continue;
         }
-        body(p, c.start, c.end, &mut out);
+        match plan {
+            Some(pl) => write_reversed(p, travel.is_some(), c, &pl, &mut out),
+            None => body(p, c.start, c.end, &mut out),
+        }
     }
     if l.footer_start < p.lines.len() {
         let fst = &p.lines[l.footer_start].before;
