@@ -306,7 +306,11 @@ pub fn optimize(p: &Parsed, opts: &Options) -> Result<Optimized> {
             time_limit: opts
                 .time_limit
                 .map(|t| std::time::Duration::from_secs_f64(t * g.len() as f64 / total as f64)),
-            max_evals: None,
+            // without a time limit: an evaluation budget, so the output is deterministic
+            max_evals: opts
+                .time_limit
+                .is_none()
+                .then(|| (g.len() as u64 * 20_000).clamp(100_000, 10_000_000)),
         };
         let r = solvers::run(
             &opts.solver,
