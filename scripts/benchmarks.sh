@@ -55,9 +55,10 @@ if [ "$run" = 1 ]; then
     "$bin" run "experiments/$p.toml" --threads 1
   done
   # 10^6 cells: greedy (no budget), and greedy + one improvement pass (VND to a local optimum)
-  # capped at the 60 s, one process each so that the peak resident memory is that run's.
+  # capped at the 60 s (plus greedy at 10^5 for the memory growth), one process each so that the peak resident memory is that run's.
   if [ ! -s results/scale-1e6.csv ]; then
     for preds in 0 1; do
+      "$ex" 100000 greedy gen.preds=$preds csv=results/scale-1e6.csv   # memory at 10^5, for linearity
       "$ex" 1000000 greedy gen.preds=$preds csv=results/scale-1e6.csv
       "$ex" 1000000 local-search kicks=0 seconds=60 gen.preds=$preds csv=results/scale-1e6.csv
     done
