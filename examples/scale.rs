@@ -2,6 +2,12 @@
 //! printing wall time, air length and peak resident memory.
 //!
 //! `cargo run --release --example scale -- 1000000 greedy [KEY=VALUE...]`
+//!
+//! `KEY=VALUE` arguments are solver parameters, except `gen.KEY=VALUE` (generator parameters,
+//! e.g. `gen.preds=1`), `seconds=S` (wall-clock budget; default none) and `csv=PATH` (append one
+//! row `n,preds,solver,params,seconds,air,greedy_air,elapsed_s,solver_s,peak_rss_mib` to PATH,
+//! with a header if the file is new; `greedy_air` is the greedy air length measured in the same
+//! process after the solver, so the peak memory is the solver's).
 
 use cellseq::model::Objective;
 use cellseq::solvers::{self, Budget, NoObserver};
@@ -33,9 +39,15 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut gp: BTreeMap<String, String> = BTreeMap::new();
     gp.insert("n".into(), n.to_string());
     let mut sp = BTreeMap::new();
+    let mut csv: Option<String> = None;
+    let mut budget = Budget::default();
     for kv in &args[2.min(args.len())..] {
         if let Some((k, v)) = kv.split_once('=') {
-            if let Some(g) = k.strip_prefix("gen.") {
+            if k == "csv" {
+                csv = Some(v.to_string());
+            } else if k == "seconds" {
+                budget.time_limit = Some(std::time::Duration::from_secs_f64(v.parse()?));
+            } else if let Some(g) = k.strip_prefix("gen.") {
                 gp.insert(g.into(), v.into());
             } else {
                 sp.insert(k.to_string(), v.to_string());
@@ -56,15 +68,61 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         Objective::Air,
         &sp,
         1,
-        Budget::default(),
+        budget,
         &mut NoObserver,
     )?;
+    let elapsed = t.elapsed().as_secs_f64();
+    let peak = peak_rss_mib();
     println!(
         "{solver}: air {:.0} mm in {:.2} s (solver {:.2} s incl. check), peak RSS {:.0} MiB",
-        r.report.air_length,
-        t.elapsed().as_secs_f64(),
-        r.elapsed_s,
-        peak_rss_mib()
+        r.report.air_length, elapsed, r.elapsed_s, peak
     );
+    if let Some(path) = csv {
+        let greedy_air = if solver == "greedy" {
+            r.report.air_length
+        } else {
+            solvers::run(
+                "greedy",
+                &inst,
+                Objective::Air,
+                &BTreeMap::new(),
+                1,
+                Budget::default(),
+                &mut NoObserver,
+            )?
+            .report
+            .air_length
+        };
+        let params: Vec<String> = sp.iter().map(|(k, v)| format!("{k}={v}")).collect();
+        let new = !std::path::Path::new(&path).exists();
+        let mut f = std::fs::OpenOptions::new()
+            .create(true)
+            .append(true)
+            .open(&path)?;
+        use std::io::Write;
+        if new {
+            writeln!(
+                f,
+                "n,preds,solver,params,seconds,air,greedy_air,elapsed_s,solver_s,peak_rss_mib"
+            )?;
+        }
+        writeln!(
+            f,
+            "{},{},{},{},{},{:.3},{:.3},{:.3},{:.3},{:.1}",
+            inst.n(),
+            gp.get("preds").map(String::as_str).unwrap_or("0"),
+            solver,
+            params.join(";"),
+            budget
+                .time_limit
+                .map(|d| d.as_secs_f64().to_string())
+                .unwrap_or_default(),
+            r.report.air_length,
+            greedy_air,
+            elapsed,
+            r.elapsed_s,
+            peak
+        )?;
+    }
     Ok(())
 }
