@@ -54,14 +54,33 @@ struct Ctx<'a> {
 /// Most points a drawing may expand to (inserts and flattening included).
 pub const MAX_POINTS: usize = 20_000_000;
 
+/// Parses with the `dxf` crate, which can panic on some malformed values (for example an
+/// out-of-range date in the header): the panic is caught, kept off stderr, and reported as
+/// a clear error naming the file.
+fn load_guarded(file: &str, bytes: &[u8]) -> Result<dxf::Drawing> {
+    let previous = std::panic::take_hook();
+    std::panic::set_hook(Box::new(|_| {}));
+    let outcome = std::panic::catch_unwind(|| {
+        let mut cur = std::io::Cursor::new(bytes);
+        dxf::Drawing::load(&mut cur)
+    });
+    std::panic::set_hook(previous);
+    match outcome {
+        Ok(Ok(d)) => Ok(d),
+        Ok(Err(e)) => Err(Error::invalid(file, format!("DXF: {e}"))),
+        Err(_) => Err(Error::invalid(
+            file,
+            "DXF: malformed file (the DXF reader rejected a value it could not represent)",
+        )),
+    }
+}
+
 /// Reads a DXF file's bytes.
 pub fn read(file: &str, bytes: &[u8], opts: ReadOptions) -> Result<Drawing> {
     if !(opts.tolerance > 0.0 && opts.tolerance.is_finite() && opts.join >= 0.0) {
         return Err(Error::invalid(file, "tolerances must be positive"));
     }
-    let mut cur = std::io::Cursor::new(bytes);
-    let dwg =
-        dxf::Drawing::load(&mut cur).map_err(|e| Error::invalid(file, format!("DXF: {e}")))?;
+    let dwg = load_guarded(file, bytes)?;
     let mm = match dwg.header.default_drawing_units {
         dxf::enums::Units::Inches => 25.4,
         dxf::enums::Units::Feet => 304.8,
