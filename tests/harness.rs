@@ -372,3 +372,88 @@ fn another_plans_results_are_never_mixed_in() {
     let s = run_plan(&b, &o).unwrap();
     assert_eq!((s.ran, s.skipped), (s.planned, 0));
 }
+
+#[test]
+fn paper_sections_layers_and_tools() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = r#"
+name = "paper-t"
+seed = 3
+replicates = 1
+objective = "time"
+reference = "greedy"
+[budget]
+evaluations = 5000
+[[instances]]
+generator = "casing"
+seeds = [1]
+grid = { regions = 2 }
+[[instances]]
+files = ["ESC07.pcglns"]
+[[solvers]]
+name = "as-given"
+[[solvers]]
+name = "greedy"
+[[solvers]]
+name = "two-opt"
+[paper]
+layers = true
+tools = true
+source = "test"
+"#;
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    std::fs::copy(
+        root.join("instances/pcgtsplib/ESC07.pcglns"),
+        dir.path().join("ESC07.pcglns"),
+    )
+    .unwrap();
+    let plan_path = write_plan(dir.path(), text);
+    let plan = Plan::load(&plan_path).unwrap();
+    let out = dir.path().join("o");
+    run_plan(&plan, &opts(&out, 2)).unwrap();
+    let rows: Vec<Row> = read_strict(&out.join("results.csv")).unwrap();
+    let layers: Vec<cellseq::harness::results::LayerRow> =
+        read_strict(&out.join("layers.csv")).unwrap();
+    let mut casing_trials = 0;
+    for r in rows.iter().filter(|r| r.feasible) {
+        let mine: Vec<_> = layers.iter().filter(|l| l.run_key == r.run_key).collect();
+        if r.generator == "casing" {
+            casing_trials += 1;
+            assert!(mine.len() >= 2, "casing has several layers");
+            assert_eq!(mine.iter().map(|l| l.cells).sum::<usize>(), r.n);
+            assert_eq!(mine.iter().map(|l| l.lifts).sum::<u64>(), r.lifts.unwrap());
+            let path: f64 = mine.iter().map(|l| l.path_length).sum();
+            // the layers hold everything but the final return home
+            assert!(path <= r.path_length.unwrap() + 1e-6);
+            assert!(path > 0.5 * r.path_length.unwrap());
+            if r.solver == "as-given" {
+                for l in &mine {
+                    assert!((l.as_given_path_length.unwrap() - l.path_length).abs() < 1e-9);
+                    assert_eq!(l.as_given_lifts, Some(l.lifts));
+                }
+            }
+        } else {
+            // matrix instance: no layers, and blanks rather than zeros for machine figures
+            assert!(mine.is_empty());
+            assert_eq!(
+                (r.lifts, r.tool_changes, r.machining_time),
+                (None, None, None)
+            );
+        }
+    }
+    assert_eq!(casing_trials, 3);
+    let insts = std::fs::read_to_string(out.join("instances.csv")).unwrap();
+    assert!(
+        insts.lines().count() == 3 && insts.contains("casing"),
+        "{insts}"
+    );
+    let rep = cellseq::harness::report::report(&out, &out.join("r")).unwrap();
+    let md = std::fs::read_to_string(&rep.markdown).unwrap();
+    assert!(
+        md.contains("## Per layer") && md.contains("| two-opt | total |"),
+        "{md}"
+    );
+    assert!(md.contains("## Tools and reduction per solver"), "{md}");
+    let summary = std::fs::read_to_string(out.join("r").join("layers_summary.csv")).unwrap();
+    assert!(summary.lines().count() > 3 * 2);
+}

@@ -8,6 +8,8 @@
 //! Everything goes through the solver and generator registries, so new entries just work.
 
 pub mod hash;
+pub mod layers;
+pub mod paper;
 pub mod plan;
 pub mod plots;
 pub mod report;

@@ -122,6 +122,12 @@ pub struct Paper {
     /// The figures (may be empty: the source is then only cited).
     #[serde(default)]
     pub figures: Vec<Figure>,
+    /// Add the per-layer table (path length, lifts, machining time per layer, from `layers.csv`).
+    #[serde(default)]
+    pub layers: bool,
+    /// Add the tool table (tools chosen and cells per tool, from `instances.csv`).
+    #[serde(default)]
+    pub tools: bool,
 }
 
 /// One published figure and the metric of ours it corresponds to.

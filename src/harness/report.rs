@@ -575,6 +575,17 @@ pub fn report(dir: &Path, out: &Path) -> Result<ReportFiles> {
         }
         let _ = writeln!(md);
     }
+    if let Some(paper) = plan.as_ref().and_then(|p| p.paper.as_ref()) {
+        if paper.layers
+            && let Some((section, p)) = super::paper::layer_section(dir, out, &rows, &solvers)?
+        {
+            md.push_str(&section);
+            files.push(p);
+        }
+        if paper.tools {
+            md.push_str(&super::paper::tools_section(dir, &rows, &solvers)?);
+        }
+    }
 
     // plots
     let plot_dir = out.join("plots");

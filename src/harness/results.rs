@@ -107,6 +107,64 @@ pub struct TraceRow {
     pub best: f64,
 }
 
+/// One layer of one trial, a row of `layers.csv` (see [`super::layers`]): what the moves into the
+/// layer's cells and their cutting cost, beside the same figures of the as-given order.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+pub struct LayerRow {
+    /// Trial key.
+    pub run_key: String,
+    /// Trial position.
+    pub trial: usize,
+    /// Instance id.
+    pub instance: String,
+    /// Solver configuration id.
+    pub solver_id: String,
+    /// Replicate.
+    pub replicate: u32,
+    /// Layer index (0 = top).
+    pub layer: u32,
+    /// Cells of the layer.
+    pub cells: usize,
+    /// Length cut in the layer's cells (mm).
+    pub cut_length: f64,
+    /// Air length of the moves into the layer's cells (mm).
+    pub air_length: f64,
+    /// Cut + air (mm).
+    pub path_length: f64,
+    /// Lifts into the layer's cells.
+    pub lifts: u64,
+    /// Tool changes into the layer's cells.
+    pub tool_changes: u64,
+    /// Machining time of the layer (s).
+    pub machining_time: f64,
+    /// The as-given order's path length in this layer (mm).
+    pub as_given_path_length: Option<f64>,
+    /// The as-given order's lifts into this layer.
+    pub as_given_lifts: Option<u64>,
+    /// The as-given order's machining time of this layer (s).
+    pub as_given_machining_time: Option<f64>,
+}
+
+/// One instance of a campaign, a row of `instances.csv`: its tools and how the cells are
+/// spread over them (paper 002: tool groups chosen, cells per tool).
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+pub struct InstanceRow {
+    /// Instance id.
+    pub instance: String,
+    /// Generator or source format.
+    pub generator: String,
+    /// Number of cells.
+    pub n: usize,
+    /// Tools used.
+    pub tools: usize,
+    /// Cells per tool, `TOOL:count` separated by spaces, in the instance's tool order.
+    pub cells_per_tool: String,
+    /// Layers present.
+    pub layers: usize,
+    /// The instance's comment (e.g. the panel generator's tool-group choice).
+    pub comment: String,
+}
+
 /// Serialises rows to CSV bytes (no header).
 pub fn to_csv_bytes<T: Serialize>(rows: &[T]) -> Result<Vec<u8>> {
     let mut w = csv::WriterBuilder::new()
@@ -291,6 +349,10 @@ pub struct OutFiles {
     pub results: PathBuf,
     /// Trace table.
     pub traces: PathBuf,
+    /// Per-layer table.
+    pub layers: PathBuf,
+    /// Instance table.
+    pub instances: PathBuf,
     /// Manifest.
     pub manifest: PathBuf,
 }
@@ -305,6 +367,8 @@ impl OutFiles {
         OutFiles {
             results: dir.join(format!("results{suffix}.csv")),
             traces: dir.join(format!("traces{suffix}.csv")),
+            layers: dir.join(format!("layers{suffix}.csv")),
+            instances: dir.join(format!("instances{suffix}.csv")),
             manifest: dir.join(format!("manifest{suffix}.json")),
         }
     }
@@ -331,6 +395,8 @@ fn files_matching(dir: &Path, prefix: &str, ext: &str) -> Result<Vec<PathBuf>> {
 pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<(usize, usize)> {
     let mut rows: Vec<Row> = Vec::new();
     let mut traces: Vec<TraceRow> = Vec::new();
+    let mut layers: Vec<LayerRow> = Vec::new();
+    let mut insts: Vec<InstanceRow> = Vec::new();
     let mut manifests = Vec::new();
     for d in dirs {
         for f in files_matching(d, "results", ".csv")? {
@@ -338,6 +404,12 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<(usize, usize)> {
         }
         for f in files_matching(d, "traces", ".csv")? {
             traces.extend(read_lenient::<TraceRow>(&f)?.0);
+        }
+        for f in files_matching(d, "layers", ".csv")? {
+            layers.extend(read_lenient::<LayerRow>(&f)?.0);
+        }
+        for f in files_matching(d, "instances", ".csv")? {
+            insts.extend(read_lenient::<InstanceRow>(&f)?.0);
         }
         for f in files_matching(d, "manifest", ".json")? {
             let text = crate::formats::read_text(&f)?;
@@ -367,9 +439,21 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<(usize, usize)> {
         }
     }
     keep.sort_by_key(|t| t.trial);
+    // layers: one row per (key, layer)
+    let mut seen_layer = BTreeSet::new();
+    layers.retain(|l| seen.contains(&l.run_key) && seen_layer.insert((l.run_key.clone(), l.layer)));
+    layers.sort_by_key(|l| (l.trial, l.layer));
     std::fs::create_dir_all(out).map_err(|e| Error::io(out.display().to_string(), e))?;
     write_table(&out.join("results.csv"), &rows)?;
     write_table(&out.join("traces.csv"), &keep)?;
+    if !layers.is_empty() {
+        write_table(&out.join("layers.csv"), &layers)?;
+    }
+    let mut seen_inst = BTreeSet::new();
+    insts.retain(|i| seen_inst.insert(i.instance.clone()));
+    if !insts.is_empty() {
+        write_table(&out.join("instances.csv"), &insts)?;
+    }
     if let Some(first) = manifests.first() {
         let mut m = first.clone();
         m["merged_from"] = serde_json::Value::Array(manifests.clone());

@@ -1,8 +1,11 @@
 //! Running a plan: instance preparation, machine calibration, parallel seeded trials with
 //! crash-safe appending and resume, and the manifest.
 
+use super::layers::{Breakdown, breakdown};
 use super::plan::{Plan, Source, Trial};
-use super::results::{Appender, OutFiles, Row, TraceRow, read_lenient, write_table};
+use super::results::{
+    Appender, InstanceRow, LayerRow, OutFiles, Row, TraceRow, read_lenient, write_table,
+};
 use crate::error::{Error, Result};
 use crate::formats::{best_known, load_instance};
 use crate::model::{Instance, Objective};
@@ -60,6 +63,8 @@ pub struct Prepared {
     pub bks: Option<(f64, bool)>,
     /// Precedence density.
     pub density: f64,
+    /// Per-layer breakdown of the as-given order (geometric instances).
+    pub as_given_layers: Option<Breakdown>,
 }
 
 /// Loads or generates an instance of the plan and computes its baseline and features.
@@ -86,8 +91,11 @@ pub fn prepare(plan: &Plan, idx: usize) -> Result<Prepared> {
         Budget::default(),
         &mut NoObserver,
     )
-    .ok()
-    .map(|r| {
+    .ok();
+    let as_given_layers = as_given
+        .as_ref()
+        .and_then(|r| breakdown(&instance, &r.outcome.sequence));
+    let as_given = as_given.map(|r| {
         (
             r.report.cost,
             r.report.air_length,
@@ -102,6 +110,7 @@ pub fn prepare(plan: &Plan, idx: usize) -> Result<Prepared> {
         as_given,
         bks,
         density,
+        as_given_layers,
     })
 }
 
@@ -126,8 +135,38 @@ fn kv(m: &BTreeMap<String, String>) -> String {
         .join(";")
 }
 
+/// The `instances.csv` row of a prepared instance.
+pub fn instance_row(id: &str, inst: &Instance) -> InstanceRow {
+    let mut order: Vec<String> = inst.tools.iter().map(|t| t.id.clone()).collect();
+    for c in &inst.cells {
+        if !order.contains(&c.tool) {
+            order.push(c.tool.clone());
+        }
+    }
+    let per_tool: Vec<String> = order
+        .iter()
+        .filter_map(|t| {
+            let k = inst.cells.iter().filter(|c| &c.tool == t).count();
+            (k > 0).then(|| format!("{}:{k}", if t.is_empty() { "-" } else { t }))
+        })
+        .collect();
+    let layers: BTreeSet<u32> = inst.cells.iter().map(|c| c.layer).collect();
+    InstanceRow {
+        instance: id.to_string(),
+        generator: inst.meta.generator.clone().unwrap_or_else(|| "file".into()),
+        n: inst.n(),
+        tools: inst.used_tools().len(),
+        cells_per_tool: per_tool.join(" "),
+        layers: layers.len(),
+        comment: inst.meta.comment.clone().unwrap_or_default(),
+    }
+}
+
+/// What one trial produced: its result row, its anytime trace and its per-layer rows.
+pub type TrialOutput = (Row, Vec<TraceRow>, Vec<LayerRow>);
+
 /// Runs one trial; never fails: errors, refusals and panics become an infeasible row.
-pub fn run_trial(plan: &Plan, prep: &Prepared, t: &Trial, calib_s: f64) -> (Row, Vec<TraceRow>) {
+pub fn run_trial(plan: &Plan, prep: &Prepared, t: &Trial, calib_s: f64) -> TrialOutput {
     let iref = &plan.instances[t.instance];
     let sref = &plan.solvers[t.solver];
     let inst = &prep.instance;
@@ -181,16 +220,46 @@ pub fn run_trial(plan: &Plan, prep: &Prepared, t: &Trial, calib_s: f64) -> (Row,
         wall_elapsed_s: wall,
         ..Row::default()
     };
+    let mut layer_rows = Vec::new();
     match result {
         Ok(Ok(r)) => {
+            if let Some(b) = breakdown(inst, &r.outcome.sequence) {
+                for l in &b.layers {
+                    let base = prep
+                        .as_given_layers
+                        .as_ref()
+                        .and_then(|a| a.layers.iter().find(|x| x.layer == l.layer));
+                    layer_rows.push(LayerRow {
+                        run_key: t.key.clone(),
+                        trial: t.index,
+                        instance: iref.id.clone(),
+                        solver_id: sref.id.clone(),
+                        replicate: t.replicate,
+                        layer: l.layer,
+                        cells: l.cells,
+                        cut_length: l.cut_length,
+                        air_length: l.air_length,
+                        path_length: l.cut_length + l.air_length,
+                        lifts: l.lifts,
+                        tool_changes: l.tool_changes,
+                        machining_time: l.machining_time,
+                        as_given_path_length: base.map(|a| a.cut_length + a.air_length),
+                        as_given_lifts: base.map(|a| a.lifts),
+                        as_given_machining_time: base.map(|a| a.machining_time),
+                    });
+                }
+            }
             let rep = r.report;
             row.feasible = true;
             row.cost = Some(rep.cost);
             row.air_length = Some(rep.air_length);
             row.path_length = Some(rep.path_length);
-            row.lifts = Some(rep.lifts);
-            row.tool_changes = Some(rep.tool_changes);
-            row.machining_time = Some(rep.machining_time);
+            // matrix instances have no lifts, tools or machine: blanks, not zeros
+            if !inst.is_matrix() {
+                row.lifts = Some(rep.lifts);
+                row.tool_changes = Some(rep.tool_changes);
+                row.machining_time = Some(rep.machining_time);
+            }
             row.reduction_pct = pct_less(row.as_given_cost, row.cost);
             if !inst.is_matrix() {
                 row.air_reduction_pct = pct_less(prep.as_given.map(|a| a.1), row.air_length);
@@ -234,7 +303,7 @@ pub fn run_trial(plan: &Plan, prep: &Prepared, t: &Trial, calib_s: f64) -> (Row,
             best: p.best,
         })
         .collect();
-    (row, traces)
+    (row, traces, layer_rows)
 }
 
 /// Seconds of the calibration kernel: the median of 5 greedy solves of a fixed generated
@@ -379,6 +448,12 @@ pub fn run_plan(plan: &Plan, opts: &RunOptions) -> Result<RunSummary> {
     if torn_t || done_traces.len() != before_t {
         write_table(&files.traces, &done_traces)?;
     }
+    let (mut done_layers, torn_l) = read_lenient::<LayerRow>(&files.layers)?;
+    let before_l = done_layers.len();
+    done_layers.retain(|l| seen.contains(&l.run_key));
+    if torn_l || done_layers.len() != before_l {
+        write_table(&files.layers, &done_layers)?;
+    }
     let skipped = done_rows.len();
     trials.retain(|t| !seen.contains(&t.key));
 
@@ -395,9 +470,29 @@ pub fn run_plan(plan: &Plan, opts: &RunOptions) -> Result<RunSummary> {
             .collect::<Result<HashMap<_, _>>>()
     })?;
 
+    {
+        // instance table: the old one plus the instances prepared now, in plan order
+        let (mut rows, _) = read_lenient::<InstanceRow>(&files.instances)?;
+        for (&i, p) in &prepared {
+            let id = &plan.instances[i].id;
+            if !rows.iter().any(|r| &r.instance == id) {
+                rows.push(instance_row(id, &p.instance));
+            }
+        }
+        let pos: HashMap<&str, usize> = plan
+            .instances
+            .iter()
+            .enumerate()
+            .map(|(i, r)| (r.id.as_str(), i))
+            .collect();
+        rows.retain(|r| pos.contains_key(r.instance.as_str()));
+        rows.sort_by_key(|r| pos[r.instance.as_str()]);
+        write_table(&files.instances, &rows)?;
+    }
     let writer = Mutex::new((
         Appender::open::<Row>(&files.results)?,
         Appender::open::<TraceRow>(&files.traces)?,
+        Appender::open::<LayerRow>(&files.layers)?,
     ));
     let bar = if opts.progress && std::io::stderr().is_terminal() {
         ProgressBar::new(trials.len() as u64)
@@ -414,7 +509,7 @@ pub fn run_plan(plan: &Plan, opts: &RunOptions) -> Result<RunSummary> {
     let res: Result<()> = pool.install(|| {
         trials.par_iter().try_for_each(|t| {
             let prep = &prepared[&t.instance];
-            let (row, traces) = run_trial(plan, prep, t, calib);
+            let (row, traces, layers) = run_trial(plan, prep, t, calib);
             if !row.feasible {
                 failed.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
             }
@@ -424,6 +519,7 @@ pub fn run_plan(plan: &Plan, opts: &RunOptions) -> Result<RunSummary> {
                     .map_err(|_| Error::Param("writer lock poisoned".into()))?;
                 // traces first: a trial counts as done only once its result row is there
                 w.1.append(&traces)?;
+                w.2.append(&layers)?;
                 w.0.append(&[row])?;
             }
             bar.inc(1);
@@ -446,6 +542,11 @@ pub fn run_plan(plan: &Plan, opts: &RunOptions) -> Result<RunSummary> {
     let (mut traces, _) = read_lenient::<TraceRow>(&files.traces)?;
     traces.sort_by_key(|t| t.trial);
     write_table(&files.traces, &traces)?;
+    let (mut layers, _) = read_lenient::<LayerRow>(&files.layers)?;
+    let mut seen_layer = BTreeSet::new();
+    layers.retain(|l| seen.contains(&l.run_key) && seen_layer.insert((l.run_key.clone(), l.layer)));
+    layers.sort_by_key(|l| (l.trial, l.layer));
+    write_table(&files.layers, &layers)?;
     let summary = RunSummary {
         planned,
         skipped,
