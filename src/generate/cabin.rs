@@ -15,7 +15,7 @@
 //! the features cut into it. As-programmed order: tool by tool (larger first), then feature
 //! numbering.
 
-use super::common::{closed_modes, programmed_order, pt, r3, stroke_modes};
+use super::common::{closed_modes, programmed_order, pt, r3, stroke_modes, tools_larger_first};
 use super::toolsel::{ToolLibrary, ToolSpec};
 use crate::error::{Error, Result};
 use crate::geom::Point3;
@@ -259,21 +259,7 @@ pub fn generate(p: &Params, seed: u64) -> Result<Instance> {
             prec.push((faces[face_of(cx)], c));
         }
     }
-    let mut used: Vec<&ToolSpec> = lib
-        .tools
-        .iter()
-        .filter(|t| b.cells.iter().any(|c| c.tool == t.id))
-        .collect();
-    used.sort_by(|a, c| {
-        c.diameter
-            .total_cmp(&a.diameter)
-            .then_with(|| a.id.cmp(&c.id))
-    });
-    let rank: Vec<u32> = b
-        .cells
-        .iter()
-        .map(|c| used.iter().position(|t| t.id == c.tool).expect("used") as u32)
-        .collect();
+    let (used, rank) = tools_larger_first(&lib, &b.cells);
     prec.sort_unstable();
     prec.dedup();
     let order = programmed_order(b.cells.len(), &prec, &rank, &b.keys);

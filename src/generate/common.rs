@@ -1,9 +1,37 @@
 //! Helpers shared by the part generators: the as-programmed order of a CAM programmer and
 //! small geometric conveniences.
 
+use super::toolsel::{ToolLibrary, ToolSpec};
 use crate::geom::Point3;
-use crate::model::{Mode, Visit};
+use crate::model::{Cell, Mode, Visit};
 use std::collections::{BTreeMap, BTreeSet};
+
+/// The library's tools that `cells` use, larger first (ties by id), and every cell's rank in
+/// that list: the procedure order of the as-programmed sequence ("larger tool first").
+pub fn tools_larger_first<'a>(
+    lib: &'a ToolLibrary,
+    cells: &[Cell],
+) -> (Vec<&'a ToolSpec>, Vec<u32>) {
+    let mut used: Vec<&ToolSpec> = lib
+        .tools
+        .iter()
+        .filter(|t| cells.iter().any(|c| c.tool == t.id))
+        .collect();
+    used.sort_by(|a, c| {
+        c.diameter
+            .total_cmp(&a.diameter)
+            .then_with(|| a.id.cmp(&c.id))
+    });
+    let rank = cells
+        .iter()
+        .map(|c| {
+            used.iter()
+                .position(|t| t.id == c.tool)
+                .expect("a used tool") as u32
+        })
+        .collect();
+    (used, rank)
+}
 
 /// The order a CAM programmer would write without optimization: procedure by procedure
 /// (a procedure = the cells cut with one tool; `tool_rank` 0 is programmed first), inside a

@@ -25,7 +25,7 @@
 //! As-programmed order: by procedure (tool, larger first), then feature numbering (outer
 //! contour, pockets 1…, ribs, flange, holes), layer by layer.
 
-use super::common::{closed_modes, programmed_order, pt, r3, stroke_modes};
+use super::common::{closed_modes, programmed_order, pt, r3, stroke_modes, tools_larger_first};
 use super::toolsel::{self, RoughJob, ToolLibrary, ToolSpec};
 use crate::error::{Error, Result};
 use crate::geom::Point3;
@@ -789,21 +789,7 @@ pub fn generate(p: &Params, seed: u64) -> Result<Instance> {
     }
 
     // tools actually used, largest first
-    let mut used: Vec<&ToolSpec> = lib
-        .tools
-        .iter()
-        .filter(|t| b.cells.iter().any(|c| c.tool == t.id))
-        .collect();
-    used.sort_by(|a, c| {
-        c.diameter
-            .total_cmp(&a.diameter)
-            .then_with(|| a.id.cmp(&c.id))
-    });
-    let rank: Vec<u32> = b
-        .cells
-        .iter()
-        .map(|c| used.iter().position(|t| t.id == c.tool).expect("used tool") as u32)
-        .collect();
+    let (used, rank) = tools_larger_first(&lib, &b.cells);
     b.prec.sort_unstable();
     b.prec.dedup();
     let order = programmed_order(b.cells.len(), &b.prec, &rank, &b.keys);
