@@ -5,7 +5,7 @@
 //! rule, local and global pheromone updates, the engine's local search (SOP-3-exchange VND) on
 //! the ants, and the mode DP (the greedy pass over contact points) on every tour.
 
-use super::start::{greedy_start, outcome};
+use super::start::{greedy_solution, outcome};
 use super::{Context, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo};
 use crate::engine::modes::mode_dp;
 use crate::engine::search::Search;
@@ -238,9 +238,7 @@ impl Solver for Aco {
         let n = m.n();
         let c = Costs::open(m);
         let mut rng = ChaCha8Rng::seed_from_u64(ctx.seed);
-        let greedy = greedy_start(ctx);
-        let mut best = Solution::new(&c, &greedy);
-        ctx.report(best.cost + m.constant());
+        let mut best = greedy_solution(ctx, &c);
         if n < 2 {
             return Ok(outcome(m, &best));
         }

@@ -8,7 +8,7 @@
 //! `restart` kicks without a new best the walk restarts from the best solution. Without a
 //! budget it stops after `stall` kicks without a new best.
 
-use super::start::{greedy_start, outcome};
+use super::start::{greedy_solution, outcome};
 use super::{Context, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo};
 use crate::engine::moves::sop3_delta;
 use crate::engine::search::Search;
@@ -237,9 +237,7 @@ impl Solver for Ils {
         let m = ctx.model;
         let n = m.n();
         let c = Costs::open(m);
-        let seq = greedy_start(ctx);
-        let mut cur = Solution::new(&c, &seq);
-        ctx.report(cur.cost + m.constant());
+        let mut cur = greedy_solution(ctx, &c);
         let mut search = Search::new(c, self.k);
         search.vnd(&mut cur, ctx);
         let mut best = cur.clone();

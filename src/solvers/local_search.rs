@@ -3,11 +3,11 @@
 //! After the first descent it iterates: kick the best with a few random feasible Or-opt moves,
 //! descend again, keep the result when better (until the budget, or `kicks` failures in a row).
 
-use super::start::{greedy_start, outcome};
+use super::start::{greedy_solution, outcome};
 use super::{Context, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo};
+use crate::engine::Costs;
 use crate::engine::moves::{apply_segment, segment_delta, window};
 use crate::engine::search::Search;
-use crate::engine::{Costs, Solution};
 use crate::error::Result;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -70,9 +70,7 @@ impl Solver for LocalSearch {
     fn solve(&self, ctx: &mut Context) -> Result<Outcome> {
         let m = ctx.model;
         let c = Costs::open(m);
-        let seq = greedy_start(ctx);
-        let mut s = Solution::new(&c, &seq);
-        ctx.report(s.cost + m.constant());
+        let mut s = greedy_solution(ctx, &c);
         let mut search = Search::new(c, self.k);
         if self.max_block > 0 {
             search.max_block = self.max_block;

@@ -17,6 +17,14 @@ pub fn greedy_start(ctx: &mut Context) -> Sequence {
     }
 }
 
+/// The greedy start as an engine solution (evaluated with `c`), reported to the observer.
+pub fn greedy_solution(ctx: &mut Context, c: &Costs) -> Solution {
+    let seq = greedy_start(ctx);
+    let s = Solution::new(c, &seq);
+    ctx.report(s.cost + c.m.constant());
+    s
+}
+
 /// A randomized fringe construction, O(n²): at each step the cheapest ready (cell, mode) is
 /// taken with probability `1 − noise`, otherwise one of the three cheapest at random. With
 /// `first` set, that ready cell starts the path.

@@ -1,9 +1,9 @@
 //! `two-opt`: greedy start, then 2-opt with mode flip to a local optimum.
 
-use super::start::{greedy_start, outcome};
+use super::start::{greedy_solution, outcome};
 use super::{Context, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo};
+use crate::engine::Costs;
 use crate::engine::search::Search;
-use crate::engine::{Costs, Solution};
 use crate::error::Result;
 
 /// Registry entry.
@@ -33,9 +33,7 @@ impl Solver for TwoOpt {
     fn solve(&self, ctx: &mut Context) -> Result<Outcome> {
         let m = ctx.model;
         let c = Costs::open(m);
-        let seq = greedy_start(ctx);
-        let mut s = Solution::new(&c, &seq);
-        ctx.report(s.cost + m.constant());
+        let mut s = greedy_solution(ctx, &c);
         let mut search = Search::new(c, self.k);
         while search.two_opt(&mut s, ctx) {
             ctx.report(s.cost + m.constant());
