@@ -42,6 +42,9 @@ pub struct CostModel {
     cut_rate: Vec<f64>,
     /// the mode that cuts the same cell in the opposite direction, per node (itself if none)
     flip: Vec<u32>,
+    /// Per node: the node that cuts the cell the other way in a reversed segment (see
+    /// [`CostModel::turned`]), `u32::MAX` if none.
+    turn: Vec<u32>,
     reversible: Vec<bool>,
     constant: f64,
     matrix: Option<CostMatrix>,
@@ -153,7 +156,7 @@ impl CostModel {
         } else {
             None
         };
-        CostModel {
+        let mut cm = CostModel {
             objective,
             return_node,
             offsets,
@@ -161,12 +164,39 @@ impl CostModel {
             tools,
             cut_rate,
             flip,
+            turn: Vec::new(),
             reversible,
             constant,
             matrix,
             geo,
             dag,
-        }
+        };
+        cm.turn = (0..cm.nodes())
+            .map(|nd| {
+                let (cell, mode) = cm.cell_mode(nd);
+                let t = if cm.reversible(cell)
+                    && let Some(f) = cm.flipped(cell, mode)
+                {
+                    Some(f)
+                } else if !cm.is_geometric() || cm.entry(nd) == cm.exit(nd) {
+                    Some(mode)
+                } else {
+                    None
+                };
+                t.map_or(u32::MAX, |md| cm.node(cell, md) as u32)
+            })
+            .collect();
+        cm
+    }
+
+    /// The mode that cuts `cell` in the opposite direction when the cell sits in a reversed
+    /// segment: its flipped mode when it is reversible, the same mode when the mode has no
+    /// direction (entry = exit, or a matrix instance whose nodes carry no geometry), else
+    /// `None`. A table lookup.
+    #[inline]
+    pub fn turned(&self, cell: usize, mode: usize) -> Option<usize> {
+        let t = self.turn[self.node(cell, mode)];
+        (t != u32::MAX).then(|| t as usize - self.offsets[cell] as usize)
     }
 
     /// The objective costs are expressed in.

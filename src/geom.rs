@@ -25,7 +25,10 @@ impl Point3 {
     }
     /// Planar (XY) distance.
     pub fn dist_xy(&self, o: &Point3) -> f64 {
-        (self.x - o.x).hypot(self.y - o.y)
+        // not `hypot`: libm's overflow-safe version is several times slower, and coordinates
+        // in millimetres are nowhere near overflow
+        let (dx, dy) = (self.x - o.x, self.y - o.y);
+        (dx * dx + dy * dy).sqrt()
     }
     /// Euclidean 3-D distance.
     pub fn dist(&self, o: &Point3) -> f64 {

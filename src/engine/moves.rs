@@ -65,29 +65,65 @@ pub fn segment_delta(
     p: isize,
     reversed: bool,
 ) -> f64 {
-    let (ii, e) = (i as isize, (i + len) as isize - 1);
-    if !reversed {
-        return if p > e {
-            sop3_delta(c, s, ii - 1, e, p)
-        } else {
-            sop3_delta(c, s, p, ii - 1, e)
+    SegmentMove::new(c, s, i, len, reversed).delta(c, s, p, reversed)
+}
+
+/// The part of an Or-opt move that does not depend on where the segment goes, computed once
+/// per segment so that each insertion point costs three (kept) or two more (reversed) links.
+#[derive(Debug, Clone, Copy)]
+pub struct SegmentMove {
+    /// First and last positions of the segment.
+    first: isize,
+    last: isize,
+    /// Cost change of closing the gap the segment leaves (negative of the removal gain).
+    close: f64,
+    /// Cost change of the segment's internal links when it is reversed.
+    inner_rev: f64,
+    /// The segment's end cells in their flipped modes.
+    ffirst: Slot,
+    flast: Slot,
+}
+
+impl SegmentMove {
+    /// Prepares moves of `[i..i+len)`; with `reversible` the reversed variant too.
+    #[inline]
+    pub fn new(c: &Costs, s: &Solution, i: usize, len: usize, reversible: bool) -> Self {
+        let (ii, e) = (i as isize, (i + len) as isize - 1);
+        let close = s.link(c, ii - 1, e + 1) - s.link(c, ii - 1, ii) - s.link(c, e, e + 1);
+        let mut mv = SegmentMove {
+            first: ii,
+            last: e,
+            close,
+            inner_rev: 0.0,
+            ffirst: None,
+            flast: None,
         };
+        if reversible {
+            let m = c.m;
+            let flipped = |q: isize| -> Slot {
+                s.at(q)
+                    .map(|(cell, md)| (cell, flip_mode(m, cell, md).unwrap_or(md)))
+            };
+            for q in ii..e {
+                mv.inner_rev += c.link(flipped(q + 1), flipped(q)) - s.link(c, q, q + 1);
+            }
+            mv.ffirst = flipped(ii);
+            mv.flast = flipped(e);
+        }
+        mv
     }
-    let m = c.m;
-    let flipped = |q: isize| -> Slot {
-        s.at(q)
-            .map(|(cell, md)| (cell, flip_mode(m, cell, md).unwrap_or(md)))
-    };
-    let (first, last) = (s.at(ii), s.at(e));
-    let (ffirst, flast) = (flipped(ii), flipped(e));
-    let mut d = s.link(c, ii - 1, e + 1) - s.link(c, ii - 1, ii) - s.link(c, e, e + 1);
-    // internal arcs
-    for q in ii..e {
-        d += c.link(flipped(q + 1), flipped(q)) - s.link(c, q, q + 1);
+    /// Delta of inserting the segment between positions `p` and `p + 1` (outside the
+    /// segment and not just before it), `reversed` only if prepared with `reversible`.
+    #[inline]
+    pub fn delta(&self, c: &Costs, s: &Solution, p: isize, reversed: bool) -> f64 {
+        let (a, b) = (s.at(p), s.at(p + 1));
+        let open = c.link(a, b);
+        if reversed {
+            self.close + self.inner_rev + c.link(a, self.flast) + c.link(self.ffirst, b) - open
+        } else {
+            self.close + c.link(a, s.at(self.first)) + c.link(s.at(self.last), b) - open
+        }
     }
-    let _ = (first, last);
-    d += c.link(s.at(p), flast) + c.link(ffirst, s.at(p + 1)) - s.link(c, p, p + 1);
-    d
 }
 
 /// Applies [`segment_delta`]'s move.
@@ -113,64 +149,166 @@ pub fn apply_segment(
     }
 }
 
-/// Prefix sums for O(1) 2-opt deltas on asymmetric costs, and the reach of every position
-/// (the last position a reversal starting there may end at without inverting a precedence
-/// pair or reversing a cell that has no reversal mode).
-#[derive(Debug, Clone, Default)]
+/// Above this many cells, reversal feasibility under precedence is checked per candidate
+/// ([`reversible_segment`], early exit) instead of through a `reach` array that costs O(n) to
+/// refresh after every applied reversal.
+pub const LAZY_REACH_CELLS: usize = 5000;
+
+/// How [`Reversal`] knows which segments may be reversed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+enum Reach {
+    /// Every cell has a reversal mode and there is no precedence: any segment may be reversed.
+    #[default]
+    All,
+    /// `reach[i]` is kept exact (refreshed in O(n) after each applied reversal; small n).
+    Array,
+    /// Checked per candidate with [`reversible_segment`] (large n with precedence).
+    Lazy,
+}
+
+/// O(1) 2-opt deltas on asymmetric costs, and which segments may be reversed.
+///
+/// A reversal of `[i..=j]` changes the cost of the links inside the segment by
+/// `Σ_{p=i}^{j−1} asym[p]`, where `asym[p]` is the cost of the link `p → p+1` read backwards
+/// (both cells in their flipped modes) minus its cost forwards. On symmetric instances (air
+/// length on geometric cells: every `asym[p]` is 0) the sum is 0 and an applied reversal costs
+/// O(j − i) to record: the segment's values are reversed and negated (the flip is an
+/// involution) and only the two boundary links are recomputed. Asymmetric instances keep
+/// prefix sums, rebuilt in O(n) before the next query after a reversal.
+#[derive(Debug, Clone)]
 pub struct Reversal {
-    fwd: Vec<f64>,
-    bwd: Vec<f64>,
-    /// `reach[i]`: largest j such that `[i..=j]` may be reversed (i − 1 if none).
-    pub reach: Vec<isize>,
+    /// Above this many cells (with precedence or cells that cannot be reversed) feasibility
+    /// is checked per candidate; default [`LAZY_REACH_CELLS`].
+    pub lazy_above: usize,
+    asym: Vec<f64>,
+    nonzero: usize,
+    prefix: Vec<f64>,
+    prefix_ok: bool,
+    mode: Reach,
+    reach: Vec<isize>,
+}
+
+impl Default for Reversal {
+    fn default() -> Self {
+        Reversal {
+            lazy_above: LAZY_REACH_CELLS,
+            asym: Vec::new(),
+            nonzero: 0,
+            prefix: Vec::new(),
+            prefix_ok: false,
+            mode: Reach::All,
+            reach: Vec::new(),
+        }
+    }
+}
+
+fn flipped_slot(m: &CostModel, s: &Solution, p: usize) -> Slot {
+    let cell = s.order[p] as usize;
+    flip_mode(m, cell, s.mode[cell] as usize).map(|f| (cell, f))
 }
 
 impl Reversal {
+    fn asym_at(c: &Costs, s: &Solution, p: usize) -> f64 {
+        match (flipped_slot(c.m, s, p), flipped_slot(c.m, s, p + 1)) {
+            (Some(a), Some(b)) => c.link(Some(b), Some(a)) - s.link(c, p as isize, p as isize + 1),
+            _ => 0.0,
+        }
+    }
+
     /// Recomputes everything for the current solution, O(n + edges).
     pub fn refresh(&mut self, c: &Costs, s: &Solution) {
         let m = c.m;
         let n = s.n();
-        let flip: Vec<Slot> = (0..n)
-            .map(|p| {
-                let cell = s.order[p] as usize;
-                flip_mode(m, cell, s.mode[cell] as usize).map(|f| (cell, f))
-            })
-            .collect();
-        self.fwd.clear();
-        self.bwd.clear();
-        self.fwd.push(0.0);
-        self.bwd.push(0.0);
-        for p in 0..n.saturating_sub(1) {
-            let f = self.fwd[p] + s.link(c, p as isize, p as isize + 1);
-            let b = self.bwd[p]
-                + match (flip[p], flip[p + 1]) {
-                    (Some(_), Some(_)) => c.link(flip[p + 1], flip[p]),
-                    _ => 0.0,
-                };
-            self.fwd.push(f);
-            self.bwd.push(b);
+        self.asym.clear();
+        self.asym
+            .extend((0..n.saturating_sub(1)).map(|p| Self::asym_at(c, s, p)));
+        self.nonzero = self.asym.iter().filter(|&&v| v != 0.0).count();
+        self.prefix_ok = false;
+        let all_flip = (0..n).all(|p| flipped_slot(m, s, p).is_some());
+        let no_prec = m.dag.succs.iter().all(|v| v.is_empty());
+        self.mode = if all_flip && no_prec {
+            Reach::All
+        } else if n <= self.lazy_above {
+            Reach::Array
+        } else {
+            Reach::Lazy
+        };
+        self.reach.clear();
+        if self.mode == Reach::Array {
+            self.refresh_reach(m, s);
         }
+    }
+
+    fn refresh_reach(&mut self, m: &CostModel, s: &Solution) {
+        let n = s.n();
+        let flip: Vec<bool> = (0..n).map(|p| flipped_slot(m, s, p).is_some()).collect();
         let lp: Vec<isize> = (0..n)
             .map(|p| s.last_pred(m, s.order[p] as usize))
             .collect();
         self.reach.clear();
         let mut prev: isize = -1;
         for i in 0..n {
-            if flip[i].is_none() {
+            if !flip[i] {
                 self.reach.push(i as isize - 1);
                 prev = i as isize - 1;
                 continue;
             }
             let mut j = prev.max(i as isize) as usize;
-            while j + 1 < n && flip[j + 1].is_some() && lp[j + 1] < i as isize {
+            while j + 1 < n && flip[j + 1] && lp[j + 1] < i as isize {
                 j += 1;
             }
             self.reach.push(j as isize);
             prev = j as isize;
         }
     }
-    /// Delta of reversing `[i..=j]` with mode flip (j ≤ reach\[i\]).
+
+    /// The last position a reversal starting at `i` may end at: exact for small instances,
+    /// an upper bound (n − 1) for large ones with precedence, where [`Reversal::allowed`]
+    /// decides per candidate.
     #[inline]
-    pub fn delta(&self, c: &Costs, s: &Solution, i: usize, j: usize) -> f64 {
+    pub fn reach(&self, i: usize) -> isize {
+        match self.mode {
+            Reach::Array => self.reach[i],
+            _ => self.asym.len() as isize,
+        }
+    }
+
+    /// True when `[i..=j]` (with j ≤ [`Reversal::reach`]`(i)`) may be reversed.
+    #[inline]
+    pub fn allowed(&self, m: &CostModel, s: &Solution, i: usize, j: usize) -> bool {
+        match self.mode {
+            Reach::Lazy => reversible_segment(m, s, i, j - i + 1),
+            _ => true,
+        }
+    }
+
+    /// Records that `[i..=j]` has just been reversed (by [`Solution::reverse`]).
+    pub fn reversed(&mut self, c: &Costs, s: &Solution, i: usize, j: usize) {
+        let n = s.n();
+        if n < 2 {
+            return;
+        }
+        // inside: the link q -> q+1 is the old link (i+j-1-q) read backwards
+        let inner = &mut self.asym[i..j];
+        inner.reverse();
+        inner.iter_mut().for_each(|v| *v = -*v);
+        for p in [i.checked_sub(1), (j + 1 < n).then_some(j)]
+            .into_iter()
+            .flatten()
+        {
+            let new = Self::asym_at(c, s, p);
+            self.nonzero = self.nonzero + (new != 0.0) as usize - (self.asym[p] != 0.0) as usize;
+            self.asym[p] = new;
+        }
+        self.prefix_ok = false;
+        if self.mode == Reach::Array {
+            self.refresh_reach(c.m, s);
+        }
+    }
+
+    /// Delta of reversing `[i..=j]` with mode flip (the reversal must be allowed).
+    #[inline]
+    pub fn delta(&mut self, c: &Costs, s: &Solution, i: usize, j: usize) -> f64 {
         let m = c.m;
         let fl = |p: usize| -> Slot {
             let cell = s.order[p] as usize;
@@ -178,11 +316,25 @@ impl Reversal {
             Some((cell, flip_mode(m, cell, md).unwrap_or(md)))
         };
         let (ii, jj) = (i as isize, j as isize);
+        let inner = if self.nonzero == 0 {
+            0.0
+        } else {
+            if !self.prefix_ok {
+                self.prefix.clear();
+                self.prefix.push(0.0);
+                let mut acc = 0.0;
+                for &v in &self.asym {
+                    acc += v;
+                    self.prefix.push(acc);
+                }
+                self.prefix_ok = true;
+            }
+            self.prefix[j] - self.prefix[i]
+        };
         c.link(s.at(ii - 1), fl(j)) + c.link(fl(i), s.at(jj + 1))
             - s.link(c, ii - 1, ii)
             - s.link(c, jj, jj + 1)
-            + (self.bwd[j] - self.bwd[i])
-            - (self.fwd[j] - self.fwd[i])
+            + inner
     }
 }
 

@@ -5,6 +5,7 @@
 
 use crate::cost::CostModel;
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
+use rayon::prelude::*;
 use std::num::NonZero;
 
 /// Candidate lists of at most K cells per cell.
@@ -118,7 +119,14 @@ fn geometric(m: &CostModel, k: usize) -> Neighbours {
             want *= 4;
         }
     };
-    let out = (0..n).map(|c| query(&entries, c, true)).collect();
-    let inn = (0..n).map(|c| query(&exits, c, false)).collect();
+    // independent per cell: built in parallel, identical whatever the number of threads
+    let out = (0..n)
+        .into_par_iter()
+        .map(|c| query(&entries, c, true))
+        .collect();
+    let inn = (0..n)
+        .into_par_iter()
+        .map(|c| query(&exits, c, false))
+        .collect();
     Neighbours { out, inn }
 }

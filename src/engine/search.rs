@@ -2,7 +2,8 @@
 
 use super::modes::mode_dp;
 use super::moves::{
-    Reversal, apply_segment, mode_delta, reversible_segment, segment_delta, sop3_delta, window,
+    LAZY_REACH_CELLS, Reversal, SegmentMove, apply_segment, mode_delta, reversible_segment,
+    sop3_delta, window,
 };
 use super::{Costs, Neighbours, Solution};
 use crate::solvers::Context;
@@ -64,6 +65,8 @@ pub struct Search<'a> {
     pub nb: Neighbours,
     /// Longest block considered by SOP-3-exchange (each side).
     pub max_block: usize,
+    /// Longest segment 2-opt reverses (array reversal costs O(length)).
+    pub max_reverse: usize,
     stamp: Vec<u32>,
     label: u32,
     rev: Reversal,
@@ -76,7 +79,14 @@ impl<'a> Search<'a> {
         Search {
             c,
             nb: Neighbours::new(c.m, k),
-            max_block: if n <= 120 { n } else { 64 },
+            max_block: if n <= 120 {
+                n
+            } else if n <= LAZY_REACH_CELLS {
+                64
+            } else {
+                8
+            },
+            max_reverse: usize::MAX,
             stamp: vec![0; n],
             label: 0,
             rev: Reversal::default(),
@@ -111,6 +121,7 @@ impl<'a> Search<'a> {
             for len in 1..=3usize.min(n - i) {
                 let (lo, hi) = window(m, s, i, len);
                 let rev_ok = len > 1 && reversible_segment(m, s, i, len);
+                let mv = SegmentMove::new(&c, s, i, len, rev_ok);
                 let first = s.order[i];
                 let last = s.order[i + len - 1];
                 let cands = self.nb.inn[first as usize]
@@ -124,11 +135,13 @@ impl<'a> Search<'a> {
                     .chain(
                         self.nb.inn[last as usize]
                             .iter()
+                            .filter(|_| len > 1)
                             .map(|&v| s.pos[v as usize] as isize),
                     )
                     .chain(
                         self.nb.out[first as usize]
                             .iter()
+                            .filter(|_| len > 1)
                             .map(|&w| s.pos[w as usize] as isize - 1),
                     );
                 for p in cands {
@@ -140,7 +153,7 @@ impl<'a> Search<'a> {
                             continue;
                         }
                         evals += 1;
-                        let d = segment_delta(&c, s, i, len, p, r);
+                        let d = mv.delta(&c, s, p, r);
                         if d < best.0 {
                             best = (d, len, p, r);
                         }
@@ -181,7 +194,10 @@ impl<'a> Search<'a> {
             // x just before the segment: new arc x -> reversed end
             if q + 1 < n {
                 let i = q + 1;
-                let reach = self.rev.reach[i];
+                let reach = self
+                    .rev
+                    .reach(i)
+                    .min(i.saturating_add(self.max_reverse).min(isize::MAX as usize) as isize);
                 let ends = self.nb.out[x as usize]
                     .iter()
                     .map(|&w| s.pos[w as usize] as isize)
@@ -190,7 +206,7 @@ impl<'a> Search<'a> {
                     if j > i as isize && j <= reach {
                         evals += 1;
                         let d = self.rev.delta(&c, s, i, j as usize);
-                        if d < best.0 {
+                        if d < best.0 && self.rev.allowed(c.m, s, i, j as usize) {
                             best = (d, i, j as usize);
                         }
                     }
@@ -199,13 +215,16 @@ impl<'a> Search<'a> {
             // x first of the segment: new arc reversed x -> successor candidate
             {
                 let i = q;
-                let reach = self.rev.reach[i];
+                let reach = self
+                    .rev
+                    .reach(i)
+                    .min(i.saturating_add(self.max_reverse).min(isize::MAX as usize) as isize);
                 for &w in &self.nb.out[x as usize] {
                     let j = s.pos[w as usize] as isize - 1;
                     if j > i as isize && j <= reach {
                         evals += 1;
                         let d = self.rev.delta(&c, s, i, j as usize);
-                        if d < best.0 {
+                        if d < best.0 && self.rev.allowed(c.m, s, i, j as usize) {
                             best = (d, i, j as usize);
                         }
                     }
@@ -215,7 +234,7 @@ impl<'a> Search<'a> {
             if improves(best.0, s.cost) {
                 let (d, i, j) = best;
                 s.reverse(c.m, i, j, d);
-                self.rev.refresh(&c, s);
+                self.rev.reversed(&c, s, i, j);
                 improved = true;
                 queue.push_around(s, i as isize, 1);
                 queue.push_around(s, j as isize, 1);

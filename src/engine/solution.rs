@@ -134,14 +134,5 @@ impl Solution {
 /// direction (entry = exit, or a matrix instance whose nodes carry no geometry), else `None`.
 #[inline]
 pub fn flip_mode(m: &CostModel, cell: usize, mode: usize) -> Option<usize> {
-    if m.reversible(cell)
-        && let Some(f) = m.flipped(cell, mode)
-    {
-        return Some(f);
-    }
-    if !m.is_geometric() {
-        return Some(mode);
-    }
-    let nd = m.node(cell, mode);
-    (m.entry(nd) == m.exit(nd)).then_some(mode)
+    m.turned(cell, mode)
 }
