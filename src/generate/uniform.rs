@@ -69,6 +69,12 @@ pub static SPECS: &[ParamSpec] = &[
         help: "probability of a precedence pair (n <= 5000)",
     },
     ParamSpec {
+        name: "lift",
+        default: "7",
+        kind: ParamKind::Float,
+        help: "height of the retract plane above the top layer (mm); 0 = plotter/laser-like travel with no vertical moves on the top layer",
+    },
+    ParamSpec {
         name: "preds",
         default: "0",
         kind: ParamKind::Int,
@@ -88,12 +94,16 @@ pub fn generate(p: &Params, seed: u64) -> Result<Instance> {
     let layers = p.int("layers").max(1) as u32;
     let density = p.float("density");
     let preds = p.int("preds") as usize;
+    let lift = p.float("lift");
     let bad = |m: String| Err(Error::Param(format!("uniform: {m}")));
     if n == 0 {
         return bad("n must be at least 1".into());
     }
     if size.is_nan() || size <= 0.0 || len.is_nan() || len < 0.0 {
         return bad("size must be positive and length non-negative".into());
+    }
+    if lift.is_nan() || lift < 0.0 {
+        return bad("lift must be non-negative".into());
     }
     if !(0.0..=1.0).contains(&closed) || !(0.0..=1.0).contains(&density) {
         return bad("closed and density must lie in [0, 1]".into());
@@ -186,7 +196,7 @@ pub fn generate(p: &Params, seed: u64) -> Result<Instance> {
     let machine = Machine {
         home: Point3::new(0.0, 0.0, 50.0),
         tool_change: Point3::new(0.0, 0.0, 50.0),
-        clearance: 5.0,
+        clearance: lift - step,
         ..Machine::default()
     };
     Ok(Instance {

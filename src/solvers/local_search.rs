@@ -1,9 +1,10 @@
-//! `local-search`: greedy start, then variable neighbourhood descent over every move of the
+//! `local-search`: greedy start (or the greedy matching start where it applies and is
+//! cheaper, see [`super::edge`]), then variable neighbourhood descent over every move of the
 //! engine (Or-opt, 2-opt with mode flip, single-cell mode change, SOP-3-exchange, mode DP).
 //! After the first descent it iterates: kick the best with a few random feasible Or-opt moves,
 //! descend again, keep the result when better (until the budget, or `kicks` failures in a row).
 
-use super::start::{greedy_solution, outcome};
+use super::start::{best_start, outcome};
 use super::{Context, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo};
 use crate::engine::Costs;
 use crate::engine::moves::{apply_segment, segment_delta, window};
@@ -39,7 +40,7 @@ pub static INFO: SolverInfo = SolverInfo {
             name: "max-block",
             default: "0",
             kind: ParamKind::Int,
-            help: "longest block of SOP-3-exchange (0 = n up to 120 cells, else 64)",
+            help: "longest block of SOP-3-exchange (0 = n up to 120 cells, 64 up to 5000, else 8)",
         },
     ],
     make: |p: &Params| {
@@ -70,7 +71,10 @@ impl Solver for LocalSearch {
     fn solve(&self, ctx: &mut Context) -> Result<Outcome> {
         let m = ctx.model;
         let c = Costs::open(m);
-        let mut s = greedy_solution(ctx, &c);
+        let mut s = best_start(ctx, &c, 8);
+        if ctx.exhausted() {
+            return Ok(outcome(m, &s));
+        }
         let mut search = Search::new(c, self.k);
         if self.max_block > 0 {
             search.max_block = self.max_block;

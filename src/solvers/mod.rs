@@ -8,6 +8,7 @@ pub mod aco;
 pub mod as_given;
 pub mod auto;
 pub mod beam;
+pub mod edge;
 pub mod exact;
 pub mod greedy;
 pub mod ils;
@@ -196,6 +197,7 @@ pub fn registry() -> Vec<&'static SolverInfo> {
         &auto::INFO,
         &as_given::INFO,
         &greedy::INFO,
+        &edge::INFO,
         &ils::INFO,
         &exact::INFO,
         &beam::INFO,

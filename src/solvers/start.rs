@@ -25,6 +25,21 @@ pub fn greedy_solution(ctx: &mut Context, c: &Costs) -> Solution {
     s
 }
 
+/// The better of the greedy start and, where it applies (geometric, no precedence, one tool),
+/// the greedy matching start of [`super::edge`] with `k` candidates per item end.
+pub fn best_start(ctx: &mut Context, c: &Costs, k: usize) -> Solution {
+    let mut s = greedy_solution(ctx, c);
+    if super::edge::applicable(c.m) && !ctx.exhausted() {
+        let seq = super::edge::sequence(c.m, k, &mut |k| ctx.count(k));
+        let t = Solution::new(c, &seq);
+        if t.cost < s.cost {
+            ctx.report(t.cost + c.m.constant());
+            s = t;
+        }
+    }
+    s
+}
+
 /// A randomized fringe construction, O(n²): at each step the cheapest ready (cell, mode) is
 /// taken with probability `1 − noise`, otherwise one of the three cheapest at random. With
 /// `first` set, that ready cell starts the path.
