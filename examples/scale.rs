@@ -5,7 +5,7 @@
 //!
 //! `KEY=VALUE` arguments are solver parameters, except `gen.KEY=VALUE` (generator parameters,
 //! e.g. `gen.preds=1`), `seconds=S` (wall-clock budget; default none) and `csv=PATH` (append one
-//! row `n,preds,solver,params,seconds,air,greedy_air,elapsed_s,solver_s,peak_rss_mib` to PATH,
+//! row `n,preds,solver,params,seconds,air,greedy_air,elapsed_s,solver_s,peak_rss_mib,lift` to PATH,
 //! with a header if the file is new; `greedy_air` is the greedy air length measured in the same
 //! process after the solver, so the peak memory is the solver's).
 
@@ -103,12 +103,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         if new {
             writeln!(
                 f,
-                "n,preds,solver,params,seconds,air,greedy_air,elapsed_s,solver_s,peak_rss_mib"
+                "n,preds,solver,params,seconds,air,greedy_air,elapsed_s,solver_s,peak_rss_mib,lift"
             )?;
         }
         writeln!(
             f,
-            "{},{},{},{},{},{:.3},{:.3},{:.3},{:.3},{:.1}",
+            "{},{},{},{},{},{:.3},{:.3},{:.3},{:.3},{:.1},{}",
             inst.n(),
             gp.get("preds").map(String::as_str).unwrap_or("0"),
             solver,
@@ -121,7 +121,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             greedy_air,
             elapsed,
             r.elapsed_s,
-            peak
+            peak,
+            gp.get("lift").map(String::as_str).unwrap_or("7"),
         )?;
     }
     Ok(())

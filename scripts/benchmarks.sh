@@ -57,11 +57,14 @@ if [ "$run" = 1 ]; then
   # 10^6 cells: greedy (no budget), and greedy + one improvement pass (VND to a local optimum)
   # capped at the 60 s (plus greedy at 10^5 for the memory growth), one process each so that the peak resident memory is that run's.
   if [ ! -s results/scale-1e6.csv ]; then
-    for preds in 0 1; do
-      "$ex" 100000 greedy gen.preds=$preds csv=results/scale-1e6.csv   # memory at 10^5, for linearity
-      "$ex" 1000000 greedy gen.preds=$preds csv=results/scale-1e6.csv
-      "$ex" 1000000 local-search kicks=0 seconds=60 gen.preds=$preds csv=results/scale-1e6.csv
+    for pl in "0 0" "0 7" "1 7"; do
+      set -- $pl
+      g="gen.preds=$1 gen.lift=$2 csv=results/scale-1e6.csv"
+      "$ex" 100000 greedy $g   # memory at 10^5, for linearity
+      "$ex" 1000000 greedy $g
+      "$ex" 1000000 local-search kicks=0 seconds=60 $g
     done
+    "$ex" 1000000 greedy-edge gen.preds=0 gen.lift=0 csv=results/scale-1e6.csv
   fi
   echo "load average after the runs: $(cut -d' ' -f1-3 /proc/loadavg)" >> results/machine.txt
   echo "date (UTC, end): $(date -u '+%Y-%m-%d %H:%M')" >> results/machine.txt

@@ -331,7 +331,7 @@ def main():
 
     def short(gp):
         kv = dict(x.split("=", 1) for x in gp.split(";") if "=" in x)
-        return ", ".join(f"{k}={kv[k]}" for k in ("preds", "reversible") if k in kv)
+        return ", ".join(f"{k}={kv[k]}" for k in ("preds", "reversible", "lift") if k in kv)
 
     p = os.path.join(args.results, "scale", "results.csv")
     if os.path.exists(p):
@@ -373,12 +373,12 @@ def main():
         rows = load(p)
         L.append("## Scale: one process per run with peak memory (`examples/scale.rs`, `results/scale-1e6.csv`)")
         L.append("")
-        L.append("| n | preds | solver | params | budget (s) | air (mm) | greedy air (mm) | ratio | wall time after generation (s) | `solvers::run` time incl. check (s) | peak RSS (MiB) |")
-        L.append("|---|---|---|---|---|---|---|---|---|---|---|")
+        L.append("| n | preds | lift | solver | params | budget (s) | air (mm) | greedy air (mm) | ratio | wall time after generation (s) | `solvers::run` time incl. check (s) | peak RSS (MiB) |")
+        L.append("|---|---|---|---|---|---|---|---|---|---|---|---|")
         for r in rows:
             air, ga = float(r["air"]), float(r["greedy_air"])
             L.append(
-                f"| {r['n']} | {r['preds']} | {r['solver']} | {r['params']} | {r['seconds'] or 'none'} | "
+                f"| {r['n']} | {r['preds']} | {r.get('lift') or '7'} | {r['solver']} | {r['params']} | {r['seconds'] or 'none'} | "
                 f"{air:.0f} | {ga:.0f} | {air / ga:.3f} | {float(r['elapsed_s']):.2f} | "
                 f"{float(r['solver_s']):.2f} | {float(r['peak_rss_mib']):.0f} |"
             )
@@ -386,7 +386,7 @@ def main():
                 t, m = float(r["solver_s"]), float(r["peak_rss_mib"])
                 targets.append(
                     (
-                        f"10^6: greedy + one improvement pass (that improves) within 60 s and 4 GiB (preds={r['preds']}, {r['solver']} {r['params']}, cap {r['seconds'] or 'none'} s)",
+                        f"10^6: greedy + one improvement pass (that improves) within 60 s and 4 GiB (preds={r['preds']}, lift={r.get('lift') or '7'}, {r['solver']} {r['params']}, cap {r['seconds'] or 'none'} s)",
                         f"{t:.1f} s incl. check, {m:.0f} MiB, air {air / ga:.3f} × greedy's",
                         t <= 60 and m <= 4096 and air < ga,
                     )
