@@ -38,6 +38,24 @@ proptest! {
     }
 }
 
+/// The checked result of `solver` on `inst` (no budget, seed 1).
+fn solve(
+    solver: &str,
+    inst: &cellseq::model::Instance,
+    obj: cellseq::model::Objective,
+) -> cellseq::solvers::RunResult {
+    run(
+        solver,
+        inst,
+        obj,
+        &BTreeMap::new(),
+        1,
+        Budget::default(),
+        &mut NoObserver,
+    )
+    .unwrap()
+}
+
 #[test]
 fn beats_nearest_neighbour_on_uniform_strokes() {
     for seed in 1..4 {
@@ -81,7 +99,6 @@ fn beats_nearest_neighbour_on_uniform_strokes() {
 
 #[test]
 fn falls_back_to_greedy_under_precedence_or_several_tools() {
-    let none = BTreeMap::new();
     for p in [
         kv(&[("n", "200".into()), ("preds", "1".into())]),
         kv(&[("n", "200".into()), ("tools", "3".into())]),
