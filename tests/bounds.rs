@@ -62,6 +62,19 @@ fn check_instance(inst: &Instance, obj: Objective) {
             p.value
         );
     }
+    // a one-prefix beam rarely proves anything: its reported lower bound (the first-level
+    // node bound) must still be below the optimum
+    let mut p = BTreeMap::new();
+    p.insert("warm_evals".to_string(), "0".to_string());
+    p.insert("max_width".to_string(), "1".to_string());
+    let narrow = solvers::run("beam", inst, obj, &p, 1, Budget::default(), &mut NoObserver)
+        .expect("beam solves");
+    let lb = narrow.outcome.lower_bound.expect("beam reports a bound");
+    assert!(
+        lb <= opt + 1e-6 * opt.abs().max(1.0),
+        "{}: beam lower bound {lb} exceeds the optimum {opt}",
+        inst.name
+    );
     for r in [beam(inst, obj), beam_alone(inst, obj)] {
         assert!(
             r.outcome.proven_optimal,

@@ -289,7 +289,18 @@ impl Beam {
         }
         let t = tables(m, self.potentials)?;
         let constant = m.constant();
-        let mut root_lb = f64::NEG_INFINITY;
+        // the node bound at the first level (every possible first cell and mode) bounds the
+        // optimum: reported as the lower bound when no proof is reached
+        let mut root_lb = if self.refine {
+            first_level_bound::<W>(m, &t)
+        } else {
+            f64::NEG_INFINITY
+        };
+        if !root_lb.is_finite() {
+            root_lb = f64::NEG_INFINITY;
+        } else if t.integral {
+            root_lb = (root_lb - 1e-6).ceil();
+        }
         // prune a bound f when it cannot beat `ub` strictly
         let cut = |ub: f64| {
             if !ub.is_finite() {
@@ -345,7 +356,7 @@ impl Beam {
                     upper: best.as_ref().map(|b| b.0),
                     ..BoundOptions::default()
                 };
-                root_lb = bound::compute(m, &opts).best;
+                root_lb = root_lb.max(bound::compute(m, &opts).best);
             }
             if let Some((c, _)) = &best
                 && root_lb > cut(*c)
@@ -884,6 +895,33 @@ fn refined<const W: usize>(
     }
     let _ = nc;
     p.g + pot + (h_in + home_in).max(h_out + last_out)
+}
+
+/// The smallest refined bound over all one-cell prefixes: a lower bound on the optimum.
+fn first_level_bound<const W: usize>(m: &CostModel, t: &Tables) -> f64 {
+    let n = m.n();
+    let mut scratch = vec![(0.0, 0.0); n + t.clusters.len()];
+    let mut lb = f64::INFINITY;
+    for c in 0..n {
+        if t.pred_mask[c].iter().any(|&w| w != 0) {
+            continue;
+        }
+        for md in 0..m.modes(c) {
+            let mut bits = [0u64; W];
+            bits[c / 64] |= 1 << (c % 64);
+            let p = Prefix {
+                bits,
+                node: m.node(c, md) as u32,
+                parent: u32::MAX,
+                g: m.constant() + m.start(c, md),
+                rem_in: 0.0,
+                rem_out: 0.0,
+                f: 0.0,
+            };
+            lb = lb.min(refined(m, t, &p, &mut scratch));
+        }
+    }
+    lb
 }
 
 /// Order by bound, then cost, last node and visited set (a total order on distinct prefixes).
