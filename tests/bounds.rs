@@ -31,16 +31,18 @@ fn exact(inst: &Instance, obj: Objective) -> f64 {
 }
 
 fn beam(inst: &Instance, obj: Objective) -> solvers::RunResult {
-    solvers::run(
-        "beam",
-        inst,
-        obj,
-        &BTreeMap::new(),
-        1,
-        Budget::default(),
-        &mut NoObserver,
-    )
-    .expect("beam solves")
+    let mut p = BTreeMap::new();
+    p.insert("warm_evals".to_string(), "20000".to_string());
+    solvers::run("beam", inst, obj, &p, 1, Budget::default(), &mut NoObserver).expect("beam solves")
+}
+
+/// The beam with no warm start and no root bound: the tree search alone must find and prove
+/// the optimum, so an invalid node bound (over-pruning) shows up as a wrong cost.
+fn beam_alone(inst: &Instance, obj: Objective) -> solvers::RunResult {
+    let mut p = BTreeMap::new();
+    p.insert("warm_evals".to_string(), "0".to_string());
+    p.insert("root_bound".to_string(), "false".to_string());
+    solvers::run("beam", inst, obj, &p, 1, Budget::default(), &mut NoObserver).expect("beam solves")
 }
 
 fn all_bounds(inst: &Instance, obj: Objective) -> bound::Bounds {
@@ -60,18 +62,75 @@ fn check_instance(inst: &Instance, obj: Objective) {
             p.value
         );
     }
-    let r = beam(inst, obj);
+    // a one-prefix beam rarely proves anything: its reported lower bound (the first-level
+    // node bound) must still be below the optimum
+    let mut p = BTreeMap::new();
+    p.insert("warm_evals".to_string(), "0".to_string());
+    p.insert("max_width".to_string(), "1".to_string());
+    let narrow = solvers::run("beam", inst, obj, &p, 1, Budget::default(), &mut NoObserver)
+        .expect("beam solves");
+    let lb = narrow.outcome.lower_bound.expect("beam reports a bound");
     assert!(
-        r.outcome.proven_optimal,
-        "{}: beam did not prove optimality",
+        lb <= opt + 1e-6 * opt.abs().max(1.0),
+        "{}: beam lower bound {lb} exceeds the optimum {opt}",
         inst.name
     );
-    assert!(
-        (r.report.cost - opt).abs() <= 1e-6 * opt.abs().max(1.0),
-        "{}: beam {} vs exact {opt}",
-        inst.name,
-        r.report.cost
+    for r in [beam(inst, obj), beam_alone(inst, obj)] {
+        assert!(
+            r.outcome.proven_optimal,
+            "{}: beam did not prove optimality",
+            inst.name
+        );
+        assert!(
+            (r.report.cost - opt).abs() <= 1e-6 * opt.abs().max(1.0),
+            "{}: beam {} vs exact {opt}",
+            inst.name,
+            r.report.cost
+        );
+    }
+}
+
+/// A TSPLIB SOP text whose cells fall into groups: cheap arcs inside a group, expensive ones
+/// between groups (like p43), so the beam's cluster surcharges are exercised.
+fn clustered_sop_text(group: &[usize], small: &[u32], big: &[u32], prec: &[bool]) -> String {
+    let k = group.len();
+    let n = k + 2;
+    let mut s = format!(
+        "NAME: rnd\nTYPE: SOP\nDIMENSION: {n}\nEDGE_WEIGHT_TYPE: EXPLICIT\n\
+         EDGE_WEIGHT_FORMAT: FULL_MATRIX\nEDGE_WEIGHT_SECTION\n{n}\n"
     );
+    let mut idx = 0;
+    for i in 0..n {
+        let mut row = Vec::new();
+        for j in 0..n {
+            let v: i64 = if i == j {
+                0
+            } else if j == 0 || i == n - 1 {
+                -1
+            } else if i == 0 || j == n - 1 {
+                (small[(i + j) % small.len()] % 10) as i64
+            } else {
+                idx += 1;
+                // j precedes i (only for j < i, so the order stays acyclic)
+                if j < i && prec[idx % prec.len()] {
+                    -1
+                } else {
+                    let (gi, gj) = (group[i - 1], group[j - 1]);
+                    let c = small[idx % small.len()] as i64;
+                    if gi == gj {
+                        c
+                    } else {
+                        c + big[idx % big.len()] as i64
+                    }
+                }
+            };
+            row.push(v.to_string());
+        }
+        s += &row.join(" ");
+        s += "\n";
+    }
+    s += "EOF\n";
+    s
 }
 
 #[test]
@@ -93,7 +152,7 @@ fn bounds_and_beam_on_small_pcgtsp() {
 #[test]
 fn beam_proves_known_optima() {
     // values from instances/tsplib-sop/bks.csv (proven optimal there)
-    for (name, opt) in [("ESC25", 1681.0), ("ESC63", 62.0)] {
+    for (name, opt) in [("ESC25", 1681.0), ("ESC47", 1288.0), ("ESC63", 62.0)] {
         let inst = load(&format!("instances/tsplib-sop/{name}.sop"));
         let r = beam(&inst, Objective::Matrix);
         assert!(r.outcome.proven_optimal, "{name} not proven");
@@ -206,6 +265,18 @@ proptest! {
     ) {
         let text = pcglns_text(sizes.len(), &sizes, &costs, &prec);
         let inst = formats::parse_instance("rnd.pcglns", &text, Format::Pcglns).unwrap();
+        check_instance(&inst, Objective::Matrix);
+    }
+
+    #[test]
+    fn beam_exact_on_random_clustered_sop(
+        group in prop::collection::vec(0usize..3, 4..=9),
+        small in prop::collection::vec(0u32..20, 40),
+        big in prop::collection::vec(50u32..500, 40),
+        prec in prop::collection::vec(prop::bool::weighted(0.15), 40),
+    ) {
+        let text = clustered_sop_text(&group, &small, &big, &prec);
+        let inst = formats::parse_instance("rnd.sop", &text, Format::Sop).unwrap();
         check_instance(&inst, Objective::Matrix);
     }
 

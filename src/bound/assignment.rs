@@ -8,8 +8,32 @@ use super::cells::CellGraph;
 /// Returns the optimal value and the column of each row, or `None` if no finite assignment
 /// exists.
 pub fn hungarian(d: usize, cost: impl Fn(usize, usize) -> f64) -> Option<(f64, Vec<usize>)> {
+    hungarian_duals(d, cost).map(|a| (a.value, a.col))
+}
+
+/// An optimal assignment with its dual potentials.
+#[derive(Debug, Clone)]
+pub struct Assignment {
+    /// Optimal value.
+    pub value: f64,
+    /// Column assigned to each row.
+    pub col: Vec<usize>,
+    /// Row potentials: `cost(i, j) - u[i] - v[j] >= 0` for every finite entry (up to rounding).
+    pub u: Vec<f64>,
+    /// Column potentials.
+    pub v: Vec<f64>,
+}
+
+/// Like [`hungarian`], and also returns the dual potentials `u`, `v` (reduced costs
+/// `cost(i, j) - u[i] - v[j]` are non-negative; `Σu + Σv` = the optimal value).
+pub fn hungarian_duals(d: usize, cost: impl Fn(usize, usize) -> f64) -> Option<Assignment> {
     if d == 0 {
-        return Some((0.0, Vec::new()));
+        return Some(Assignment {
+            value: 0.0,
+            col: Vec::new(),
+            u: Vec::new(),
+            v: Vec::new(),
+        });
     }
     // Replace forbidden entries by a penalty larger than any finite assignment.
     let mut finite_max = 0.0f64;
@@ -89,7 +113,12 @@ pub fn hungarian(d: usize, cost: impl Fn(usize, usize) -> f64) -> Option<(f64, V
         }
         total += c;
     }
-    Some((total, col))
+    Some(Assignment {
+        value: total,
+        col,
+        u: u[1..].to_vec(),
+        v: v[1..].to_vec(),
+    })
 }
 
 /// The assignment bound on the arc part of the cost (without the model's constant).
@@ -107,6 +136,14 @@ mod tests {
         let (v, col) = hungarian(3, |i, j| m[i][j]).unwrap();
         assert_eq!(v, 5.0);
         assert_eq!(col, vec![1, 0, 2]);
+        let a = hungarian_duals(3, |i, j| m[i][j]).unwrap();
+        for i in 0..3 {
+            for j in 0..3 {
+                assert!(m[i][j] - a.u[i] - a.v[j] >= -1e-9);
+            }
+        }
+        let dual: f64 = a.u.iter().chain(&a.v).sum();
+        assert!((dual - 5.0).abs() < 1e-9);
     }
 
     #[test]

@@ -15,10 +15,12 @@
 //! once (Σ cheapest allowed out-arc). A root bound from [`crate::bound`] (Lagrangian
 //! arborescence) may close the gap at once.
 
-use super::{Context, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo};
+use super::{
+    Budget, Context, NoObserver, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo,
+};
 use crate::bound::cells::CellGraph;
 use crate::bound::closure::Closure;
-use crate::bound::{self, BoundOptions};
+use crate::bound::{self, BoundOptions, assignment};
 use crate::cost::CostModel;
 use crate::error::{Error, Result};
 use crate::model::{Sequence, Visit};
@@ -60,6 +62,19 @@ pub static INFO: SolverInfo = SolverInfo {
             kind: ParamKind::Bool,
             help: "compute the Lagrangian root bound (stops as soon as the incumbent meets it)",
         },
+        ParamSpec {
+            name: "potentials",
+            default: "true",
+            kind: ParamKind::Bool,
+            help: "bound in reduced costs of the root assignment duals, with its subtours as \
+                   clusters that must be entered and left (n <= 600)",
+        },
+        ParamSpec {
+            name: "warm_evals",
+            default: "2000000",
+            kind: ParamKind::Int,
+            help: "evaluations of an `ils` run that gives the first incumbent (0 = none)",
+        },
     ],
     make: |p: &Params| {
         Box::new(Beam {
@@ -68,6 +83,8 @@ pub static INFO: SolverInfo = SolverInfo {
             root_bound: p.bool("root_bound"),
             refine: p.bool("refine"),
             by_cost: p.word("guide") == "cost",
+            potentials: p.bool("potentials"),
+            warm_evals: p.int("warm_evals"),
         })
     },
 };
@@ -84,6 +101,10 @@ pub struct Beam {
     pub refine: bool,
     /// Rank prefixes by cost so far instead of cost + bound.
     pub by_cost: bool,
+    /// Bound in reduced costs of the root assignment (with clusters).
+    pub potentials: bool,
+    /// Evaluation budget of the `ils` warm start (0 = none).
+    pub warm_evals: u64,
 }
 
 /// Largest instance accepted (visited sets are fixed-size bitsets).
@@ -121,20 +142,46 @@ struct Prefix<const W: usize> {
 }
 
 /// Static data of the incremental bound.
+///
+/// All bound terms are written with the dual potentials `u`, `v` of the root assignment
+/// problem (cells plus home = index n): every arc cost splits as `c(i, j) = u_i + v_j +
+/// r(i, j)` with reduced cost `r`, so the rest of a path from the last cell `l` through the
+/// unvisited set `U` to home costs exactly `u_l + v_home + Σ_{U} (u + v) + Σ r` over its arcs,
+/// and `Σ r` is bounded below by degree arguments on reduced costs (valid for any potentials;
+/// the assignment duals make them strong).
 struct Tables {
     pred_mask: Vec<Vec<u64>>,
+    /// per cell: u + v + cheapest reduced in-arc
     cell_in: Vec<f64>,
+    /// per cell: u + v + cheapest reduced out-arc
     cell_out: Vec<f64>,
+    /// per node: u(cell) + v(home) + cheapest reduced arc out of the node
     node_out: Vec<f64>,
-    home_in: f64,
+    /// per node: u(cell) + v(home) + cheapest reduced arc into home
+    node_in: Vec<f64>,
+    /// row potentials (cells, then home)
+    u: Vec<f64>,
+    /// column potentials (cells, then home)
+    v: Vec<f64>,
+    /// per cell: reduced cost of the cheapest finish (∞ when the cell cannot be last)
+    r_home: Vec<f64>,
     integral: bool,
-    /// per cell: allowed predecessor cells by increasing arc cost
+    /// per cell: allowed predecessor cells by increasing reduced cost
     in_list: Vec<Vec<(f64, u32)>>,
-    /// per cell: allowed successor cells (and home = n when it may be last) by increasing cost
+    /// per cell: allowed successor cells (and home = n when it may be last) by increasing
+    /// reduced cost
     out_list: Vec<Vec<(f64, u32)>>,
+    /// cluster index of each cell (`u32::MAX`: none); clusters are the subtours of the root
+    /// assignment, which any path must enter and leave at least once
+    cluster: Vec<u32>,
+    /// the clusters' cells
+    clusters: Vec<Vec<u32>>,
 }
 
-fn tables(m: &CostModel) -> Result<Tables> {
+/// Largest instance for which the root assignment (O(n³)) gives the potentials.
+const POTENTIAL_MAX_CELLS: usize = 600;
+
+fn tables(m: &CostModel, use_potentials: bool) -> Result<Tables> {
     let n = m.n();
     let words = n.div_ceil(64).max(1);
     let cl = Closure::new(&m.dag).ok_or_else(|| Error::Solver {
@@ -142,8 +189,15 @@ fn tables(m: &CostModel) -> Result<Tables> {
         msg: "precedence has a cycle".into(),
     })?;
     let g = CellGraph::new(m, &cl);
-    let min_in = g.min_in();
-    let min_out = g.min_out();
+    let asg = (use_potentials && n <= POTENTIAL_MAX_CELLS)
+        .then(|| assignment::hungarian_duals(g.size(), |i, j| g.c(i, j)))
+        .flatten()
+        .filter(|a| a.u.iter().chain(&a.v).all(|x| x.is_finite()));
+    let (u, v) = match &asg {
+        Some(a) => (a.u.clone(), a.v.clone()),
+        None => (vec![0.0; n + 1], vec![0.0; n + 1]),
+    };
+    let r = |i: usize, j: usize| g.c(i, j) - u[i] - v[j];
     let pred_mask = (0..n)
         .map(|c| {
             let mut v = vec![0u64; words];
@@ -153,34 +207,36 @@ fn tables(m: &CostModel) -> Result<Tables> {
             v
         })
         .collect();
-    let mut node_out = vec![f64::INFINITY; m.nodes()];
-    for (u, slot) in node_out.iter_mut().enumerate() {
-        let (a, ma) = m.cell_mode(u);
+    let fin = |x: f64| if x.is_finite() { x } else { 0.0 };
+    let mut node_out = vec![0.0; m.nodes()];
+    let mut node_in = vec![0.0; m.nodes()];
+    let home_in = fin((0..n).map(|i| r(i, n)).fold(f64::INFINITY, f64::min));
+    for (nd, slot) in node_out.iter_mut().enumerate() {
+        let (a, ma) = m.cell_mode(nd);
         let mut best = if cl.can_be_last(a) {
-            m.finish(a, ma)
+            m.finish(a, ma) - u[a] - v[n]
         } else {
             f64::INFINITY
         };
         for b in 0..n {
             if cl.arc_allowed(a, b) {
                 for mb in 0..m.modes(b) {
-                    best = best.min(m.arc(a, ma, b, mb));
+                    best = best.min(m.arc(a, ma, b, mb) - u[a] - v[b]);
                 }
             }
         }
-        *slot = best;
+        *slot = u[a] + v[n] + fin(best);
+        node_in[nd] = u[a] + v[n] + home_in;
     }
-    let fin = |x: f64| if x.is_finite() { x } else { 0.0 };
     let mut in_list = vec![Vec::new(); n];
     let mut out_list = vec![Vec::new(); n];
     #[allow(clippy::needless_range_loop)]
     for i in 0..n {
         for j in 0..=n {
-            let c = g.c(i, j);
-            if c.is_finite() {
-                out_list[i].push((c, j as u32));
+            if g.c(i, j).is_finite() {
+                out_list[i].push((r(i, j), j as u32));
                 if j < n {
-                    in_list[j].push((c, i as u32));
+                    in_list[j].push((r(i, j), i as u32));
                 }
             }
         }
@@ -188,15 +244,39 @@ fn tables(m: &CostModel) -> Result<Tables> {
     for l in in_list.iter_mut().chain(out_list.iter_mut()) {
         l.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
     }
+    let first = |l: &Vec<(f64, u32)>| l.first().map(|e| e.0).unwrap_or(0.0);
+    let clusters = if asg.is_some() {
+        choose_clusters(&g, &r)
+    } else {
+        Vec::new()
+    };
+    if std::env::var_os("CELLSEQ_BEAM_TRACE").is_some() {
+        eprintln!(
+            "beam: assignment {:?}, clusters {:?}",
+            asg.as_ref().map(|a| a.value),
+            clusters
+        );
+    }
+    let mut cluster = vec![u32::MAX; n];
+    for (k, cs) in clusters.iter().enumerate() {
+        for &c in cs {
+            cluster[c as usize] = k as u32;
+        }
+    }
     Ok(Tables {
+        cell_in: (0..n).map(|c| u[c] + v[c] + first(&in_list[c])).collect(),
+        cell_out: (0..n).map(|c| u[c] + v[c] + first(&out_list[c])).collect(),
+        r_home: (0..n).map(|i| r(i, n)).collect(),
         in_list,
         out_list,
         pred_mask,
-        cell_in: min_in[..n].iter().map(|&x| fin(x)).collect(),
-        cell_out: min_out[..n].iter().map(|&x| fin(x)).collect(),
-        node_out: node_out.into_iter().map(fin).collect(),
-        home_in: fin(min_in[n]),
+        node_out,
+        node_in,
+        u,
+        v,
         integral: g.integral() && m.constant().fract() == 0.0,
+        cluster,
+        clusters,
     })
 }
 
@@ -207,9 +287,20 @@ impl Beam {
         if n == 0 {
             return Ok(super::outcome_of(m, Vec::new()));
         }
-        let t = tables(m)?;
+        let t = tables(m, self.potentials)?;
         let constant = m.constant();
-        let mut root_lb = f64::NEG_INFINITY;
+        // the node bound at the first level (every possible first cell and mode) bounds the
+        // optimum: reported as the lower bound when no proof is reached
+        let mut root_lb = if self.refine {
+            first_level_bound::<W>(m, &t)
+        } else {
+            f64::NEG_INFINITY
+        };
+        if !root_lb.is_finite() {
+            root_lb = f64::NEG_INFINITY;
+        } else if t.integral {
+            root_lb = (root_lb - 1e-6).ceil();
+        }
         // prune a bound f when it cannot beat `ub` strictly
         let cut = |ub: f64| {
             if !ub.is_finite() {
@@ -220,7 +311,10 @@ impl Beam {
                 ub - 1e-9 * ub.abs().max(1.0)
             }
         };
-        let mut best: Option<(f64, Sequence)> = None;
+        let mut best: Option<(f64, Sequence)> = self.warm_start(ctx)?;
+        if let Some((c, _)) = &best {
+            ctx.report(*c);
+        }
         let mut proven = false;
         let prefix_bytes = (std::mem::size_of::<Prefix<W>>() + 24) as u64;
         let mut width = 1usize;
@@ -262,7 +356,7 @@ impl Beam {
                     upper: best.as_ref().map(|b| b.0),
                     ..BoundOptions::default()
                 };
-                root_lb = bound::compute(m, &opts).best;
+                root_lb = root_lb.max(bound::compute(m, &opts).best);
             }
             if let Some((c, _)) = &best
                 && root_lb > cut(*c)
@@ -291,6 +385,36 @@ impl Beam {
         })
     }
 
+    /// A first incumbent from a short, evaluation-bounded `ils` run (deterministic).
+    fn warm_start(&self, ctx: &mut Context) -> Result<Option<(f64, Sequence)>> {
+        if self.warm_evals == 0 || ctx.model.n() < 3 {
+            return Ok(None);
+        }
+        let info = &super::ils::INFO;
+        let params = Params::new(info.name, info.params, &Default::default())?;
+        let solver = (info.make)(&params);
+        let budget = Budget {
+            max_evals: Some(match ctx.budget.max_evals {
+                Some(b) => (b / 4).min(self.warm_evals),
+                None => self.warm_evals,
+            }),
+            time_limit: ctx.budget.time_limit.map(|t| t.mul_f64(0.25)),
+        };
+        let mut quiet = NoObserver;
+        let mut sub = Context::new(
+            ctx.instance,
+            ctx.model,
+            &params,
+            ctx.seed,
+            budget,
+            &mut quiet,
+        );
+        let out = solver.solve(&mut sub)?;
+        ctx.count(sub.evaluations());
+        let cost = ctx.model.evaluate(&out.sequence);
+        Ok(Some((cost, out.sequence)))
+    }
+
     /// One beam pass of the given width. Returns the best complete sequence found (cost, seq),
     /// whether any child was discarded because of the width, and whether the budget stopped it.
     fn iteration<const W: usize>(
@@ -306,10 +430,11 @@ impl Beam {
         let total_in: f64 = t.cell_in.iter().sum();
         let total_out: f64 = t.cell_out.iter().sum();
         let bound = |p: &Prefix<W>| {
-            let h_in = p.rem_in + t.home_in;
+            let h_in = p.rem_in + t.node_in[p.node as usize];
             let h_out = p.rem_out + t.node_out[p.node as usize];
             p.g + h_in.max(h_out)
         };
+        let mut scratch = vec![(0.0, 0.0); n + t.clusters.len()];
         let mut levels: Vec<Vec<Prefix<W>>> = Vec::with_capacity(n);
         let mut truncated = false;
         // level 1: every cell that may come first, in every mode
@@ -337,6 +462,15 @@ impl Beam {
             }
         }
         ctx.count(cands.len() as u64);
+        if self.refine {
+            for c in cands.iter_mut() {
+                c.f = c.f.max(refined(m, t, c, &mut scratch));
+            }
+        }
+        if width == 1 && std::env::var_os("CELLSEQ_BEAM_TRACE").is_some() {
+            let lb = cands.iter().map(|c| c.f).fold(f64::INFINITY, f64::min);
+            eprintln!("beam: first-level bound {lb}");
+        }
         truncated |= keep_best(&mut cands, width, self.by_cost);
         levels.push(cands);
         let mut index: FxHashMap<([u64; W], u32), u32> = FxHashMap::default();
@@ -394,9 +528,27 @@ impl Beam {
                 }
             }
             ctx.count(evals);
-            if self.refine {
+            if self.refine && cands.len() > width && !self.by_cost {
+                // refine lazily in order of the incremental bound until more than `width`
+                // survive: the rest is discarded (and the level counts as truncated)
+                cands.sort_unstable_by(rank);
+                let mut kept = Vec::with_capacity(width + 1);
+                let mut done = 0u64;
+                for mut c in cands.drain(..) {
+                    done += 1;
+                    c.f = c.f.max(refined(m, t, &c, &mut scratch));
+                    if c.f <= cut {
+                        kept.push(c);
+                        if kept.len() > width {
+                            break;
+                        }
+                    }
+                }
+                ctx.count(done);
+                cands = kept;
+            } else if self.refine {
                 for c in cands.iter_mut() {
-                    c.f = c.f.max(refined(m, t, c));
+                    c.f = c.f.max(refined(m, t, c, &mut scratch));
                 }
                 ctx.count(cands.len() as u64);
                 cands.retain(|c| c.f <= cut);
@@ -406,6 +558,14 @@ impl Beam {
             if may_abort && ctx.exhausted() {
                 return (None, truncated, true);
             }
+        }
+        if std::env::var_os("CELLSEQ_BEAM_TRACE").is_some() {
+            let sizes: Vec<usize> = levels.iter().map(|l| l.len()).collect();
+            eprintln!(
+                "beam: width {width} stored {} largest level {}",
+                sizes.iter().sum::<usize>(),
+                sizes.iter().max().unwrap_or(&0)
+            );
         }
         // complete sequences
         let last = levels.last().expect("a level");
@@ -436,13 +596,150 @@ impl Beam {
     }
 }
 
-/// The dynamic degree bound of a prefix: every unvisited cell is entered from an unvisited cell
-/// or the last one, and left to an unvisited cell or home; the last node is left to an
-/// unvisited cell. O(|unvisited| · scan) with the sorted arc lists.
-fn refined<const W: usize>(m: &CostModel, t: &Tables, p: &Prefix<W>) -> f64 {
+/// Disjoint clusters of cells for the bound: subtours of the assignment relaxation, found
+/// hierarchically (contract every subtour that avoids home into one group, solve the
+/// assignment on the groups again, repeat), then the laminar family is cut so that the root
+/// surcharge (Σ of entering + leaving surcharges, reduced costs `r`) is largest: each cluster
+/// is kept whole or replaced by its best sub-family.
+fn choose_clusters(g: &CellGraph, r: &dyn Fn(usize, usize) -> f64) -> Vec<Vec<u32>> {
+    let n = g.n;
+    // tree of clusters: cells and children
+    let mut tree: Vec<(Vec<u32>, Vec<usize>)> = Vec::new();
+    // current groups: cells (home = n) and tree node
+    let mut groups: Vec<(Vec<u32>, Option<usize>)> =
+        (0..=n).map(|c| (vec![c as u32], None)).collect();
+    for _round in 0..16 {
+        let k = groups.len();
+        if k <= 2 {
+            break;
+        }
+        let mut cost = vec![f64::INFINITY; k * k];
+        for a in 0..k {
+            for b in 0..k {
+                if a == b {
+                    continue;
+                }
+                let mut best = f64::INFINITY;
+                for &x in &groups[a].0 {
+                    for &y in &groups[b].0 {
+                        best = best.min(g.c(x as usize, y as usize));
+                    }
+                }
+                cost[a * k + b] = best;
+            }
+        }
+        let Some(asg) = assignment::hungarian(k, |a, b| cost[a * k + b]) else {
+            break;
+        };
+        let home = groups.iter().position(|gr| gr.0.contains(&(n as u32)));
+        let mut seen = vec![false; k];
+        let mut next: Vec<(Vec<u32>, Option<usize>)> = Vec::new();
+        let mut merged = false;
+        for s0 in 0..k {
+            if seen[s0] {
+                continue;
+            }
+            let mut cyc = Vec::new();
+            let mut x = s0;
+            while !seen[x] {
+                seen[x] = true;
+                cyc.push(x);
+                x = asg.1[x];
+            }
+            if cyc.len() >= 2 && !cyc.iter().any(|&x| Some(x) == home) {
+                let cells: Vec<u32> = cyc.iter().flat_map(|&x| groups[x].0.clone()).collect();
+                let children: Vec<usize> = cyc.iter().filter_map(|&x| groups[x].1).collect();
+                tree.push((cells.clone(), children));
+                next.push((cells, Some(tree.len() - 1)));
+                merged = true;
+            } else {
+                next.extend(cyc.iter().map(|&x| groups[x].clone()));
+            }
+        }
+        groups = next;
+        if !merged {
+            break;
+        }
+    }
+    // root surcharge of each cluster
+    let d = n + 1;
+    let mut min_in = vec![f64::INFINITY; n];
+    let mut min_out = vec![f64::INFINITY; n];
+    for i in 0..d {
+        for j in 0..d {
+            let c = r(i, j);
+            if g.c(i, j).is_finite() {
+                if j < n {
+                    min_in[j] = min_in[j].min(c);
+                }
+                if i < n {
+                    min_out[i] = min_out[i].min(c);
+                }
+            }
+        }
+    }
+    let mut inside = vec![false; d];
+    let surcharge = |cells: &[u32], inside: &mut Vec<bool>| {
+        for &c in cells {
+            inside[c as usize] = true;
+        }
+        let mut d_in = f64::INFINITY;
+        let mut d_out = f64::INFINITY;
+        for &j in cells {
+            let j = j as usize;
+            for i in 0..d {
+                if !inside[i] && g.c(i, j).is_finite() {
+                    d_in = d_in.min(r(i, j) - min_in[j]);
+                }
+                if !inside[i] && g.c(j, i).is_finite() {
+                    d_out = d_out.min(r(j, i) - min_out[j]);
+                }
+            }
+        }
+        for &c in cells {
+            inside[c as usize] = false;
+        }
+        let f = |x: f64| if x.is_finite() { x.max(0.0) } else { 0.0 };
+        f(d_in) + f(d_out)
+    };
+    // children come before parents in `tree`
+    let mut val = vec![0.0; tree.len()];
+    let mut whole = vec![false; tree.len()];
+    for t in 0..tree.len() {
+        let own = surcharge(&tree[t].0, &mut inside);
+        let sub: f64 = tree[t].1.iter().map(|&c| val[c]).sum();
+        whole[t] = own >= sub && own > 0.0;
+        val[t] = own.max(sub);
+    }
+    let mut out = Vec::new();
+    let mut stack: Vec<usize> = groups.iter().filter_map(|gr| gr.1).collect();
+    while let Some(t) = stack.pop() {
+        if whole[t] {
+            out.push(tree[t].0.clone());
+        } else {
+            stack.extend(tree[t].1.iter().copied());
+        }
+    }
+    out.sort();
+    out
+}
+
+/// The dynamic bound of a prefix, in reduced costs (see [`Tables`]): every unvisited cell is
+/// entered from an unvisited cell or the last one, and left to an unvisited cell or home; the
+/// last node is left to an unvisited cell; and every root-assignment cluster's unvisited part
+/// must be entered from outside it and left to outside it at least once, which adds the
+/// cheapest surcharge of doing so over its members' own cheapest arcs.
+/// O(|unvisited| · scan) with the sorted arc lists; `scratch` holds n + clusters entries.
+fn refined<const W: usize>(
+    m: &CostModel,
+    t: &Tables,
+    p: &Prefix<W>,
+    scratch: &mut [(f64, f64)],
+) -> f64 {
     let n = m.n();
     let open = |c: usize| c < n && p.bits[c / 64] >> (c % 64) & 1 == 0;
     let (l, lm) = m.cell_mode(p.node as usize);
+    let mut pot = t.u[l] + t.v[n];
     let mut h_in = 0.0;
     let mut h_out = 0.0;
     let mut home_in = f64::INFINITY;
@@ -453,34 +750,186 @@ fn refined<const W: usize>(m: &CostModel, t: &Tables, p: &Prefix<W>) -> f64 {
             continue;
         }
         any = true;
-        let i = t.in_list[j]
+        pot += t.u[j] + t.v[j];
+        let Some(i) = t.in_list[j]
             .iter()
             .find(|&&(_, i)| open(i as usize) || i as usize == l)
-            .map(|e| e.0);
-        let Some(i) = i else {
+            .map(|e| e.0)
+        else {
             return f64::INFINITY;
         };
         h_in += i;
-        let o = t.out_list[j]
+        let Some(o) = t.out_list[j]
             .iter()
             .find(|&&(_, k)| open(k as usize) || k as usize == n)
-            .map(|e| e.0);
-        let Some(o) = o else {
+            .map(|e| e.0)
+        else {
             return f64::INFINITY;
         };
         h_out += o;
-        if let Some(&(c, _)) = t.out_list[j].iter().find(|&&(_, k)| k as usize == n) {
-            home_in = home_in.min(c);
-        }
+        scratch[j] = (i, o);
+        home_in = home_in.min(t.r_home[j]);
         for mj in 0..m.modes(j) {
-            last_out = last_out.min(m.arc(l, lm, j, mj));
+            last_out = last_out.min(m.arc(l, lm, j, mj) - t.u[l] - t.v[j]);
         }
     }
     if !any {
         return p.g + m.finish(l, lm);
     }
+    if !last_out.is_finite() {
+        return f64::INFINITY;
+    }
     let home_in = if home_in.is_finite() { home_in } else { 0.0 };
-    p.g + (h_in + home_in).max(h_out + last_out)
+    let nc = t.clusters.len();
+    let (io, dd) = scratch.split_at_mut(n);
+    // pass 1: entering / leaving surcharge of each cluster's open part
+    let mut any_cluster = false;
+    for (s, cells) in t.clusters.iter().enumerate() {
+        let s = s as u32;
+        let mut d_in = f64::INFINITY;
+        let mut d_out = f64::INFINITY;
+        let mut touched = false;
+        for &j in cells {
+            let j = j as usize;
+            if !open(j) {
+                continue;
+            }
+            touched = true;
+            let (i0, o0) = io[j];
+            if let Some(&(c, _)) = t.in_list[j].iter().find(|&&(_, i)| {
+                let i = i as usize;
+                i == l || (open(i) && t.cluster[i] != s)
+            }) {
+                d_in = d_in.min(c - i0);
+            }
+            if let Some(&(c, _)) = t.out_list[j].iter().find(|&&(_, k)| {
+                let k = k as usize;
+                k == n || (open(k) && t.cluster[k] != s)
+            }) {
+                d_out = d_out.min(c - o0);
+            }
+        }
+        if !touched {
+            dd[s as usize] = (f64::NAN, f64::NAN);
+            continue;
+        }
+        if !d_in.is_finite() || !d_out.is_finite() {
+            return f64::INFINITY;
+        }
+        any_cluster = true;
+        dd[s as usize] = (d_in.max(0.0), d_out.max(0.0));
+        h_in += d_in.max(0.0);
+        h_out += d_out.max(0.0);
+    }
+    if any_cluster {
+        // pass 2: a cluster's leaving arc enters some cell k (or home); in the in-degree sum
+        // it costs at least min_in(k) plus, when k's cluster is entered by it, that cluster's
+        // entering surcharge: the rest is an extra surcharge on top (and symmetrically for
+        // entering arcs in the out-degree sum). Each arc is charged at most one entering and
+        // one leaving surcharge, so the sums stay valid.
+        let open_d = |k: usize| -> (f64, f64) {
+            let c = t.cluster[k];
+            if c == u32::MAX || dd[c as usize].0.is_nan() {
+                (0.0, 0.0)
+            } else {
+                dd[c as usize]
+            }
+        };
+        let mut max_in = home_in;
+        let mut max_out = last_out;
+        for j in 0..n {
+            if open(j) {
+                let d = open_d(j);
+                max_in = max_in.max(io[j].0 + d.0);
+                max_out = max_out.max(io[j].1 + d.1);
+            }
+        }
+        for (s, cells) in t.clusters.iter().enumerate() {
+            if dd[s].0.is_nan() {
+                continue;
+            }
+            let s = s as u32;
+            let mut e_out = f64::INFINITY;
+            let mut e_in = f64::INFINITY;
+            for &j in cells {
+                let j = j as usize;
+                if !open(j) {
+                    continue;
+                }
+                for &(c, k) in &t.out_list[j] {
+                    if c - max_in >= e_out {
+                        break;
+                    }
+                    let k = k as usize;
+                    let base = if k == n {
+                        home_in
+                    } else if open(k) && t.cluster[k] != s {
+                        io[k].0 + open_d(k).0
+                    } else {
+                        continue;
+                    };
+                    e_out = e_out.min(c - base);
+                }
+                for &(c, i) in &t.in_list[j] {
+                    if c - max_out >= e_in {
+                        break;
+                    }
+                    let i = i as usize;
+                    let base = if i == l {
+                        last_out
+                    } else if open(i) && t.cluster[i] != s {
+                        io[i].1 + open_d(i).1
+                    } else {
+                        continue;
+                    };
+                    e_in = e_in.min(c - base);
+                }
+            }
+            if e_out.is_finite() {
+                h_in += e_out.max(0.0);
+            }
+            if e_in.is_finite() {
+                h_out += e_in.max(0.0);
+            }
+        }
+    }
+    let _ = nc;
+    p.g + pot + (h_in + home_in).max(h_out + last_out)
+}
+
+/// The smallest refined bound over all one-cell prefixes: a lower bound on the optimum.
+fn first_level_bound<const W: usize>(m: &CostModel, t: &Tables) -> f64 {
+    let n = m.n();
+    let mut scratch = vec![(0.0, 0.0); n + t.clusters.len()];
+    let mut lb = f64::INFINITY;
+    for c in 0..n {
+        if t.pred_mask[c].iter().any(|&w| w != 0) {
+            continue;
+        }
+        for md in 0..m.modes(c) {
+            let mut bits = [0u64; W];
+            bits[c / 64] |= 1 << (c % 64);
+            let p = Prefix {
+                bits,
+                node: m.node(c, md) as u32,
+                parent: u32::MAX,
+                g: m.constant() + m.start(c, md),
+                rem_in: 0.0,
+                rem_out: 0.0,
+                f: 0.0,
+            };
+            lb = lb.min(refined(m, t, &p, &mut scratch));
+        }
+    }
+    lb
+}
+
+/// Order by bound, then cost, last node and visited set (a total order on distinct prefixes).
+fn rank<const W: usize>(a: &Prefix<W>, b: &Prefix<W>) -> std::cmp::Ordering {
+    a.f.total_cmp(&b.f)
+        .then(a.g.total_cmp(&b.g))
+        .then(a.node.cmp(&b.node))
+        .then(a.bits.cmp(&b.bits))
 }
 
 /// Keeps the `width` candidates with the smallest bound (ties: cost, then last node and visited
