@@ -67,27 +67,10 @@ fn beats_nearest_neighbour_on_uniform_strokes() {
         ]);
         let inst = generate("uniform", &p, seed).unwrap();
         let obj = cellseq::model::Objective::Air;
-        let none = BTreeMap::new();
-        let e = run(
-            "greedy-edge",
-            &inst,
-            obj,
-            &none,
-            1,
-            Budget::default(),
-            &mut NoObserver,
-        )
-        .unwrap();
-        let g = run(
-            "greedy",
-            &inst,
-            obj,
-            &none,
-            1,
-            Budget::default(),
-            &mut NoObserver,
-        )
-        .unwrap();
+        let (e, g) = (
+            solve("greedy-edge", &inst, obj),
+            solve("greedy", &inst, obj),
+        );
         assert!(
             e.report.cost < 0.95 * g.report.cost,
             "seed {seed}: greedy-edge {} vs greedy {}",
@@ -105,26 +88,10 @@ fn falls_back_to_greedy_under_precedence_or_several_tools() {
     ] {
         let inst = generate("uniform", &p, 7).unwrap();
         let obj = inst.default_objective();
-        let e = run(
-            "greedy-edge",
-            &inst,
-            obj,
-            &none,
-            1,
-            Budget::default(),
-            &mut NoObserver,
-        )
-        .unwrap();
-        let g = run(
-            "greedy",
-            &inst,
-            obj,
-            &none,
-            1,
-            Budget::default(),
-            &mut NoObserver,
-        )
-        .unwrap();
+        let (e, g) = (
+            solve("greedy-edge", &inst, obj),
+            solve("greedy", &inst, obj),
+        );
         assert_eq!(e.outcome.sequence, g.outcome.sequence);
     }
 }
