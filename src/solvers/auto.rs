@@ -15,7 +15,8 @@
 use super::{
     Budget, Context, NoObserver, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo,
 };
-use crate::error::Result;
+use crate::engine::{Costs, Solution};
+use crate::error::{Error, Result};
 use std::collections::BTreeMap;
 use std::time::Duration;
 
@@ -32,7 +33,7 @@ pub static INFO: SolverInfo = SolverInfo {
         },
         ParamSpec {
             name: "beam-share",
-            default: "0.3",
+            default: "0.05",
             kind: ParamKind::Float,
             help: "share of the budget given to the beam proof attempt",
         },
@@ -42,12 +43,19 @@ pub static INFO: SolverInfo = SolverInfo {
             kind: ParamKind::Int,
             help: "skip the beam phase on larger instances",
         },
+        ParamSpec {
+            name: "plan",
+            default: PLAN,
+            kind: ParamKind::Text,
+            help: "phases after the beam: solver:share,... (share of what is left; a '*' after the name starts ils/eacs from the best so far)",
+        },
     ],
     make: |p: &Params| {
         Box::new(Auto {
             seconds: p.float("seconds").max(0.001),
             beam_share: p.float("beam-share").clamp(0.0, 1.0),
             beam_max_cells: p.int("beam-max-cells") as usize,
+            plan: p.word("plan").to_string(),
         })
     },
 };
@@ -60,6 +68,65 @@ pub struct Auto {
     pub beam_share: f64,
     /// Largest instance for the beam phase.
     pub beam_max_cells: usize,
+    /// Phases after the beam (`solver[*]:share,...`).
+    pub plan: String,
+}
+
+/// Default phases after the beam.
+pub const PLAN: &str = "local-search:0.3,eacs*:0.5,ils*:1";
+
+/// One phase of a plan: solver name, share of what is left, start from the best so far.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Phase {
+    /// Solver name.
+    pub solver: String,
+    /// Share of the remaining budget.
+    pub share: f64,
+    /// Start from the best sequence so far (ils and eacs only).
+    pub chained: bool,
+}
+
+/// Parses a plan `solver[*]:share,...`.
+pub fn parse_plan(plan: &str) -> Result<Vec<Phase>> {
+    let bad = |msg: String| Error::Solver {
+        solver: "auto".to_string(),
+        msg,
+    };
+    let mut out = Vec::new();
+    for part in plan.split(',').map(str::trim).filter(|p| !p.is_empty()) {
+        let (name, share) = part
+            .split_once(':')
+            .ok_or_else(|| bad(format!("plan phase '{part}' is not solver:share")))?;
+        let share: f64 = share
+            .trim()
+            .parse()
+            .ok()
+            .filter(|v: &f64| v.is_finite() && *v > 0.0 && *v <= 1.0)
+            .ok_or_else(|| bad(format!("plan phase '{part}': share must be in (0, 1]")))?;
+        let name = name.trim();
+        let (solver, chained) = match name.strip_suffix('*') {
+            Some(b) => (b.to_string(), true),
+            None => (name.to_string(), false),
+        };
+        if solver == "auto" {
+            return Err(bad("a plan cannot contain auto itself".to_string()));
+        }
+        super::find(&solver)?;
+        if chained && solver != "ils" && solver != "eacs" {
+            return Err(bad(format!(
+                "plan phase '{part}': only ils and eacs can start from the best so far"
+            )));
+        }
+        out.push(Phase {
+            solver,
+            share,
+            chained,
+        });
+    }
+    if out.is_empty() {
+        return Err(bad("empty plan".to_string()));
+    }
+    Ok(out)
 }
 
 /// A share of `b` (what is left of it after `used_evals` and `used_s`).
@@ -75,7 +142,13 @@ fn share(b: Budget, used_evals: u64, used_s: f64, frac: f64) -> Budget {
 }
 
 impl Auto {
-    fn phase(&self, ctx: &mut Context, name: &str, budget: Budget) -> Result<Outcome> {
+    fn phase(
+        &self,
+        ctx: &mut Context,
+        name: &str,
+        budget: Budget,
+        start: Option<&Outcome>,
+    ) -> Result<Outcome> {
         let info = super::find(name)?;
         let params = Params::new(name, info.params, &BTreeMap::new())?;
         let solver = (info.make)(&params);
@@ -88,7 +161,16 @@ impl Auto {
             budget,
             &mut quiet,
         );
-        let out = solver.solve(&mut sub)?;
+        let out = match start {
+            Some(o) => {
+                let s = Solution::new(&Costs::open(ctx.model), &o.sequence);
+                match name {
+                    "ils" => super::ils::from_params(&params).run(&mut sub, Some(s))?,
+                    _ => super::eacs::from_params(&params).run(&mut sub, Some(s))?,
+                }
+            }
+            None => solver.solve(&mut sub)?,
+        };
         ctx.count(sub.evaluations());
         ctx.report(out.cost);
         Ok(out)
@@ -97,6 +179,7 @@ impl Auto {
 
 impl Solver for Auto {
     fn solve(&self, ctx: &mut Context) -> Result<Outcome> {
+        let plan = parse_plan(&self.plan)?;
         let mut budget = ctx.budget;
         if budget.time_limit.is_none() && budget.max_evals.is_none() {
             budget.time_limit = Some(Duration::from_secs_f64(self.seconds));
@@ -109,19 +192,19 @@ impl Solver for Auto {
         };
         if ctx.model.n() <= self.beam_max_cells && self.beam_share > 0.0 {
             let b = share(budget, 0, 0.0, self.beam_share);
-            if let Ok(o) = self.phase(ctx, "beam", b) {
+            if let Ok(o) = self.phase(ctx, "beam", b, None) {
                 if o.proven_optimal {
                     return Ok(o);
                 }
                 keep(&mut best, o);
             }
         }
-        let b = share(budget, ctx.evaluations(), ctx.elapsed(), 0.5);
-        let o = self.phase(ctx, "local-search", b)?;
-        keep(&mut best, o);
-        let b = share(budget, ctx.evaluations(), ctx.elapsed(), 1.0);
-        let o = self.phase(ctx, "ils", b)?;
-        keep(&mut best, o);
+        for ph in &plan {
+            let b = share(budget, ctx.evaluations(), ctx.elapsed(), ph.share);
+            let start = if ph.chained { best.as_ref() } else { None };
+            let o = self.phase(ctx, &ph.solver, b, start)?;
+            keep(&mut best, o);
+        }
         let mut out = best.expect("at least one phase ran");
         out.proven_optimal = false;
         Ok(out)

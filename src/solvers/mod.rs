@@ -8,6 +8,7 @@ pub mod aco;
 pub mod as_given;
 pub mod auto;
 pub mod beam;
+pub mod eacs;
 pub mod exact;
 pub mod greedy;
 pub mod ils;
@@ -204,6 +205,7 @@ pub fn registry() -> Vec<&'static SolverInfo> {
         &sa::INFO,
         &tabu::INFO,
         &aco::INFO,
+        &eacs::INFO,
         &process::INFO,
         &rules::INFO,
     ]
