@@ -1,12 +1,14 @@
 //! `auto`: the default solver — a portfolio chosen by measurement on TSPLIB SOP.
 //!
 //! 1. `beam` (iterative beam search with dominance and bounds) for a small share of the
-//!    budget on instances of at most `beam-max-cells` cells: it proves small and densely
+//!    budget (`beam-share`, 5 %) on instances of at most `beam-max-cells` cells, and only
+//!    when the wall-clock budget is at least `beam-min-seconds`: it proves small and densely
 //!    constrained instances optimal in milliseconds, and then `auto` stops.
-//! 2. `local-search` (iterated VND) for half of what remains — strongest on small and
-//!    medium instances.
-//! 3. `ils` (window-shuffle kicks with focused SOP-3-exchange repair) for the rest —
-//!    strongest on the large, densely constrained ones.
+//! 2. The phases of `plan`, each with a share of what is left. The default
+//!    `local-search:0.3,eacs*:0.5,ils*:1` runs `local-search` (greedy, VND, iterated VND)
+//!    for 30 %, then `eacs` (enhanced ant colony) for half of the rest, then `ils` for the
+//!    rest; a `*` starts a phase from the best sequence so far instead of from greedy, so
+//!    the descent is paid once.
 //!
 //! The best sequence wins. Budgets are split by fraction, evaluations as well as time, so a
 //! run with an evaluation budget stays deterministic. Without any budget `auto` gives itself
@@ -23,7 +25,7 @@ use std::time::Duration;
 /// Registry entry.
 pub static INFO: SolverInfo = SolverInfo {
     name: "auto",
-    summary: "portfolio (default): beam proof attempt on small instances, then local-search and ils; best wins",
+    summary: "portfolio (default): beam proof attempt on small instances, then local-search, eacs and ils chained; best wins",
     params: &[
         ParamSpec {
             name: "seconds",
@@ -44,6 +46,12 @@ pub static INFO: SolverInfo = SolverInfo {
             help: "skip the beam phase on larger instances",
         },
         ParamSpec {
+            name: "beam-min-seconds",
+            default: "2",
+            kind: ParamKind::Float,
+            help: "skip the beam phase under a wall-clock budget shorter than this (its set-up can take a large part of a short budget)",
+        },
+        ParamSpec {
             name: "plan",
             default: PLAN,
             kind: ParamKind::Text,
@@ -56,6 +64,7 @@ pub static INFO: SolverInfo = SolverInfo {
             beam_share: p.float("beam-share").clamp(0.0, 1.0),
             beam_max_cells: p.int("beam-max-cells") as usize,
             plan: p.word("plan").to_string(),
+            beam_min_seconds: p.float("beam-min-seconds").max(0.0),
         })
     },
 };
@@ -70,6 +79,8 @@ pub struct Auto {
     pub beam_max_cells: usize,
     /// Phases after the beam (`solver[*]:share,...`).
     pub plan: String,
+    /// Shortest wall-clock budget that gets a beam phase.
+    pub beam_min_seconds: f64,
 }
 
 /// Default phases after the beam.
@@ -190,7 +201,10 @@ impl Solver for Auto {
                 *best = Some(o);
             }
         };
-        if ctx.model.n() <= self.beam_max_cells && self.beam_share > 0.0 {
+        let short = budget
+            .time_limit
+            .is_some_and(|t| t.as_secs_f64() < self.beam_min_seconds);
+        if ctx.model.n() <= self.beam_max_cells && self.beam_share > 0.0 && !short {
             let b = share(budget, 0, 0.0, self.beam_share);
             if let Ok(o) = self.phase(ctx, "beam", b, None) {
                 if o.proven_optimal {
