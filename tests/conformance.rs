@@ -50,7 +50,15 @@ fn fixtures() -> Vec<Instance> {
     v
 }
 
-const IMPROVERS: &[&str] = &["two-opt", "local-search", "sa", "tabu", "aco"];
+const IMPROVERS: &[&str] = &[
+    "two-opt",
+    "local-search",
+    "sa",
+    "tabu",
+    "aco",
+    "eacs",
+    "ils",
+];
 
 fn budget(evals: u64) -> Budget {
     Budget {

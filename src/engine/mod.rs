@@ -13,6 +13,7 @@ pub mod moves;
 pub mod neighbours;
 pub mod search;
 pub mod solution;
+pub mod sop3x;
 
 pub use neighbours::Neighbours;
 pub use solution::Solution;

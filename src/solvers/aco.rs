@@ -151,6 +151,11 @@ impl Pheromone {
             self.dense[k]
         }
     }
+    /// The initial pheromone level.
+    #[inline]
+    pub fn tau0(&self) -> f64 {
+        self.tau0
+    }
     /// Sets pheromone on a → b.
     #[inline]
     pub fn set(&mut self, a: Option<usize>, b: usize, v: f64) {

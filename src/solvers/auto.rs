@@ -1,12 +1,14 @@
 //! `auto`: the default solver — a portfolio chosen by measurement on TSPLIB SOP.
 //!
 //! 1. `beam` (iterative beam search with dominance and bounds) for a small share of the
-//!    budget on instances of at most `beam-max-cells` cells: it proves small and densely
+//!    budget (`beam-share`, 5 %) on instances of at most `beam-max-cells` cells, and only
+//!    when the wall-clock budget is at least `beam-min-seconds`: it proves small and densely
 //!    constrained instances optimal in milliseconds, and then `auto` stops.
-//! 2. `local-search` (iterated VND) for half of what remains — strongest on small and
-//!    medium instances.
-//! 3. `ils` (window-shuffle kicks with focused SOP-3-exchange repair) for the rest —
-//!    strongest on the large, densely constrained ones.
+//! 2. The phases of `plan`, each with a share of what is left. The default
+//!    `local-search:0.3,eacs*:0.5,ils*:1` runs `local-search` (greedy, VND, iterated VND)
+//!    for 30 %, then `eacs` (enhanced ant colony) for half of the rest, then `ils` for the
+//!    rest; a `*` starts a phase from the best sequence so far instead of from greedy, so
+//!    the descent is paid once.
 //!
 //! The best sequence wins. Budgets are split by fraction, evaluations as well as time, so a
 //! run with an evaluation budget stays deterministic. Without any budget `auto` gives itself
@@ -15,14 +17,15 @@
 use super::{
     Budget, Context, NoObserver, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo,
 };
-use crate::error::Result;
+use crate::engine::{Costs, Solution};
+use crate::error::{Error, Result};
 use std::collections::BTreeMap;
 use std::time::Duration;
 
 /// Registry entry.
 pub static INFO: SolverInfo = SolverInfo {
     name: "auto",
-    summary: "portfolio (default): beam proof attempt on small instances, then local-search and ils; best wins",
+    summary: "portfolio (default): beam proof attempt on small instances, then local-search, eacs and ils chained; best wins",
     params: &[
         ParamSpec {
             name: "seconds",
@@ -32,7 +35,7 @@ pub static INFO: SolverInfo = SolverInfo {
         },
         ParamSpec {
             name: "beam-share",
-            default: "0.3",
+            default: "0.05",
             kind: ParamKind::Float,
             help: "share of the budget given to the beam proof attempt",
         },
@@ -42,12 +45,26 @@ pub static INFO: SolverInfo = SolverInfo {
             kind: ParamKind::Int,
             help: "skip the beam phase on larger instances",
         },
+        ParamSpec {
+            name: "beam-min-seconds",
+            default: "2",
+            kind: ParamKind::Float,
+            help: "skip the beam phase under a wall-clock budget shorter than this (its set-up can take a large part of a short budget)",
+        },
+        ParamSpec {
+            name: "plan",
+            default: PLAN,
+            kind: ParamKind::Text,
+            help: "phases after the beam: solver:share,... (share of what is left; a '*' after the name starts ils/eacs from the best so far)",
+        },
     ],
     make: |p: &Params| {
         Box::new(Auto {
             seconds: p.float("seconds").max(0.001),
             beam_share: p.float("beam-share").clamp(0.0, 1.0),
             beam_max_cells: p.int("beam-max-cells") as usize,
+            plan: p.word("plan").to_string(),
+            beam_min_seconds: p.float("beam-min-seconds").max(0.0),
         })
     },
 };
@@ -60,6 +77,67 @@ pub struct Auto {
     pub beam_share: f64,
     /// Largest instance for the beam phase.
     pub beam_max_cells: usize,
+    /// Phases after the beam (`solver[*]:share,...`).
+    pub plan: String,
+    /// Shortest wall-clock budget that gets a beam phase.
+    pub beam_min_seconds: f64,
+}
+
+/// Default phases after the beam.
+pub const PLAN: &str = "local-search:0.3,eacs*:0.5,ils*:1";
+
+/// One phase of a plan: solver name, share of what is left, start from the best so far.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Phase {
+    /// Solver name.
+    pub solver: String,
+    /// Share of the remaining budget.
+    pub share: f64,
+    /// Start from the best sequence so far (ils and eacs only).
+    pub chained: bool,
+}
+
+/// Parses a plan `solver[*]:share,...`.
+pub fn parse_plan(plan: &str) -> Result<Vec<Phase>> {
+    let bad = |msg: String| Error::Solver {
+        solver: "auto".to_string(),
+        msg,
+    };
+    let mut out = Vec::new();
+    for part in plan.split(',').map(str::trim).filter(|p| !p.is_empty()) {
+        let (name, share) = part
+            .split_once(':')
+            .ok_or_else(|| bad(format!("plan phase '{part}' is not solver:share")))?;
+        let share: f64 = share
+            .trim()
+            .parse()
+            .ok()
+            .filter(|v: &f64| v.is_finite() && *v > 0.0 && *v <= 1.0)
+            .ok_or_else(|| bad(format!("plan phase '{part}': share must be in (0, 1]")))?;
+        let name = name.trim();
+        let (solver, chained) = match name.strip_suffix('*') {
+            Some(b) => (b.to_string(), true),
+            None => (name.to_string(), false),
+        };
+        if solver == "auto" {
+            return Err(bad("a plan cannot contain auto itself".to_string()));
+        }
+        super::find(&solver)?;
+        if chained && solver != "ils" && solver != "eacs" {
+            return Err(bad(format!(
+                "plan phase '{part}': only ils and eacs can start from the best so far"
+            )));
+        }
+        out.push(Phase {
+            solver,
+            share,
+            chained,
+        });
+    }
+    if out.is_empty() {
+        return Err(bad("empty plan".to_string()));
+    }
+    Ok(out)
 }
 
 /// A share of `b` (what is left of it after `used_evals` and `used_s`).
@@ -75,7 +153,13 @@ fn share(b: Budget, used_evals: u64, used_s: f64, frac: f64) -> Budget {
 }
 
 impl Auto {
-    fn phase(&self, ctx: &mut Context, name: &str, budget: Budget) -> Result<Outcome> {
+    fn phase(
+        &self,
+        ctx: &mut Context,
+        name: &str,
+        budget: Budget,
+        start: Option<&Outcome>,
+    ) -> Result<Outcome> {
         let info = super::find(name)?;
         let params = Params::new(name, info.params, &BTreeMap::new())?;
         let solver = (info.make)(&params);
@@ -88,7 +172,16 @@ impl Auto {
             budget,
             &mut quiet,
         );
-        let out = solver.solve(&mut sub)?;
+        let out = match start {
+            Some(o) => {
+                let s = Solution::new(&Costs::open(ctx.model), &o.sequence);
+                match name {
+                    "ils" => super::ils::from_params(&params).run(&mut sub, Some(s))?,
+                    _ => super::eacs::from_params(&params).run(&mut sub, Some(s))?,
+                }
+            }
+            None => solver.solve(&mut sub)?,
+        };
         ctx.count(sub.evaluations());
         ctx.report(out.cost);
         Ok(out)
@@ -97,6 +190,7 @@ impl Auto {
 
 impl Solver for Auto {
     fn solve(&self, ctx: &mut Context) -> Result<Outcome> {
+        let plan = parse_plan(&self.plan)?;
         let mut budget = ctx.budget;
         if budget.time_limit.is_none() && budget.max_evals.is_none() {
             budget.time_limit = Some(Duration::from_secs_f64(self.seconds));
@@ -107,21 +201,24 @@ impl Solver for Auto {
                 *best = Some(o);
             }
         };
-        if ctx.model.n() <= self.beam_max_cells && self.beam_share > 0.0 {
+        let short = budget
+            .time_limit
+            .is_some_and(|t| t.as_secs_f64() < self.beam_min_seconds);
+        if ctx.model.n() <= self.beam_max_cells && self.beam_share > 0.0 && !short {
             let b = share(budget, 0, 0.0, self.beam_share);
-            if let Ok(o) = self.phase(ctx, "beam", b) {
+            if let Ok(o) = self.phase(ctx, "beam", b, None) {
                 if o.proven_optimal {
                     return Ok(o);
                 }
                 keep(&mut best, o);
             }
         }
-        let b = share(budget, ctx.evaluations(), ctx.elapsed(), 0.5);
-        let o = self.phase(ctx, "local-search", b)?;
-        keep(&mut best, o);
-        let b = share(budget, ctx.evaluations(), ctx.elapsed(), 1.0);
-        let o = self.phase(ctx, "ils", b)?;
-        keep(&mut best, o);
+        for ph in &plan {
+            let b = share(budget, ctx.evaluations(), ctx.elapsed(), ph.share);
+            let start = if ph.chained { best.as_ref() } else { None };
+            let o = self.phase(ctx, &ph.solver, b, start)?;
+            keep(&mut best, o);
+        }
         let mut out = best.expect("at least one phase ran");
         out.proven_optimal = false;
         Ok(out)

@@ -12,6 +12,7 @@ use super::start::{greedy_solution, outcome};
 use super::{Context, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo};
 use crate::engine::moves::sop3_delta;
 use crate::engine::search::Search;
+use crate::engine::sop3x::{TwoWay, sop3_two_way};
 use crate::engine::{Costs, Solution};
 use crate::error::Result;
 use rand::{RngExt, SeedableRng};
@@ -59,24 +60,34 @@ pub static INFO: SolverInfo = SolverInfo {
             help: "kicks without a new best before the walk restarts from the best",
         },
         ParamSpec {
+            name: "two-way",
+            default: "true",
+            kind: ParamKind::Bool,
+            help: "the repair's SOP-3-exchange searches backward as well as forward",
+        },
+        ParamSpec {
             name: "stall",
             default: "20000",
             kind: ParamKind::Int,
             help: "stop after this many kicks without a new best when no budget is set",
         },
     ],
-    make: |p: &Params| {
-        Box::new(Ils {
-            k: p.int("k").max(1) as usize,
-            kicks: p.int("kicks").max(1) as usize,
-            shuffle: p.word("perturb") == "shuffle",
-            max_seg: p.int("max-seg") as usize,
-            accept: p.float("accept").max(0.0),
-            restart: p.int("restart").max(1),
-            stall: p.int("stall").max(1),
-        })
-    },
+    make: |p: &Params| Box::new(from_params(p)),
 };
+
+/// Builds the solver from validated parameters.
+pub fn from_params(p: &Params) -> Ils {
+    Ils {
+        k: p.int("k").max(1) as usize,
+        kicks: p.int("kicks").max(1) as usize,
+        shuffle: p.word("perturb") == "shuffle",
+        max_seg: p.int("max-seg") as usize,
+        accept: p.float("accept").max(0.0),
+        restart: p.int("restart").max(1),
+        stall: p.int("stall").max(1),
+        two_way: p.bool("two-way"),
+    }
+}
 
 /// The iterated local search.
 pub struct Ils {
@@ -94,6 +105,8 @@ pub struct Ils {
     pub restart: u64,
     /// Kicks without improvement before stopping (no budget).
     pub stall: u64,
+    /// Backward as well as forward SOP-3-exchange in the repair.
+    pub two_way: bool,
 }
 
 /// One random feasible segment swap on `s`: blocks `[h+1..=i]` and `[i+1..=j]` trade places.
@@ -234,10 +247,21 @@ struct Shuffle {
 
 impl Solver for Ils {
     fn solve(&self, ctx: &mut Context) -> Result<Outcome> {
+        self.run(ctx, None)
+    }
+}
+
+impl Ils {
+    /// Runs the search from `start` (evaluated with open-loop costs), or from the greedy
+    /// sequence when `start` is `None`.
+    pub fn run(&self, ctx: &mut Context, start: Option<Solution>) -> Result<Outcome> {
         let m = ctx.model;
         let n = m.n();
         let c = Costs::open(m);
-        let mut cur = greedy_solution(ctx, &c);
+        let mut cur = match start {
+            Some(s) => s,
+            None => greedy_solution(ctx, &c),
+        };
         let mut search = Search::new(c, self.k);
         search.vnd(&mut cur, ctx);
         let mut best = cur.clone();
@@ -253,6 +277,7 @@ impl Solver for Ils {
         let mut label = 0u32;
         let mut seeds: Vec<u32> = Vec::new();
         let mut scratch = Shuffle::default();
+        let mut w = TwoWay::default();
         let bounded = ctx.budget.max_evals.is_some() || ctx.budget.time_limit.is_some();
         let mut since_best = 0u64;
         let mut since_restart = 0u64;
@@ -280,7 +305,11 @@ impl Solver for Ils {
             }
             loop {
                 let a = search.or_opt_seeded(&mut trial, ctx, &seeds);
-                let b = search.sop3_seeded(&mut trial, ctx, &seeds);
+                let b = if self.two_way {
+                    sop3_two_way(&search, &mut w, &mut trial, ctx, &seeds)
+                } else {
+                    search.sop3_seeded(&mut trial, ctx, &seeds)
+                };
                 if !(a || b) || ctx.exhausted() {
                     break;
                 }

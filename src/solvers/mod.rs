@@ -8,6 +8,7 @@ pub mod aco;
 pub mod as_given;
 pub mod auto;
 pub mod beam;
+pub mod eacs;
 pub mod edge;
 pub mod exact;
 pub mod greedy;
@@ -206,6 +207,7 @@ pub fn registry() -> Vec<&'static SolverInfo> {
         &sa::INFO,
         &tabu::INFO,
         &aco::INFO,
+        &eacs::INFO,
         &process::INFO,
         &rules::INFO,
     ]

@@ -1,0 +1,108 @@
+//! The default portfolio (`auto`) and the enhanced ant colony (`eacs`): plans, determinism
+//! under an evaluation budget, and solution quality on a small TSPLIB SOP instance.
+
+use cellseq::formats::load_instance;
+use cellseq::solvers::auto::parse_plan;
+use cellseq::solvers::{Budget, NoObserver, run};
+use std::collections::BTreeMap;
+use std::path::Path;
+
+fn sop(name: &str) -> cellseq::model::Instance {
+    let p = Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("instances/tsplib-sop/{name}.sop"));
+    load_instance(&p).unwrap()
+}
+
+fn evals(n: u64) -> Budget {
+    Budget {
+        time_limit: None,
+        max_evals: Some(n),
+    }
+}
+
+#[test]
+fn plans_parse_and_bad_plans_are_rejected() {
+    let p = parse_plan("local-search:0.3, eacs*:0.5,ils*:1").unwrap();
+    assert_eq!(p.len(), 3);
+    assert_eq!(p[1].solver, "eacs");
+    assert!(p[1].chained && !p[0].chained);
+    assert!((p[0].share - 0.3).abs() < 1e-12);
+    for bad in [
+        "",
+        "ils",
+        "ils:0",
+        "ils:1.5",
+        "nosuch:1",
+        "auto:1",
+        "local-search*:1",
+    ] {
+        assert!(parse_plan(bad).is_err(), "plan '{bad}' accepted");
+    }
+}
+
+#[test]
+fn auto_rejects_a_bad_plan_parameter() {
+    let inst = sop("ESC12");
+    let mut given = BTreeMap::new();
+    given.insert("plan".to_string(), "ils:2".to_string());
+    let e = run(
+        "auto",
+        &inst,
+        inst.default_objective(),
+        &given,
+        1,
+        evals(10_000),
+        &mut NoObserver,
+    );
+    assert!(e.is_err());
+}
+
+#[test]
+fn chained_portfolio_is_deterministic_under_an_evaluation_budget() {
+    let inst = sop("ry48p.1");
+    let none = BTreeMap::new();
+    for name in ["auto", "eacs"] {
+        let a = run(
+            name,
+            &inst,
+            inst.default_objective(),
+            &none,
+            3,
+            evals(400_000),
+            &mut NoObserver,
+        )
+        .unwrap();
+        let b = run(
+            name,
+            &inst,
+            inst.default_objective(),
+            &none,
+            3,
+            evals(400_000),
+            &mut NoObserver,
+        )
+        .unwrap();
+        assert_eq!(a.outcome.sequence, b.outcome.sequence, "{name}");
+        assert!(
+            a.evaluations <= 400_000 + 50_000,
+            "{name}: {}",
+            a.evaluations
+        );
+    }
+}
+
+#[test]
+fn eacs_reaches_the_best_known_value_of_esc25() {
+    // ESC25: best known 1681, proven optimal (instances/tsplib-sop/bks.csv)
+    let inst = sop("ESC25");
+    let r = run(
+        "eacs",
+        &inst,
+        inst.default_objective(),
+        &BTreeMap::new(),
+        1,
+        evals(3_000_000),
+        &mut NoObserver,
+    )
+    .unwrap();
+    assert!(r.report.cost <= 1681.0 + 1e-9, "{}", r.report.cost);
+}
