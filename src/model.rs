@@ -307,7 +307,11 @@ impl Objective {
 }
 
 /// A complete problem instance.
-#[derive(Debug, Clone, PartialEq)]
+///
+/// `Instance::default()` is an empty geometric instance (default machine, no precedence, no
+/// as-programmed order, no matrix, open path): builders fill in what they have with
+/// `Instance { name, cells, .., ..Instance::default() }`.
+#[derive(Debug, Clone, PartialEq, Default)]
 pub struct Instance {
     /// Instance name.
     pub name: String,

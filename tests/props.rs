@@ -3,7 +3,7 @@
 
 use cellseq::check::check;
 use cellseq::geom::Point3;
-use cellseq::model::{Cell, CostMatrix, Instance, Machine, Metadata, Mode, Objective, Tool, Visit};
+use cellseq::model::{Cell, CostMatrix, Instance, Machine, Mode, Objective, Tool, Visit};
 use cellseq::solvers::{self, Budget, NoObserver};
 use proptest::prelude::*;
 use std::collections::BTreeMap;
@@ -66,7 +66,6 @@ fn build(s: &Spec) -> Instance {
     }
     let mut inst = Instance {
         name: "prop".into(),
-        meta: Metadata::default(),
         machine: Machine {
             link_distance: 15.0,
             initial_tool: Some("T0".into()),
@@ -89,10 +88,7 @@ fn build(s: &Spec) -> Instance {
         cells,
         precedence: s.edges.clone(),
         as_given: None,
-        matrix: None,
-        first: None,
-        last: None,
-        closed: false,
+        ..Instance::default()
     };
     if let Some(mx) = &s.matrix {
         let size = inst.total_modes();

@@ -1,7 +1,7 @@
 //! Readers for TSPLIB-style text: TSPLIB SOP (`TYPE: SOP`) and PCGLNS/PCGTSP (`TYPE: PCGLNS`).
 
 use crate::error::{Error, Result};
-use crate::model::{Cell, CostMatrix, Instance, Machine, Metadata, Mode};
+use crate::model::{Cell, CostMatrix, Instance, Metadata, Mode};
 use std::collections::BTreeSet;
 
 /// Cost stored for arcs that precedence forbids (the files mark them −1).
@@ -247,15 +247,12 @@ pub fn parse_sop(file: &str, text: &str) -> Result<Instance> {
             comment: h.get("COMMENT").map(|(_, v)| v.to_string()),
             ..Default::default()
         },
-        machine: Machine::default(),
-        tools: Vec::new(),
         cells,
         precedence: edges,
-        as_given: None,
         matrix: Some(CostMatrix { size: dim, costs }),
         first: Some(0),
         last: Some(dim - 1),
-        closed: false,
+        ..Instance::default()
     })
 }
 
@@ -436,15 +433,12 @@ pub fn parse_pcglns(file: &str, text: &str) -> Result<Instance> {
             comment: h.get("COMMENT").map(|(_, v)| v.to_string()),
             ..Default::default()
         },
-        machine: Machine::default(),
-        tools: Vec::new(),
         cells,
         precedence: edges.into_iter().collect(),
-        as_given: None,
         matrix: Some(CostMatrix { size: dim, costs }),
         first: Some(start),
-        last: None,
         closed: true,
+        ..Instance::default()
     })
 }
 

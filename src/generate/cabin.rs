@@ -19,7 +19,7 @@ use super::common::{closed_modes, programmed_order, pt, r3, stroke_modes, tools_
 use super::toolsel::{ToolLibrary, ToolSpec};
 use crate::error::{Error, Result};
 use crate::geom::Point3;
-use crate::model::{Cell, Instance, Machine, Metadata, Mode, StepKind, Tool};
+use crate::model::{Cell, Instance, Machine, Mode, StepKind, Tool};
 use crate::params::{ParamKind, ParamSpec, Params};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -276,15 +276,11 @@ pub fn generate(p: &Params, seed: u64) -> Result<Instance> {
     };
     Ok(Instance {
         name: format!("cabin-f{nf}-g{ngroups}x{nholes}-s{seed}"),
-        meta: Metadata::default(),
         machine,
         tools,
         cells: b.cells,
         precedence: prec,
         as_given: Some(order),
-        matrix: None,
-        first: None,
-        last: None,
-        closed: false,
+        ..Instance::default()
     })
 }

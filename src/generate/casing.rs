@@ -25,7 +25,7 @@
 use super::common::{programmed_order, pt, r3, stroke_modes};
 use crate::error::{Error, Result};
 use crate::geom::Point3;
-use crate::model::{Cell, Instance, Machine, Metadata, StepKind, Tool};
+use crate::model::{Cell, Instance, Machine, StepKind, Tool};
 use crate::params::{ParamKind, ParamSpec, Params};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -275,15 +275,11 @@ pub fn generate(p: &Params, seed: u64) -> Result<Instance> {
     };
     Ok(Instance {
         name: format!("casing-r{regions}-f{mean}-s{seed}"),
-        meta: Metadata::default(),
         machine,
         tools: vec![tool],
         cells,
         precedence: prec,
         as_given: Some(order),
-        matrix: None,
-        first: None,
-        last: None,
-        closed: false,
+        ..Instance::default()
     })
 }

@@ -815,10 +815,7 @@ pub fn generate(p: &Params, seed: u64) -> Result<Instance> {
         cells: b.cells,
         precedence: b.prec,
         as_given: Some(order),
-        matrix: None,
-        first: None,
-        last: None,
-        closed: false,
+        ..Instance::default()
     })
 }
 

@@ -7,7 +7,7 @@
 
 use crate::error::{Error, Result};
 use crate::geom::Point3;
-use crate::model::{Cell, Instance, Machine, Metadata, Mode, StepKind, Tool, Visit};
+use crate::model::{Cell, Instance, Machine, Mode, StepKind, Tool, Visit};
 use crate::params::{ParamKind, ParamSpec, Params};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -201,15 +201,11 @@ pub fn generate(p: &Params, seed: u64) -> Result<Instance> {
     };
     Ok(Instance {
         name: format!("uniform-n{n}-s{seed}"),
-        meta: Metadata::default(),
         machine,
         tools,
         cells,
         precedence,
         as_given: Some(order.into_iter().map(|c| Visit::new(c, 0)).collect()),
-        matrix: None,
-        first: None,
-        last: None,
-        closed: false,
+        ..Instance::default()
     })
 }

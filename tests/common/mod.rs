@@ -2,7 +2,7 @@
 #![allow(dead_code)]
 
 use cellseq::geom::Point3;
-use cellseq::model::{Cell, Instance, Machine, Metadata, Mode, Tool, Visit};
+use cellseq::model::{Cell, Instance, Machine, Mode, Tool, Visit};
 use std::path::PathBuf;
 
 /// Path of a file shipped in `instances/`.
@@ -33,7 +33,6 @@ pub fn line_instance(n: usize, reversible: bool) -> Instance {
         .collect();
     Instance {
         name: format!("line{n}"),
-        meta: Metadata::default(),
         machine: Machine::default(),
         tools: vec![
             Tool {
@@ -52,9 +51,6 @@ pub fn line_instance(n: usize, reversible: bool) -> Instance {
         cells,
         precedence: vec![],
         as_given: Some((0..n).map(|c| Visit::new(c, 0)).collect()),
-        matrix: None,
-        first: None,
-        last: None,
-        closed: false,
+        ..Instance::default()
     }
 }

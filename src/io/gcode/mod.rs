@@ -210,10 +210,7 @@ pub fn group_instance(
         cells: out_cells,
         precedence,
         as_given: Some((0..n).map(|i| Visit::new(i, 0)).collect()),
-        matrix: None,
-        first: None,
-        last: None,
-        closed: false,
+        ..Instance::default()
     };
     (inst, dropped)
 }

@@ -473,10 +473,7 @@ pub fn scope_instance(
         cells,
         precedence,
         as_given: Some((0..n).map(|i| Visit::new(i, 0)).collect()),
-        matrix: None,
-        first: None,
-        last: None,
-        closed: false,
+        ..Instance::default()
     };
     (inst, orient)
 }
