@@ -304,17 +304,10 @@ impl<'a> Search<'a> {
             }
             ctx.count(evals);
             if let Some((d, h, i, j)) = found {
-                let ends = [h, h + 1, i, i + 1, j, j + 1];
-                let cells: Vec<u32> = ends
-                    .iter()
-                    .filter(|&&p| p >= 0 && p < n as isize)
-                    .map(|&p| s.order[p as usize])
-                    .collect();
-                s.swap_blocks(h, i as usize, j as usize, d);
-                improved = true;
-                for cell in cells {
+                for cell in s.swap_blocks_touched(h, i as usize, j as usize, d) {
                     queue.push(cell);
                 }
+                improved = true;
                 queue.push(x);
             }
         }

@@ -111,6 +111,19 @@ impl Solution {
         self.renumber(a, j + 1);
         self.cost += delta;
     }
+    /// [`Solution::swap_blocks`], returning the cells whose links changed (those at the six
+    /// block ends before the swap), for the don't-look queues.
+    pub fn swap_blocks_touched(&mut self, h: isize, i: usize, j: usize, delta: f64) -> Vec<u32> {
+        let n = self.n() as isize;
+        let (ii, jj) = (i as isize, j as isize);
+        let cells = [h, h + 1, ii, ii + 1, jj, jj + 1]
+            .iter()
+            .filter(|&&p| p >= 0 && p < n)
+            .map(|&p| self.order[p as usize])
+            .collect();
+        self.swap_blocks(h, i, j, delta);
+        cells
+    }
     /// Reverses positions `i..=j` and gives each cell its `flip` mode, adding `delta`.
     pub fn reverse(&mut self, m: &CostModel, i: usize, j: usize, delta: f64) {
         self.order[i..=j].reverse();

@@ -172,17 +172,10 @@ pub fn sop3_two_way(
             .or_else(|| backward(&c, s, w, x, search.max_block, &mut evals));
         ctx.count(evals);
         if let Some((d, h, i, j)) = found {
-            let ends = [h, h + 1, i, i + 1, j, j + 1];
-            let cells: Vec<u32> = ends
-                .iter()
-                .filter(|&&p| p >= 0 && p < n as isize)
-                .map(|&p| s.order[p as usize])
-                .collect();
-            s.swap_blocks(h, i as usize, j as usize, d);
-            improved = true;
-            for cell in cells {
+            for cell in s.swap_blocks_touched(h, i as usize, j as usize, d) {
                 w.push(cell);
             }
+            improved = true;
             w.push(x);
         }
     }

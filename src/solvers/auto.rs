@@ -164,14 +164,7 @@ impl Auto {
         let params = Params::new(name, info.params, &BTreeMap::new())?;
         let solver = (info.make)(&params);
         let mut quiet = NoObserver;
-        let mut sub = Context::new(
-            ctx.instance,
-            ctx.model,
-            &params,
-            ctx.seed,
-            budget,
-            &mut quiet,
-        );
+        let mut sub = ctx.sub(&params, budget, &mut quiet);
         let out = match start {
             Some(o) => {
                 let s = Solution::new(&Costs::open(ctx.model), &o.sequence);

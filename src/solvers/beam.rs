@@ -401,14 +401,7 @@ impl Beam {
             time_limit: ctx.budget.time_limit.map(|t| t.mul_f64(0.25)),
         };
         let mut quiet = NoObserver;
-        let mut sub = Context::new(
-            ctx.instance,
-            ctx.model,
-            &params,
-            ctx.seed,
-            budget,
-            &mut quiet,
-        );
+        let mut sub = ctx.sub(&params, budget, &mut quiet);
         let out = solver.solve(&mut sub)?;
         ctx.count(sub.evaluations());
         let cost = ctx.model.evaluate(&out.sequence);
