@@ -2,16 +2,16 @@
 
 use super::modes::mode_dp;
 use super::moves::{
-    LAZY_REACH_CELLS, Reversal, SegmentMove, apply_segment, mode_delta, reversible_segment,
-    sop3_delta, window,
+    LAZY_REACH_CELLS, Reversal, SegmentMove, apply_segment, mode_delta, reversible_segment, window,
 };
+use super::sop3x::{Labels, forward};
 use super::{Costs, Neighbours, Solution};
 use crate::solvers::Context;
 use std::collections::VecDeque;
 
 /// Improvement threshold (relative) below which a delta does not count as an improvement.
 #[inline]
-fn improves(delta: f64, cost: f64) -> bool {
+pub(crate) fn improves(delta: f64, cost: f64) -> bool {
     delta < -1e-9 * cost.abs().max(1.0)
 }
 
@@ -65,10 +65,7 @@ pub struct Search<'a> {
     pub nb: Neighbours,
     /// Longest block considered by SOP-3-exchange (each side).
     pub max_block: usize,
-    /// Longest segment 2-opt reverses (array reversal costs O(length)).
-    pub max_reverse: usize,
-    stamp: Vec<u32>,
-    label: u32,
+    labels: Labels,
     rev: Reversal,
 }
 
@@ -86,9 +83,7 @@ impl<'a> Search<'a> {
             } else {
                 8
             },
-            max_reverse: usize::MAX,
-            stamp: vec![0; n],
-            label: 0,
+            labels: Labels::default(),
             rev: Reversal::default(),
         }
     }
@@ -194,10 +189,7 @@ impl<'a> Search<'a> {
             // x just before the segment: new arc x -> reversed end
             if q + 1 < n {
                 let i = q + 1;
-                let reach = self
-                    .rev
-                    .reach(i)
-                    .min(i.saturating_add(self.max_reverse).min(isize::MAX as usize) as isize);
+                let reach = self.rev.reach(i);
                 let ends = self.nb.out[x as usize]
                     .iter()
                     .map(|&w| s.pos[w as usize] as isize)
@@ -215,10 +207,7 @@ impl<'a> Search<'a> {
             // x first of the segment: new arc reversed x -> successor candidate
             {
                 let i = q;
-                let reach = self
-                    .rev
-                    .reach(i)
-                    .min(i.saturating_add(self.max_reverse).min(isize::MAX as usize) as isize);
+                let reach = self.rev.reach(i);
                 for &w in &self.nb.out[x as usize] {
                     let j = s.pos[w as usize] as isize - 1;
                     if j > i as isize && j <= reach {
@@ -258,50 +247,13 @@ impl<'a> Search<'a> {
 
     fn sop3_from(&mut self, s: &mut Solution, ctx: &mut Context, mut queue: Queue) -> bool {
         let c = self.c;
-        let m = c.m;
-        let n = s.n();
         let mut improved = false;
         while let Some(x) = queue.pop() {
             if ctx.exhausted() {
                 break;
             }
-            let px = s.pos[x as usize] as isize;
-            let mut found = None;
             let mut evals = 0u64;
-            'hs: for h in [px - 1, px] {
-                if h + 2 >= n as isize {
-                    continue;
-                }
-                self.label = self.label.wrapping_add(1);
-                if self.label == 0 {
-                    self.stamp.iter_mut().for_each(|v| *v = 0);
-                    self.label = 1;
-                }
-                let label = self.label;
-                let imax = (h + self.max_block as isize).min(n as isize - 2);
-                for i in (h + 1)..=imax {
-                    let ci = s.order[i as usize] as usize;
-                    for &q in &m.dag.succs[ci] {
-                        self.stamp[q as usize] = label;
-                    }
-                    let jmax = (i + self.max_block as isize).min(n as isize - 1);
-                    let mut best = (0.0, 0isize);
-                    for j in (i + 1)..=jmax {
-                        if self.stamp[s.order[j as usize] as usize] == label {
-                            break;
-                        }
-                        evals += 1;
-                        let d = sop3_delta(&c, s, h, i, j);
-                        if d < best.0 {
-                            best = (d, j);
-                        }
-                    }
-                    if improves(best.0, s.cost) {
-                        found = Some((best.0, h, i, best.1));
-                        break 'hs;
-                    }
-                }
-            }
+            let found = forward(&c, s, &mut self.labels, x, self.max_block, &mut evals);
             ctx.count(evals);
             if let Some((d, h, i, j)) = found {
                 for cell in s.swap_blocks_touched(h, i as usize, j as usize, d) {

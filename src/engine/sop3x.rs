@@ -11,20 +11,19 @@
 //! cell of R enters R from a cell of L, and that cell is stamped.
 
 use super::moves::sop3_delta;
-use super::search::Search;
+use super::search::{Search, improves};
 use super::{Costs, Solution};
 use crate::solvers::Context;
 
-/// Scratch space and stack of [`sop3_two_way`].
+/// Labelling scratch space of SOP-3-exchange: a stamp per cell and the current label.
 #[derive(Debug, Default, Clone)]
-pub struct TwoWay {
+pub(crate) struct Labels {
     stamp: Vec<u32>,
     label: u32,
-    stack: Vec<u32>,
-    on: Vec<bool>,
 }
 
-impl TwoWay {
+impl Labels {
+    /// A fresh label for `n` cells (no cell carries it yet).
     fn next_label(&mut self, n: usize) -> u32 {
         if self.stamp.len() != n {
             self.stamp = vec![0; n];
@@ -37,6 +36,17 @@ impl TwoWay {
         }
         self.label
     }
+}
+
+/// Scratch space and stack of [`sop3_two_way`].
+#[derive(Debug, Default, Clone)]
+pub struct TwoWay {
+    labels: Labels,
+    stack: Vec<u32>,
+    on: Vec<bool>,
+}
+
+impl TwoWay {
     fn push(&mut self, c: u32) {
         if !self.on[c as usize] {
             self.on[c as usize] = true;
@@ -45,16 +55,11 @@ impl TwoWay {
     }
 }
 
-#[inline]
-fn improves(delta: f64, cost: f64) -> bool {
-    delta < -1e-9 * cost.abs().max(1.0)
-}
-
 /// Forward search from cell `x`: the first improving (h, i) with its best j, h ∈ {px−1, px}.
-fn forward(
+pub(crate) fn forward(
     c: &Costs,
     s: &Solution,
-    w: &mut TwoWay,
+    w: &mut Labels,
     x: u32,
     max_block: usize,
     evals: &mut u64,
@@ -96,7 +101,7 @@ fn forward(
 fn backward(
     c: &Costs,
     s: &Solution,
-    w: &mut TwoWay,
+    w: &mut Labels,
     x: u32,
     max_block: usize,
     evals: &mut u64,
@@ -168,8 +173,8 @@ pub fn sop3_two_way(
             break;
         }
         let mut evals = 0u64;
-        let found = forward(&c, s, w, x, search.max_block, &mut evals)
-            .or_else(|| backward(&c, s, w, x, search.max_block, &mut evals));
+        let found = forward(&c, s, &mut w.labels, x, search.max_block, &mut evals)
+            .or_else(|| backward(&c, s, &mut w.labels, x, search.max_block, &mut evals));
         ctx.count(evals);
         if let Some((d, h, i, j)) = found {
             for cell in s.swap_blocks_touched(h, i as usize, j as usize, d) {

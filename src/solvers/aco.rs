@@ -16,41 +16,50 @@ use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rustc_hash::FxHashMap;
 
+/// The colony parameters `aco` and `eacs` share: ants, beta, s, rho, phi.
+pub(crate) const COLONY: [ParamSpec; 5] = [
+    ParamSpec {
+        name: "ants",
+        default: "10",
+        kind: ParamKind::Int,
+        help: "ants per iteration",
+    },
+    ParamSpec {
+        name: "beta",
+        default: "2",
+        kind: ParamKind::Float,
+        help: "heuristic exponent",
+    },
+    ParamSpec {
+        name: "s",
+        default: "10",
+        kind: ParamKind::Float,
+        help: "exploitation: q0 = 1 - s/n (about s random choices per tour)",
+    },
+    ParamSpec {
+        name: "rho",
+        default: "0.1",
+        kind: ParamKind::Float,
+        help: "global evaporation",
+    },
+    ParamSpec {
+        name: "phi",
+        default: "0.01",
+        kind: ParamKind::Float,
+        help: "local evaporation",
+    },
+];
+
 /// Registry entry.
 pub static INFO: SolverInfo = SolverInfo {
     name: "aco",
     summary: "ant colony system (patent 003 / HAS-SOP): fringe construction, tool-change-aware heuristic, local search, mode DP",
     params: &[
-        ParamSpec {
-            name: "ants",
-            default: "10",
-            kind: ParamKind::Int,
-            help: "ants per iteration",
-        },
-        ParamSpec {
-            name: "beta",
-            default: "2",
-            kind: ParamKind::Float,
-            help: "heuristic exponent",
-        },
-        ParamSpec {
-            name: "s",
-            default: "10",
-            kind: ParamKind::Float,
-            help: "exploitation: q0 = 1 - s/n (about s random choices per tour)",
-        },
-        ParamSpec {
-            name: "rho",
-            default: "0.1",
-            kind: ParamKind::Float,
-            help: "global evaporation",
-        },
-        ParamSpec {
-            name: "phi",
-            default: "0.01",
-            kind: ParamKind::Float,
-            help: "local evaporation",
-        },
+        COLONY[0],
+        COLONY[1],
+        COLONY[2],
+        COLONY[3],
+        COLONY[4],
         ParamSpec {
             name: "iters",
             default: "300",

@@ -21,7 +21,7 @@
 //! The start is the greedy sequence after a full VND. Every construction step and every move
 //! evaluation is counted, so a run under an evaluation budget is deterministic.
 
-use super::aco::Pheromone;
+use super::aco::{COLONY, Pheromone};
 use super::start::{greedy_solution, outcome};
 use super::{Context, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo};
 use crate::engine::modes::mode_dp;
@@ -38,36 +38,11 @@ pub static INFO: SolverInfo = SolverInfo {
     name: "eacs",
     summary: "enhanced ant colony system (EACS): best-guided construction, focused SOP-3-exchange/Or-opt on near-best ants, mode DP",
     params: &[
-        ParamSpec {
-            name: "ants",
-            default: "10",
-            kind: ParamKind::Int,
-            help: "ants per iteration",
-        },
-        ParamSpec {
-            name: "beta",
-            default: "2",
-            kind: ParamKind::Float,
-            help: "heuristic exponent",
-        },
-        ParamSpec {
-            name: "s",
-            default: "10",
-            kind: ParamKind::Float,
-            help: "exploitation: q0 = 1 - s/n (about s random choices per tour)",
-        },
-        ParamSpec {
-            name: "rho",
-            default: "0.1",
-            kind: ParamKind::Float,
-            help: "global evaporation",
-        },
-        ParamSpec {
-            name: "phi",
-            default: "0.01",
-            kind: ParamKind::Float,
-            help: "local evaporation",
-        },
+        COLONY[0],
+        COLONY[1],
+        COLONY[2],
+        COLONY[3],
+        COLONY[4],
         ParamSpec {
             name: "ls-band",
             default: "10",

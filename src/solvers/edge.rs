@@ -168,8 +168,8 @@ impl<'a> Level<'a> {
     }
 
     /// One matching round: the chains it builds, as the next level's items.
-    fn round(&self, k: usize, count: &mut dyn FnMut(u64)) -> Vec<Item> {
-        let lv = self;
+    fn round(self, k: usize, count: &mut dyn FnMut(u64)) -> Vec<Item> {
+        let lv = &self;
         let all: Vec<u32> = (0..self.vars.len() as u32).collect();
         let tree = self.tree(&all);
         let kk = NonZero::new((k + 1).min(self.vars.len())).expect("items");
@@ -222,19 +222,16 @@ impl<'a> Level<'a> {
             var[xb] = vb;
         }
         drop(links);
-        let mut next = Vec::new();
+        // chains in order of their head; an untouched item moves over as it is
+        let mut next: Vec<Option<Item>> = Vec::new();
+        let mut untouched = Vec::new();
         for h in 0..n {
             if pred[h] != NONE {
                 continue;
             }
             if succ[h] == NONE {
-                // untouched: stays as it is
-                let it = &self.items[h];
-                next.push(Item {
-                    seq: it.seq.clone(),
-                    free: it.free,
-                    rev: it.rev,
-                });
+                untouched.push((h, next.len()));
+                next.push(None);
                 continue;
             }
             let mut seq = Vec::new();
@@ -246,9 +243,15 @@ impl<'a> Level<'a> {
                 self.emit(c, v, &mut seq);
                 c = succ[c as usize];
             }
-            next.push(Item { seq, free: 0, rev });
+            next.push(Some(Item { seq, free: 0, rev }));
         }
-        next
+        let mut items: Vec<Option<Item>> = self.items.into_iter().map(Some).collect();
+        for (h, slot) in untouched {
+            next[slot] = items[h].take();
+        }
+        next.into_iter()
+            .map(|it| it.expect("every slot filled"))
+            .collect()
     }
 
     /// Joins the items by a nearest-neighbour walk from the home point.
