@@ -6,12 +6,13 @@ use thiserror::Error;
 #[derive(Debug, Error)]
 pub enum Error {
     /// A file could not be read or written.
-    #[error("{file}: {source}")]
+    #[error("{file}: {cause}")]
     Io {
         /// The file.
         file: String,
-        /// The cause.
-        source: std::io::Error,
+        /// The cause (shown in the message, not chained again as a `source`, so a report
+        /// names it once).
+        cause: std::io::Error,
     },
     /// A text file is malformed at a line.
     #[error("{file}:{line}: {msg}")]
@@ -69,10 +70,10 @@ impl Error {
         }
     }
     /// An [`Error::Io`].
-    pub fn io(file: impl Into<String>, source: std::io::Error) -> Error {
+    pub fn io(file: impl Into<String>, cause: std::io::Error) -> Error {
         Error::Io {
             file: file.into(),
-            source,
+            cause,
         }
     }
 }

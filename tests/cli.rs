@@ -222,3 +222,29 @@ fn infeasible_solution_is_reported() {
         &["s.json", "'b' must come before 'a'"],
     );
 }
+
+/// `cellseq solve F | head` must not panic when the reader is gone before the report is
+/// written: the reading end is closed right after the start, the solve takes 0.3 s, so every
+/// write meets a broken pipe.
+#[test]
+fn closed_stdout_ends_quietly() {
+    use std::process::Stdio;
+    let d = tempfile::tempdir().unwrap();
+    let f = write(d.path(), "t.sop", SOP);
+    let mut child = bin()
+        .args(["solve", f.to_str().unwrap(), "--time-limit", "0.3"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take());
+    let out = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!err.contains("panicked"), "panic: {err}");
+    assert!(
+        out.status.success(),
+        "status {:?}, stderr: {err}",
+        out.status
+    );
+    assert!(err.trim().is_empty(), "unexpected stderr: {err}");
+}

@@ -64,7 +64,7 @@ pub fn bound(a: BoundArgs) -> Result<()> {
             .iter()
             .map(|p| json!({"name": p.name, "value": p.value, "seconds": p.seconds}))
             .collect();
-        println!(
+        say!(
             "{}",
             json!({
                 "instance": inst.name,
@@ -80,24 +80,24 @@ pub fn bound(a: BoundArgs) -> Result<()> {
             })
         );
     } else {
-        println!("instance        {} ({} cells)", inst.name, inst.n());
-        println!("objective       {}", model.objective().name());
+        say!("instance        {} ({} cells)", inst.name, inst.n());
+        say!("objective       {}", model.objective().name());
         for p in &b.parts {
-            println!("{:<15} {}  ({:.3} s)", p.name, fmt(p.value), p.seconds);
+            say!("{:<15} {}  ({:.3} s)", p.name, fmt(p.value), p.seconds);
         }
-        println!("lower bound     {}  ({})", fmt(b.best), b.best_name);
+        say!("lower bound     {}  ({})", fmt(b.best), b.best_name);
         if let Some(u) = upper {
-            println!("greedy          {}", fmt(u));
+            say!("greedy          {}", fmt(u));
         }
         if let Some(k) = bk {
             let g = bound::certified_gap_percent(k, b.best).unwrap_or(0.0);
-            println!(
+            say!(
                 "best known      {}  (bound is {:.3} % below)",
                 fmt(k),
                 100.0 * g / (100.0 + g)
             );
         }
-        println!("elapsed         {total:.3} s");
+        say!("elapsed         {total:.3} s");
     }
     Ok(())
 }

@@ -24,7 +24,7 @@ pub fn demo(a: DemoArgs) -> Result<()> {
         DEMO_PLAN,
         Path::new("."),
     )?;
-    println!(
+    say!(
         "demo campaign: {} instances x {} solvers x {} replicates ({} trials, evaluation budget {})",
         plan.instances.len(),
         plan.solvers.len(),
@@ -42,7 +42,7 @@ pub fn demo(a: DemoArgs) -> Result<()> {
     };
     super::harness::execute(&plan, &opts)?;
     let r = report::report(&a.out, &a.out.join("report"))?;
-    println!("report    {}", r.markdown.display());
-    println!("plots     {}", a.out.join("report").join("plots").display());
+    say!("report    {}", r.markdown.display());
+    say!("plots     {}", a.out.join("report").join("plots").display());
     Ok(())
 }

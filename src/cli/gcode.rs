@@ -154,29 +154,33 @@ fn format_of(path: &Path, given: Option<&str>) -> anyhow::Result<&'static str> {
 
 fn print_figures(before: &Figures, after: &Figures) {
     let pct = |a: f64, b: f64| if a > 0.0 { 100.0 * (a - b) / a } else { 0.0 };
-    println!("{:<16} {:>14} {:>14} {:>8}", "", "before", "after", "saved");
-    println!(
+    say!("{:<16} {:>14} {:>14} {:>8}", "", "before", "after", "saved");
+    say!(
         "{:<16} {:>14.1} {:>14.1} {:>7.1}%",
         "air length mm",
         before.air_length,
         after.air_length,
         pct(before.air_length, after.air_length)
     );
-    println!("{:<16} {:>14} {:>14}", "lifts", before.lifts, after.lifts);
-    println!(
+    say!("{:<16} {:>14} {:>14}", "lifts", before.lifts, after.lifts);
+    say!(
         "{:<16} {:>14} {:>14}",
-        "tool changes", before.tool_changes, after.tool_changes
+        "tool changes",
+        before.tool_changes,
+        after.tool_changes
     );
-    println!(
+    say!(
         "{:<16} {:>14.1} {:>14.1} {:>7.1}%",
         "est. time s",
         before.est_time_s,
         after.est_time_s,
         pct(before.est_time_s, after.est_time_s)
     );
-    println!(
+    say!(
         "{:<16} {:>14.1} {:>14.1}",
-        "cut length mm", before.cut_length, after.cut_length
+        "cut length mm",
+        before.cut_length,
+        after.cut_length
     );
 }
 
@@ -236,9 +240,9 @@ pub fn optimize(a: OptimizeArgs) -> anyhow::Result<()> {
             "before": out.before,
             "after": out.after,
         });
-        println!("{}", serde_json::to_string_pretty(&v)?);
+        say!("{}", serde_json::to_string_pretty(&v)?);
     } else {
-        println!(
+        say!(
             "{file}: {} cells in {} tool blocks; solver {} ({:.3} s); {} cutting moves verified identical",
             parsed.layout.cells.len(),
             parsed.layout.blocks.len(),
@@ -247,26 +251,26 @@ pub fn optimize(a: OptimizeArgs) -> anyhow::Result<()> {
             out.cuts
         );
         if out.reversible_cells > 0 {
-            println!(
+            say!(
                 "reversal: {} of {} reversible cells cut backwards",
                 out.reversed.iter().filter(|&&r| r).count(),
                 out.reversible_cells
             );
         }
         if out.kept_original {
-            println!(
+            say!(
                 "note: the solver's order had more air travel than the original order; original order kept"
             );
         }
         if out.inner_first_dropped > 0 {
-            println!(
+            say!(
                 "note: in {} group(s) inner-first contradicted the original order of overlapping cells; original order kept",
                 out.inner_first_dropped
             );
         }
         print_figures(&out.before, &out.after);
         if let Some(o) = &a.output {
-            println!("wrote {}", o.display());
+            say!("wrote {}", o.display());
         }
     }
     Ok(())
@@ -289,7 +293,7 @@ pub fn import(a: ImportArgs) -> anyhow::Result<()> {
         let inst = svg::import(&d, &opts)?;
         cellseq::validate::validate(&inst, &file)?;
         save_instance(&a.output, &inst)?;
-        println!(
+        say!(
             "{}: {} strokes, {} precedence edges -> {}",
             file,
             inst.n(),
@@ -315,7 +319,7 @@ pub fn import(a: ImportArgs) -> anyhow::Result<()> {
     )?;
     cellseq::validate::validate(&inst, &file)?;
     save_instance(&a.output, &inst)?;
-    println!(
+    say!(
         "{}: {} cells, {} precedence edges -> {}",
         file,
         inst.n(),
@@ -335,9 +339,9 @@ pub fn verify(a: VerifyArgs) -> anyhow::Result<()> {
     let tb = read_text(&a.optimized)?;
     let v = gcode::verify_files(&fa, &ta, &fb, &tb)?;
     if a.json {
-        println!("{}", serde_json::to_string_pretty(&v)?);
+        say!("{}", serde_json::to_string_pretty(&v)?);
     } else {
-        println!(
+        say!(
             "equivalent: {} cutting moves match (per tool, feed, speed, offset; in either direction)",
             v.cuts
         );
@@ -426,9 +430,9 @@ fn optimize_svg(a: &OptimizeArgs) -> anyhow::Result<()> {
             "before": out.before,
             "after": out.after,
         });
-        println!("{}", serde_json::to_string_pretty(&v)?);
+        say!("{}", serde_json::to_string_pretty(&v)?);
     } else {
-        println!(
+        say!(
             "{file}: {} strokes in {} scope(s); solver {} ({:.3} s, total {:.3} s); {} segments verified identical",
             d.strokes.len(),
             out.scopes,
@@ -438,32 +442,34 @@ fn optimize_svg(a: &OptimizeArgs) -> anyhow::Result<()> {
             segments
         );
         for s in &d.skipped {
-            println!("skipped: {s}");
+            say!("skipped: {s}");
         }
         let pct = |x: f64, y: f64| if x > 0.0 { 100.0 * (x - y) / x } else { 0.0 };
         let (b, f) = (&out.before, &out.after);
-        println!("{:<20} {:>14} {:>14} {:>8}", "", "before", "after", "saved");
-        println!(
+        say!("{:<20} {:>14} {:>14} {:>8}", "", "before", "after", "saved");
+        say!(
             "{:<20} {:>14.1} {:>14.1} {:>7.1}%",
             "pen-up mm (layer)",
             b.pen_up_mm,
             f.pen_up_mm,
             pct(b.pen_up_mm, f.pen_up_mm)
         );
-        println!(
+        say!(
             "{:<20} {:>14.1} {:>14.1} {:>7.1}%",
             "pen-up mm (total)",
             b.pen_up_total_mm,
             f.pen_up_total_mm,
             pct(b.pen_up_total_mm, f.pen_up_total_mm)
         );
-        println!("{:<20} {:>14} {:>14}", "pen lifts", b.lifts, f.lifts);
-        println!(
+        say!("{:<20} {:>14} {:>14}", "pen lifts", b.lifts, f.lifts);
+        say!(
             "{:<20} {:>14.1} {:>14.1}",
-            "pen-down mm", b.draw_mm, f.draw_mm
+            "pen-down mm",
+            b.draw_mm,
+            f.draw_mm
         );
         if let Some(o) = &a.output {
-            println!("wrote {}", o.display());
+            say!("wrote {}", o.display());
         }
     }
     Ok(())
@@ -544,9 +550,9 @@ fn optimize_dxf(a: &OptimizeArgs) -> anyhow::Result<()> {
             "before": out.before,
             "after": out.after,
         });
-        println!("{}", serde_json::to_string_pretty(&v)?);
+        say!("{}", serde_json::to_string_pretty(&v)?);
     } else {
-        println!(
+        say!(
             "{file}: {} contours ({closed} closed) on {} layer(s); {} inner-first edges; solver {} ({:.3} s); {} segments verified identical",
             d.strokes.len(),
             d.layers.len() - 1,
@@ -556,9 +562,9 @@ fn optimize_dxf(a: &OptimizeArgs) -> anyhow::Result<()> {
             segments
         );
         for s in &d.skipped {
-            println!("skipped: {s}");
+            say!("skipped: {s}");
         }
-        println!(
+        say!(
             "travel mm (file order -> optimized): {:.1} -> {:.1}; pierces {} -> {}",
             out.before.pen_up_total_mm,
             out.after.pen_up_total_mm,
@@ -566,7 +572,7 @@ fn optimize_dxf(a: &OptimizeArgs) -> anyhow::Result<()> {
             out.after.lifts
         );
         if let Some(o) = &a.output {
-            println!("wrote {}", o.display());
+            say!("wrote {}", o.display());
         }
     }
     Ok(())

@@ -66,7 +66,7 @@ pub fn parse_shard(s: &str) -> Result<(usize, usize)> {
 
 pub fn check(a: CheckArgs) -> Result<()> {
     let plan = Plan::load(&a.plan)?;
-    println!(
+    say!(
         "ok: {} instances x {} solvers x {} replicates = {} trials (reference {})",
         plan.instances.len(),
         plan.solvers.len(),
@@ -80,13 +80,16 @@ pub fn check(a: CheckArgs) -> Result<()> {
 /// Runs a plan and prints a summary.
 pub fn execute(plan: &Plan, opts: &RunOptions) -> Result<()> {
     let s = run_plan(plan, opts)?;
-    println!(
+    say!(
         "{} trials: {} run now, {} already done, {} without a feasible result",
-        s.planned, s.ran, s.skipped, s.failed
+        s.planned,
+        s.ran,
+        s.skipped,
+        s.failed
     );
-    println!("results   {}", s.files.results.display());
-    println!("traces    {}", s.files.traces.display());
-    println!("manifest  {}", s.files.manifest.display());
+    say!("results   {}", s.files.results.display());
+    say!("traces    {}", s.files.traces.display());
+    say!("manifest  {}", s.files.manifest.display());
     Ok(())
 }
 
@@ -118,7 +121,7 @@ pub fn merge(a: MergeArgs) -> Result<()> {
     }
     let out = a.out.unwrap_or_else(|| a.dirs[0].clone());
     let (rows, dups) = results::merge(&a.dirs, &out)?;
-    println!(
+    say!(
         "merged {rows} trials ({dups} duplicates dropped) into {}",
         out.join("results.csv").display()
     );
@@ -128,7 +131,7 @@ pub fn merge(a: MergeArgs) -> Result<()> {
 pub fn report(a: ReportArgs) -> Result<()> {
     let out = a.out.unwrap_or_else(|| a.dir.join("report"));
     let r = report::report(&a.dir, &out)?;
-    println!("report    {}", r.markdown.display());
-    println!("plots     {}", out.join("plots").display());
+    say!("report    {}", r.markdown.display());
+    say!("plots     {}", out.join("plots").display());
     Ok(())
 }

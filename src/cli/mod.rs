@@ -1,5 +1,17 @@
 //! Command-line interface: argument definitions and dispatch. One module per command group.
 
+/// `println!` for the CLI's standard output that ends the process quietly (status 0) when the
+/// reader has gone away (`cellseq solve F | head`), instead of panicking on the broken pipe;
+/// any other write error ends it with status 2 and a message.
+macro_rules! say {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        if let Err(e) = writeln!(std::io::stdout(), $($arg)*) {
+            $crate::cli::stdout_failed(e);
+        }
+    }};
+}
+
 mod bound;
 mod demo;
 mod gcode;
@@ -31,7 +43,6 @@ enum Command {
     Solvers,
     /// Generate an instance from a seeded generator.
     Generate(solve::GenerateArgs),
-    /// Run the built-in demonstration campaign into results/demo/ (no files needed).
     /// Lower bounds on the optimum of an instance.
     Bound(bound::BoundArgs),
     /// Run the built-in demonstration on a generated instance (no files needed).
@@ -74,4 +85,14 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<()> {
         Command::Merge(a) => harness::merge(a),
         Command::Report(a) => harness::report(a),
     }
+}
+
+/// Ends the process after a failed write to standard output: quietly when the reader closed
+/// the pipe (what `head` does), with a message otherwise.
+pub(crate) fn stdout_failed(e: std::io::Error) -> ! {
+    if e.kind() == std::io::ErrorKind::BrokenPipe {
+        std::process::exit(0);
+    }
+    eprintln!("error: writing to standard output: {e}");
+    std::process::exit(2);
 }

@@ -51,6 +51,6 @@ pub fn plot(a: PlotArgs) -> Result<()> {
     };
     cellseq::plot::plot(&inst, seq.as_ref(), &caption, &a.out)
         .with_context(|| format!("plotting {}", a.file.display()))?;
-    println!("wrote {}", a.out.display());
+    say!("wrote {}", a.out.display());
     Ok(())
 }

@@ -108,8 +108,8 @@ pub fn objective_of(inst: &Instance, name: Option<&str>) -> Result<Objective> {
 
 pub fn info(a: InfoArgs) -> Result<()> {
     let inst = load(&a.file)?;
-    println!("instance        {}", inst.name);
-    println!(
+    say!("instance        {}", inst.name);
+    say!(
         "kind            {}",
         if inst.is_matrix() {
             "matrix"
@@ -117,20 +117,20 @@ pub fn info(a: InfoArgs) -> Result<()> {
             "geometric"
         }
     );
-    println!("cells           {}", inst.n());
-    println!("modes           {}", inst.total_modes());
-    println!("tools           {}", inst.used_tools().len());
-    println!("precedence      {} edges", inst.precedence.len());
-    println!("density         {:.4}", inst.precedence_density());
+    say!("cells           {}", inst.n());
+    say!("modes           {}", inst.total_modes());
+    say!("tools           {}", inst.used_tools().len());
+    say!("precedence      {} edges", inst.precedence.len());
+    say!("density         {:.4}", inst.precedence_density());
     if let Some(g) = &inst.meta.generator {
-        println!("source          {g}");
+        say!("source          {g}");
     }
-    println!(
+    say!(
         "as-programmed   {}",
         if inst.as_given.is_some() { "yes" } else { "no" }
     );
     if let Some((bk, proven)) = best_known(&a.file) {
-        println!(
+        say!(
             "best known      {bk}{}",
             if proven { " (optimal)" } else { "" }
         );
@@ -140,7 +140,7 @@ pub fn info(a: InfoArgs) -> Result<()> {
 
 pub fn validate(a: ValidateArgs) -> Result<()> {
     load(&a.file)?;
-    println!("ok");
+    say!("ok");
     Ok(())
 }
 
@@ -176,7 +176,7 @@ pub fn solve(a: SolveArgs) -> Result<()> {
             .with_context(|| format!("writing {}", out.display()))?;
     }
     if a.json {
-        println!(
+        say!(
             "{}",
             serde_json::to_string(&result_json(&inst, &a.solver, a.seed, &r, bk))?
         );
@@ -259,37 +259,37 @@ pub fn result_json(
 
 fn print_report(inst: &Instance, solver: &str, r: &RunResult, bk: Option<f64>) {
     let rep = &r.report;
-    println!("instance        {} ({} cells)", inst.name, inst.n());
-    println!("solver          {solver}");
-    println!("objective       {}", r.objective.name());
-    println!("cost            {}", fmt_num(rep.cost));
+    say!("instance        {} ({} cells)", inst.name, inst.n());
+    say!("solver          {solver}");
+    say!("objective       {}", r.objective.name());
+    say!("cost            {}", fmt_num(rep.cost));
     if !inst.is_matrix() {
-        println!("cut length      {:.3} mm", rep.cut_length);
-        println!("air length      {:.3} mm", rep.air_length);
-        println!("path length     {:.3} mm", rep.path_length);
-        println!("lifts           {}", rep.lifts);
-        println!("tool changes    {}", rep.tool_changes);
-        println!("machining time  {:.3} s", rep.machining_time);
+        say!("cut length      {:.3} mm", rep.cut_length);
+        say!("air length      {:.3} mm", rep.air_length);
+        say!("path length     {:.3} mm", rep.path_length);
+        say!("lifts           {}", rep.lifts);
+        say!("tool changes    {}", rep.tool_changes);
+        say!("machining time  {:.3} s", rep.machining_time);
     }
     if let Some(b) = bk {
-        println!(
+        say!(
             "best known      {}  (gap {:.3} %)",
             fmt_num(b),
             gap(rep.cost, Some(b)).unwrap_or(0.0)
         );
     }
     if r.outcome.proven_optimal {
-        println!("proven optimal  yes");
+        say!("proven optimal  yes");
     }
     if let Some(lb) = r.outcome.lower_bound {
-        println!("lower bound     {}", fmt_num(lb));
+        say!("lower bound     {}", fmt_num(lb));
         if let Some(g) = cellseq::bound::certified_gap_percent(rep.cost, lb) {
-            println!("certified gap   {g:.3} %");
+            say!("certified gap   {g:.3} %");
         }
     }
-    println!("feasible        yes (independent checker)");
-    println!("evaluations     {}", r.evaluations);
-    println!("elapsed         {:.3} s", r.elapsed_s);
+    say!("feasible        yes (independent checker)");
+    say!("evaluations     {}", r.evaluations);
+    say!("elapsed         {:.3} s", r.elapsed_s);
 }
 
 fn fmt_num(x: f64) -> String {
@@ -311,22 +311,22 @@ pub fn eval(a: EvalArgs) -> Result<()> {
         .map_err(|v| anyhow::anyhow!("{spath}: infeasible: {v}"))?;
     let bk = best_known(&a.file).map(|b| b.0);
     if a.json {
-        println!(
+        say!(
             "{}",
             json!({"instance": inst.name, "feasible": true, "objective": objective.name(),
                    "report": rep, "best_known": bk, "gap_percent": gap(rep.cost, bk)})
         );
     } else {
-        println!("feasible        yes");
-        println!("cost            {}", fmt_num(rep.cost));
+        say!("feasible        yes");
+        say!("cost            {}", fmt_num(rep.cost));
         if !inst.is_matrix() {
-            println!("air length      {:.3} mm", rep.air_length);
-            println!("lifts           {}", rep.lifts);
-            println!("tool changes    {}", rep.tool_changes);
-            println!("machining time  {:.3} s", rep.machining_time);
+            say!("air length      {:.3} mm", rep.air_length);
+            say!("lifts           {}", rep.lifts);
+            say!("tool changes    {}", rep.tool_changes);
+            say!("machining time  {:.3} s", rep.machining_time);
         }
         if let Some(b) = bk {
-            println!(
+            say!(
                 "best known      {}  (gap {:.3} %)",
                 fmt_num(b),
                 gap(rep.cost, Some(b)).unwrap_or(0.0)
@@ -343,7 +343,7 @@ pub fn solvers() -> Result<()> {
         } else {
             ""
         };
-        println!("{}{default}\n    {}", s.name, s.summary);
+        say!("{}{default}\n    {}", s.name, s.summary);
         for p in s.params {
             let kind = match p.kind {
                 ParamKind::Int => "int".to_string(),
@@ -352,7 +352,7 @@ pub fn solvers() -> Result<()> {
                 ParamKind::Choice(c) => c.join("|"),
                 ParamKind::Text => "text".to_string(),
             };
-            println!("    --param {}={}  [{kind}]  {}", p.name, p.default, p.help);
+            say!("    --param {}={}  [{kind}]  {}", p.name, p.default, p.help);
         }
     }
     Ok(())
@@ -362,6 +362,6 @@ pub fn generate(a: GenerateArgs) -> Result<()> {
     let params = parse_kv(&a.params)?;
     let inst = cellseq::generate::generate(&a.kind, &params, a.seed)?;
     formats::save_instance(&a.out, &inst)?;
-    println!("wrote {} ({} cells)", a.out.display(), inst.n());
+    say!("wrote {} ({} cells)", a.out.display(), inst.n());
     Ok(())
 }
