@@ -4,7 +4,8 @@
 //! `cargo run --release --example scale -- 1000000 greedy [KEY=VALUE...]`
 //!
 //! `KEY=VALUE` arguments are solver parameters, except `gen.KEY=VALUE` (generator parameters,
-//! e.g. `gen.preds=1`), `seconds=S` (wall-clock budget; default none) and `csv=PATH` (append one
+//! e.g. `gen.preds=1`), `seconds=S` (wall-clock budget; default none), `evals=E` (evaluation
+//! budget) and `csv=PATH` (append one
 //! row `n,preds,solver,params,seconds,air,greedy_air,elapsed_s,solver_s,peak_rss_mib,lift` to PATH,
 //! with a header if the file is new; `greedy_air` is the greedy air length measured in the same
 //! process after the solver, so the peak memory is the solver's).
@@ -45,6 +46,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         if let Some((k, v)) = kv.split_once('=') {
             if k == "csv" {
                 csv = Some(v.to_string());
+            } else if k == "evals" {
+                budget.max_evals = Some(v.parse()?);
             } else if k == "seconds" {
                 budget.time_limit = Some(std::time::Duration::from_secs_f64(v.parse()?));
             } else if let Some(g) = k.strip_prefix("gen.") {
@@ -74,8 +77,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let elapsed = t.elapsed().as_secs_f64();
     let peak = peak_rss_mib();
     println!(
-        "{solver}: air {:.0} mm in {:.2} s (solver {:.2} s incl. check), peak RSS {:.0} MiB",
-        r.report.air_length, elapsed, r.elapsed_s, peak
+        "{solver}: air {:.0} mm in {:.2} s (solver {:.2} s incl. check, {} evaluations), peak RSS {:.0} MiB",
+        r.report.air_length, elapsed, r.elapsed_s, r.evaluations, peak
     );
     if let Some(path) = csv {
         let greedy_air = if solver == "greedy" {

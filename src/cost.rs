@@ -45,6 +45,9 @@ pub struct CostModel {
     /// Per node: the node that cuts the cell the other way in a reversed segment (see
     /// [`CostModel::turned`]), `u32::MAX` if none.
     turn: Vec<u32>,
+    /// Per cell: x such that the reversed-segment mode of every mode m is `m ^ x` (the mode
+    /// itself where [`CostModel::turned`] is `None`), or `u8::MAX` when no such x exists.
+    turn_xor: Vec<u8>,
     reversible: Vec<bool>,
     constant: f64,
     matrix: Option<CostMatrix>,
@@ -165,6 +168,7 @@ impl CostModel {
             cut_rate,
             flip,
             turn: Vec::new(),
+            turn_xor: Vec::new(),
             reversible,
             constant,
             matrix,
@@ -186,7 +190,26 @@ impl CostModel {
                 t.map_or(u32::MAX, |md| cm.node(cell, md) as u32)
             })
             .collect();
+        cm.turn_xor = (0..cm.n())
+            .map(|cell| {
+                let k = cm.modes(cell);
+                let x = cm.turned(cell, 0).unwrap_or(0);
+                let fits = x < u8::MAX as usize
+                    && (0..k).all(|md| cm.turned(cell, md).unwrap_or(md) == md ^ x);
+                if fits { x as u8 } else { u8::MAX }
+            })
+            .collect();
         cm
+    }
+
+    /// The mode of `cell` in a reversed segment as `mode ^ x` for every mode (`Some(x)`):
+    /// x = 1 for a reversible stroke with two modes, 0 when no mode has a direction or none
+    /// can be reversed; `None` when the modes do not pair up that way (use
+    /// [`CostModel::turned`]).
+    #[inline]
+    pub fn turn_xor(&self, cell: usize) -> Option<u32> {
+        let x = self.turn_xor[cell];
+        (x != u8::MAX).then_some(x as u32)
     }
 
     /// The mode that cuts `cell` in the opposite direction when the cell sits in a reversed

@@ -127,12 +127,18 @@ impl Solution {
     /// Reverses positions `i..=j` and gives each cell its `flip` mode, adding `delta`.
     pub fn reverse(&mut self, m: &CostModel, i: usize, j: usize, delta: f64) {
         self.order[i..=j].reverse();
+        // one pass over the segment: every access by cell is random, so touch each cell once
         for p in i..=j {
             let c = self.order[p] as usize;
-            self.mode[c] =
-                flip_mode(m, c, self.mode[c] as usize).unwrap_or(self.mode[c] as usize) as u32;
+            self.pos[c] = p as u32;
+            self.mode[c] = match m.turn_xor(c) {
+                Some(x) => self.mode[c] ^ x,
+                None => {
+                    let md = self.mode[c] as usize;
+                    flip_mode(m, c, md).unwrap_or(md) as u32
+                }
+            };
         }
-        self.renumber(i, j + 1);
         self.cost += delta;
     }
     /// Sets the mode of a cell, adding `delta`.

@@ -50,7 +50,7 @@ pub fn best_start(ctx: &mut Context, c: &Costs, k: usize) -> Solution {
 }
 
 /// See [`best_start`].
-pub const EDGE_ONLY_CELLS: usize = 200_000;
+pub const EDGE_ONLY_CELLS: usize = 50_000;
 
 /// A randomized fringe construction, O(n²): at each step the cheapest ready (cell, mode) is
 /// taken with probability `1 − noise`, otherwise one of the three cheapest at random. With
