@@ -1,14 +1,15 @@
 //! `local-search`: greedy start (or the greedy matching start where it applies and is
-//! cheaper, see [`super::edge`]), then variable neighbourhood descent over every move of the
+//! cheaper, see [`super::edge`]), on large instances without precedence a first Or-opt pass
+//! on a linked list (O(1) moves), then variable neighbourhood descent over every move of the
 //! engine (Or-opt, 2-opt with mode flip, single-cell mode change, SOP-3-exchange, mode DP).
 //! After the first descent it iterates: kick the best with a few random feasible Or-opt moves,
 //! descend again, keep the result when better (until the budget, or `kicks` failures in a row).
 
 use super::start::{best_start, outcome};
 use super::{Context, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo};
-use crate::engine::Costs;
 use crate::engine::moves::{apply_segment, segment_delta, window};
 use crate::engine::search::Search;
+use crate::engine::{Costs, linked};
 use crate::error::Result;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -55,6 +56,10 @@ pub static INFO: SolverInfo = SolverInfo {
     },
 };
 
+/// From this many cells on, instances without precedence get a first Or-opt pass on a linked
+/// list ([`linked::or_opt`]) before the VND.
+pub const LINKED_CELLS: usize = 20_000;
+
 /// The VND solver.
 pub struct LocalSearch {
     /// Candidate neighbours per cell.
@@ -78,6 +83,11 @@ impl Solver for LocalSearch {
         let mut search = Search::new(c, self.k);
         if self.max_block > 0 {
             search.max_block = self.max_block;
+        }
+        if s.n() >= LINKED_CELLS && linked::applies(&c) {
+            // O(1) Or-opt moves first: on the array every move shifts the cells in between
+            linked::or_opt(&c, &search.nb, &mut s, ctx);
+            ctx.report(s.cost + m.constant());
         }
         search.vnd(&mut s, ctx);
         ctx.report(s.cost + m.constant());

@@ -1,0 +1,285 @@
+//! Or-opt on a doubly linked list, for large instances without precedence.
+//!
+//! In the array form of [`Solution`] an Or-opt move shifts every cell between the old and the
+//! new place of the segment, O(distance). From a greedy start on 10^6 cells most useful moves
+//! go to a spatial neighbour that sits far away in the order, so a pass costs O(n²) in the
+//! worst case and does not finish in a minute. Without precedence nothing needs positions:
+//! with `next`/`prev` links every Or-opt move (a segment of 1–3 cells moved between a
+//! candidate neighbour and its successor, kept or cut the other way) and every in-place mode
+//! change is O(1). [`or_opt`] runs that pass to a local optimum (don't-look bits, best move per
+//! looked-at cell) and writes the result back into the array form.
+
+use super::{Costs, Neighbours, Solution};
+use crate::solvers::Context;
+use std::collections::VecDeque;
+
+/// True when [`or_opt`] may run: the instance has no precedence.
+pub fn applies(c: &Costs) -> bool {
+    c.m.dag.succs.iter().all(|v| v.is_empty())
+}
+
+/// The path as a cyclic doubly linked list through a sentinel (index n: before the first
+/// cell and after the last).
+struct List {
+    next: Vec<u32>,
+    prev: Vec<u32>,
+    mode: Vec<u32>,
+}
+
+impl List {
+    fn slot(&self, x: u32) -> Option<(usize, usize)> {
+        let n = self.mode.len() as u32;
+        (x != n).then(|| (x as usize, self.mode[x as usize] as usize))
+    }
+    /// Cost of the link x → y (either may be the sentinel), with the given modes for cells.
+    #[inline]
+    fn link(&self, c: &Costs, x: u32, mx: u32, y: u32, my: u32) -> f64 {
+        let n = self.mode.len() as u32;
+        let a = (x != n).then_some((x as usize, mx as usize));
+        let b = (y != n).then_some((y as usize, my as usize));
+        c.link(a, b)
+    }
+    #[inline]
+    fn cur(&self, c: &Costs, x: u32, y: u32) -> f64 {
+        c.link(self.slot(x), self.slot(y))
+    }
+    #[inline]
+    fn md(&self, x: u32) -> u32 {
+        self.mode.get(x as usize).copied().unwrap_or(0)
+    }
+}
+
+/// A move found for a looked-at cell.
+#[derive(Clone, Copy)]
+struct Found {
+    delta: f64,
+    /// Segment: first, last (in current order), length.
+    f: u32,
+    l: u32,
+    /// Insert between v and w = next[v]; reversed or not. `v == u32::MAX`: in-place mode
+    /// change of f to mode `w`.
+    v: u32,
+    w: u32,
+    rev: bool,
+}
+
+/// Or-opt (segments of 1–3 cells, kept or reversed, next to candidate neighbours) and
+/// single-cell mode changes on a linked list, to a local optimum or until the budget ends.
+/// Call only when [`applies`] holds. Returns true on any improvement; `s` is rewritten, its
+/// cost updated by the move deltas.
+pub fn or_opt(c: &Costs, nb: &Neighbours, s: &mut Solution, ctx: &mut Context) -> bool {
+    let m = c.m;
+    let n = s.n();
+    if n < 2 {
+        return false;
+    }
+    let d = n as u32;
+    let mut l = List {
+        next: vec![0; n + 1],
+        prev: vec![0; n + 1],
+        mode: s.mode.clone(),
+    };
+    let mut last = d;
+    for &x in &s.order {
+        l.next[last as usize] = x;
+        l.prev[x as usize] = last;
+        last = x;
+    }
+    l.next[last as usize] = d;
+    l.prev[d as usize] = last;
+
+    let mut on = vec![true; n];
+    let mut queue: VecDeque<u32> = s.order.iter().copied().collect();
+    let mut improved = false;
+    let mut seg_modes = [0u32; 3];
+    let mut seg = [0u32; 3];
+    while let Some(x) = queue.pop_front() {
+        on[x as usize] = false;
+        if ctx.exhausted() {
+            break;
+        }
+        let mut evals = 0u64;
+        let mut best = Found {
+            delta: 0.0,
+            f: x,
+            l: x,
+            v: 0,
+            w: 0,
+            rev: false,
+        };
+        // in-place mode change
+        let (p, q) = (l.prev[x as usize], l.next[x as usize]);
+        let here = l.cur(c, p, x) + l.cur(c, x, q);
+        for mx in 0..m.modes(x as usize) as u32 {
+            if mx == l.mode[x as usize] {
+                continue;
+            }
+            evals += 1;
+            let dl = l.link(c, p, l.md(p), x, mx) + l.link(c, x, mx, q, l.md(q)) - here;
+            if dl < best.delta {
+                best = Found {
+                    delta: dl,
+                    f: x,
+                    l: x,
+                    v: u32::MAX,
+                    w: mx,
+                    rev: false,
+                };
+            }
+        }
+        // segments x, x+1, x+2 following the order
+        let mut len = 0usize;
+        let mut y = x;
+        let mut can_rev = true;
+        while len < 3 && y != d {
+            seg[len] = y;
+            match m.turned(y as usize, l.mode[y as usize] as usize) {
+                Some(t) => seg_modes[len] = t as u32,
+                None => can_rev = false,
+            }
+            len += 1;
+            let (f, lst) = (seg[0], seg[len - 1]);
+            let (p, q) = (l.prev[f as usize], l.next[lst as usize]);
+            let gain = l.cur(c, p, f) + l.cur(c, lst, q) - l.cur(c, p, q);
+            let inside = |z: u32| seg[..len].contains(&z);
+            let (mf, ml) = (l.mode[f as usize], l.mode[lst as usize]);
+            let (rf, rl) = (seg_modes[0], seg_modes[len - 1]);
+            // candidate insertion edges (v, w = next v), forward: v → f … lst → w;
+            // reversed: v → lst' … f' → w
+            let fwd = nb.inn[f as usize]
+                .iter()
+                .copied()
+                .chain(nb.out[lst as usize].iter().map(|&w| l.prev[w as usize]))
+                .chain([d]);
+            for v in fwd {
+                let w = l.next[v as usize];
+                if inside(v) || inside(w) || v == p {
+                    continue;
+                }
+                evals += 1;
+                let dl = l.link(c, v, l.md(v), f, mf) + l.link(c, lst, ml, w, l.md(w))
+                    - l.cur(c, v, w)
+                    - gain;
+                if dl < best.delta {
+                    best = Found {
+                        delta: dl,
+                        f,
+                        l: lst,
+                        v,
+                        w,
+                        rev: false,
+                    };
+                }
+            }
+            if can_rev && (len > 1 || rf != mf) {
+                let bwd = nb.inn[lst as usize]
+                    .iter()
+                    .copied()
+                    .chain(nb.out[f as usize].iter().map(|&w| l.prev[w as usize]))
+                    .chain([d]);
+                for v in bwd {
+                    let w = l.next[v as usize];
+                    // v == p (then w == f) reverses the segment in place
+                    if inside(v) || (v != p && inside(w)) {
+                        continue;
+                    }
+                    let (vv, ww) = if v == p { (p, q) } else { (v, w) };
+                    let removed = if v == p {
+                        l.cur(c, p, f) + l.cur(c, lst, q)
+                    } else {
+                        l.cur(c, v, w) + gain
+                    };
+                    evals += 1;
+                    let mut dl =
+                        l.link(c, vv, l.md(vv), lst, rl) + l.link(c, f, rf, ww, l.md(ww)) - removed;
+                    // inner links of the reversed segment
+                    for k in 0..len - 1 {
+                        let (a, b) = (seg[k], seg[k + 1]);
+                        dl += l.link(c, b, seg_modes[k + 1], a, seg_modes[k]) - l.cur(c, a, b);
+                    }
+                    if dl < best.delta {
+                        best = Found {
+                            delta: dl,
+                            f,
+                            l: lst,
+                            v,
+                            w,
+                            rev: true,
+                        };
+                    }
+                }
+            }
+            y = l.next[y as usize];
+        }
+        ctx.count(evals);
+        if !super::search::improves(best.delta, s.cost) {
+            continue;
+        }
+        improved = true;
+        s.cost += best.delta;
+        let mut touched = [d; 9];
+        if best.v == u32::MAX {
+            l.mode[x as usize] = best.w;
+            touched[..3].copy_from_slice(&[l.prev[x as usize], x, l.next[x as usize]]);
+        } else {
+            let (f, lst) = (best.f, best.l);
+            let (p, q) = (l.prev[f as usize], l.next[lst as usize]);
+            // the segment's cells, first to last
+            let mut cells = [d; 3];
+            let mut k = 0;
+            let mut z = f;
+            loop {
+                cells[k] = z;
+                k += 1;
+                if z == lst {
+                    break;
+                }
+                z = l.next[z as usize];
+            }
+            // insertion edge (v, w) once the segment is unlinked
+            let (v, w) = if best.v == p {
+                (p, q)
+            } else {
+                (best.v, best.w)
+            };
+            l.next[p as usize] = q;
+            l.prev[q as usize] = p;
+            let order: Vec<u32> = if best.rev {
+                cells[..k].iter().rev().copied().collect()
+            } else {
+                cells[..k].to_vec()
+            };
+            let mut a = v;
+            for &z in &order {
+                if best.rev {
+                    let md = l.mode[z as usize] as usize;
+                    l.mode[z as usize] = m.turned(z as usize, md).unwrap_or(md) as u32;
+                }
+                l.next[a as usize] = z;
+                l.prev[z as usize] = a;
+                a = z;
+            }
+            l.next[a as usize] = w;
+            l.prev[w as usize] = a;
+            touched[..k].copy_from_slice(&cells[..k]);
+            touched[3..7].copy_from_slice(&[p, q, v, w]);
+        }
+        for z in touched {
+            if z != d && !on[z as usize] {
+                on[z as usize] = true;
+                queue.push_back(z);
+            }
+        }
+    }
+    // back to the array form
+    let mut z = l.next[d as usize];
+    let mut p = 0usize;
+    while z != d {
+        s.order[p] = z;
+        s.pos[z as usize] = p as u32;
+        p += 1;
+        z = l.next[z as usize];
+    }
+    s.mode = l.mode;
+    improved
+}
