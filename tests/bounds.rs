@@ -163,6 +163,63 @@ fn beam_proves_known_optima() {
 }
 
 #[test]
+fn qpath_bound_is_strong_under_dense_precedence() {
+    // rbg048a: optimum 351 (bks.csv); the assignment bound is 337
+    let inst = load("instances/tsplib-sop/rbg048a.sop");
+    let m = CostModel::new(&inst, Objective::Matrix);
+    let q = bound::qpath::QPath::new(&m, Some(351.0), 1000).expect("qpath bound");
+    assert!(q.root <= 351.0 + 1e-6, "qpath {} above the optimum", q.root);
+    assert!(q.root > 345.0, "qpath {} is weak", q.root);
+    let opts = BoundOptions {
+        upper: Some(351.0),
+        ..BoundOptions::default()
+    };
+    let b = bound::compute(&m, &opts);
+    assert_eq!(b.best_name, "qpath");
+    assert!(b.best <= 351.0);
+}
+
+/// The qpath completion bound of every prefix along an optimal sequence never exceeds the
+/// cost of the rest of that sequence.
+fn check_qpath_along_optimum(inst: &Instance, obj: Objective) {
+    let r = solvers::run(
+        "exact",
+        inst,
+        obj,
+        &BTreeMap::new(),
+        1,
+        Budget::default(),
+        &mut NoObserver,
+    )
+    .expect("exact solves");
+    let m = CostModel::new(inst, obj);
+    let seq = &r.outcome.sequence;
+    let opt = m.evaluate(seq);
+    for upper in [None, Some(opt)] {
+        let Some(q) = bound::qpath::QPath::new(&m, upper, 200) else {
+            continue;
+        };
+        assert!(q.root <= opt + 1e-6 * opt.abs().max(1.0));
+        let mut g = m.constant() + m.start(seq[0].cell, seq[0].mode);
+        let mut open = q.lambda_total();
+        for p in 1..=seq.len() {
+            let (c, md) = (seq[p - 1].cell, seq[p - 1].mode);
+            open -= q.lambda(c);
+            let node = m.node(c, md);
+            let lb = g + q.completion(p, node, open);
+            assert!(
+                lb <= opt + 1e-6 * opt.abs().max(1.0),
+                "qpath prefix bound {lb} above the optimum {opt} at position {p}"
+            );
+            if p < seq.len() {
+                let (d, mdd) = (seq[p].cell, seq[p].mode);
+                g += m.arc(c, md, d, mdd);
+            }
+        }
+    }
+}
+
+#[test]
 fn lagrangian_beats_assignment_on_ry48p() {
     let inst = load("instances/tsplib-sop/ry48p.1.sop");
     let b = all_bounds(&inst, Objective::Matrix);
@@ -278,6 +335,31 @@ proptest! {
         let text = clustered_sop_text(&group, &small, &big, &prec);
         let inst = formats::parse_instance("rnd.sop", &text, Format::Sop).unwrap();
         check_instance(&inst, Objective::Matrix);
+    }
+
+    #[test]
+    fn beam_exact_on_random_dense_precedence_sop(
+        small in prop::collection::vec(0u32..20, 40),
+        big in prop::collection::vec(0u32..60, 40),
+        prec in prop::collection::vec(prop::bool::weighted(0.5), 40),
+        k in 5usize..=10,
+    ) {
+        // one group: plain random costs, dense precedence (narrow qpath windows)
+        let text = clustered_sop_text(&vec![0; k], &small, &big, &prec);
+        let inst = formats::parse_instance("rnd.sop", &text, Format::Sop).unwrap();
+        check_instance(&inst, Objective::Matrix);
+        check_qpath_along_optimum(&inst, Objective::Matrix);
+    }
+
+    #[test]
+    fn qpath_prefix_bounds_valid_on_random_matrix(
+        sizes in prop::collection::vec(1usize..=3, 3..=7),
+        costs in prop::collection::vec(0u32..100, 64),
+        prec in prop::collection::vec(prop::bool::weighted(0.4), 32),
+    ) {
+        let text = pcglns_text(sizes.len(), &sizes, &costs, &prec);
+        let inst = formats::parse_instance("rnd.pcglns", &text, Format::Pcglns).unwrap();
+        check_qpath_along_optimum(&inst, Objective::Matrix);
     }
 
     #[test]

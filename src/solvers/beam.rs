@@ -12,7 +12,9 @@
 //! The incremental bound is the larger of two degree bounds over the part still to do, both
 //! maintained in O(1) per child: every unvisited cell (and home) is still to be entered once
 //! (Σ cheapest allowed in-arc), and the last node and every unvisited cell are still to be left
-//! once (Σ cheapest allowed out-arc). A root bound from [`crate::bound`] (Lagrangian
+//! once (Σ cheapest allowed out-arc). With `qpath` (default), the position-indexed path
+//! relaxation of [`crate::bound::qpath`] adds an O(1) table bound per (cells visited, last
+//! node), strong under dense precedence. A root bound from [`crate::bound`] (Lagrangian
 //! arborescence) may close the gap at once.
 
 use super::{
@@ -20,6 +22,7 @@ use super::{
 };
 use crate::bound::cells::CellGraph;
 use crate::bound::closure::Closure;
+use crate::bound::qpath::{self, QPath};
 use crate::bound::{self, BoundOptions, assignment};
 use crate::cost::CostModel;
 use crate::error::{Error, Result};
@@ -70,6 +73,13 @@ pub static INFO: SolverInfo = SolverInfo {
                    clusters that must be entered and left (n <= 600)",
         },
         ParamSpec {
+            name: "qpath",
+            default: "true",
+            kind: ParamKind::Bool,
+            help: "also bound prefixes with the position-indexed path relaxation \
+                   (bound::qpath, multipliers from subgradient steps at the root)",
+        },
+        ParamSpec {
             name: "warm_evals",
             default: "2000000",
             kind: ParamKind::Int,
@@ -85,6 +95,7 @@ pub static INFO: SolverInfo = SolverInfo {
             by_cost: p.word("guide") == "cost",
             potentials: p.bool("potentials"),
             warm_evals: p.int("warm_evals"),
+            qpath: p.bool("qpath"),
         })
     },
 };
@@ -105,6 +116,8 @@ pub struct Beam {
     pub potentials: bool,
     /// Evaluation budget of the `ils` warm start (0 = none).
     pub warm_evals: u64,
+    /// Bound prefixes with the position-indexed path relaxation too.
+    pub qpath: bool,
 }
 
 /// Largest instance accepted (visited sets are fixed-size bitsets).
@@ -138,6 +151,8 @@ struct Prefix<const W: usize> {
     rem_in: f64,
     /// Σ cheapest out-arc over unvisited cells
     rem_out: f64,
+    /// Σ qpath multipliers over unvisited cells
+    lam_open: f64,
     f: f64,
 }
 
@@ -177,6 +192,9 @@ struct Tables {
     /// the clusters' cells
     clusters: Vec<Vec<u32>>,
 }
+
+/// Work budget (arc evaluations) of the qpath multipliers' subgradient steps.
+const QPATH_WORK: f64 = 4e8;
 
 /// Largest instance for which the root assignment (O(n³)) gives the potentials.
 const POTENTIAL_MAX_CELLS: usize = 600;
@@ -315,13 +333,37 @@ impl Beam {
         if let Some((c, _)) = &best {
             ctx.report(*c);
         }
+        let qp = if self.qpath {
+            let iters = qpath::affordable_iterations(m, QPATH_WORK, 1000);
+            (iters >= 10)
+                .then(|| QPath::new(m, best.as_ref().map(|b| b.0), iters))
+                .flatten()
+        } else {
+            None
+        };
+        if let Some(q) = &qp {
+            let r = if t.integral {
+                (q.root - 1e-6).ceil()
+            } else {
+                q.root
+            };
+            if std::env::var_os("CELLSEQ_BEAM_TRACE").is_some() {
+                eprintln!(
+                    "beam: qpath root {} after {} iterations, {:.2}s",
+                    q.root,
+                    q.iterations,
+                    ctx.elapsed()
+                );
+            }
+            root_lb = root_lb.max(r);
+        }
         let mut proven = false;
         let prefix_bytes = (std::mem::size_of::<Prefix<W>>() + 24) as u64;
         let mut width = 1usize;
         loop {
             let ub = best.as_ref().map(|b| b.0).unwrap_or(f64::INFINITY);
             let (found, truncated, aborted) =
-                self.iteration::<W>(ctx, &t, width, cut(ub), best.is_some());
+                self.iteration::<W>(ctx, &t, qp.as_ref(), width, cut(ub), best.is_some());
             if let Some((c, seq)) = found
                 && best
                     .as_ref()
@@ -353,6 +395,7 @@ impl Beam {
                 let opts = BoundOptions {
                     assignment_max_cells: 0,
                     lagrangian_iterations: 150,
+                    qpath_work: 0.0,
                     upper: best.as_ref().map(|b| b.0),
                     ..BoundOptions::default()
                 };
@@ -414,6 +457,7 @@ impl Beam {
         &self,
         ctx: &mut Context,
         t: &Tables,
+        qp: Option<&QPath>,
         width: usize,
         cut: f64,
         may_abort: bool,
@@ -422,11 +466,22 @@ impl Beam {
         let n = m.n();
         let total_in: f64 = t.cell_in.iter().sum();
         let total_out: f64 = t.cell_out.iter().sum();
-        let bound = |p: &Prefix<W>| {
+        // `cells`: the prefix's number of cells
+        let bound = |p: &Prefix<W>, cells: usize| {
             let h_in = p.rem_in + t.node_in[p.node as usize];
             let h_out = p.rem_out + t.node_out[p.node as usize];
-            p.g + h_in.max(h_out)
+            let h = match qp {
+                // rounding slack: λ sums are kept incrementally
+                Some(q) => {
+                    let h_q = q.completion(cells, p.node as usize, p.lam_open);
+                    h_q - 1e-9 * h_q.abs().max(1.0)
+                }
+                None => f64::NEG_INFINITY,
+            };
+            p.g + h_in.max(h_out).max(h)
         };
+        let lam = |c: usize| qp.map_or(0.0, |q| q.lambda(c));
+        let lam_total = qp.map_or(0.0, |q| q.lambda_total());
         let mut scratch = vec![(0.0, 0.0); n + t.clusters.len()];
         let mut levels: Vec<Vec<Prefix<W>>> = Vec::with_capacity(n);
         let mut truncated = false;
@@ -446,9 +501,10 @@ impl Beam {
                     g: m.constant() + m.start(c, md),
                     rem_in: total_in - t.cell_in[c],
                     rem_out: total_out - t.cell_out[c],
+                    lam_open: lam_total - lam(c),
                     f: 0.0,
                 };
-                p.f = bound(&p);
+                p.f = bound(&p, 1);
                 if p.f <= cut {
                     cands.push(p);
                 }
@@ -467,7 +523,7 @@ impl Beam {
         truncated |= keep_best(&mut cands, width, self.by_cost);
         levels.push(cands);
         let mut index: FxHashMap<([u64; W], u32), u32> = FxHashMap::default();
-        for _k in 1..n {
+        for k in 1..n {
             let prev = levels.last().expect("a level");
             if prev.is_empty() {
                 break;
@@ -499,9 +555,10 @@ impl Beam {
                             g: p.g + m.arc(a, ma, v, mv),
                             rem_in: p.rem_in - t.cell_in[v],
                             rem_out: p.rem_out - t.cell_out[v],
+                            lam_open: p.lam_open - lam(v),
                             f: 0.0,
                         };
-                        c.f = bound(&c);
+                        c.f = bound(&c, k + 1);
                         if c.f > cut {
                             continue;
                         }
@@ -909,6 +966,7 @@ fn first_level_bound<const W: usize>(m: &CostModel, t: &Tables) -> f64 {
                 g: m.constant() + m.start(c, md),
                 rem_in: 0.0,
                 rem_out: 0.0,
+                lam_open: 0.0,
                 f: 0.0,
             };
             lb = lb.min(refined(m, t, &p, &mut scratch));
