@@ -311,6 +311,74 @@ fn pcglns_text(groups: usize, sizes: &[usize], costs: &[u32], prec: &[bool]) -> 
     s
 }
 
+/// A random TSPLIB SOP text on `k` cells where cell 2 is a copy of cell 1 (and cell 3 too
+/// when `triple`), so the beam's symmetry breaking applies; `skew` makes the arcs between
+/// the copies asymmetric (then they are not interchangeable).
+fn twin_sop_text(k: usize, costs: &[u32], prec: &[bool], triple: bool, skew: bool) -> String {
+    let n = k + 2;
+    let mut idx = 0;
+    let mut m: Vec<Vec<i64>> = (0..n)
+        .map(|i| {
+            (0..n)
+                .map(|j| {
+                    idx += 1;
+                    let forced = j == 0 || i == n - 1 || (j < i && i > 1 && prec[idx % prec.len()]);
+                    if i == j {
+                        0
+                    } else if forced {
+                        -1
+                    } else {
+                        costs[idx % costs.len()] as i64
+                    }
+                })
+                .collect()
+        })
+        .collect();
+    let copies: &[usize] = if triple { &[2, 3] } else { &[2] };
+    for &c in copies {
+        m[c] = m[1].clone();
+        for row in m.iter_mut() {
+            row[c] = row[1];
+        }
+        m[c][c] = 0;
+    }
+    for &a in &[1usize, 2, 3][..copies.len() + 1] {
+        for &b in &[1usize, 2, 3][..copies.len() + 1] {
+            if a != b {
+                m[a][b] = 7;
+            }
+        }
+    }
+    if skew {
+        m[1][2] = 9;
+    }
+    let mut s = format!(
+        "NAME: twins\nTYPE: SOP\nDIMENSION: {n}\nEDGE_WEIGHT_TYPE: EXPLICIT\n\
+         EDGE_WEIGHT_FORMAT: FULL_MATRIX\nEDGE_WEIGHT_SECTION\n{n}\n"
+    );
+    for row in &m {
+        let r: Vec<String> = row.iter().map(|v| v.to_string()).collect();
+        s += &r.join(" ");
+        s += "\n";
+    }
+    s += "EOF\n";
+    s
+}
+
+#[test]
+fn interchangeable_cells_are_found() {
+    let costs: Vec<u32> = (0..50).map(|i| (i * 37 % 41) as u32).collect();
+    let text = twin_sop_text(6, &costs, &[false], true, false);
+    let inst = formats::parse_instance("twins.sop", &text, Format::Sop).unwrap();
+    let m = CostModel::new(&inst, Objective::Matrix);
+    let pairs = solvers::beam::interchangeable_order(&m);
+    assert_eq!(pairs.len(), 2, "{pairs:?}");
+    let text = twin_sop_text(6, &costs, &[false], false, true);
+    let inst = formats::parse_instance("twins.sop", &text, Format::Sop).unwrap();
+    let m = CostModel::new(&inst, Objective::Matrix);
+    assert!(solvers::beam::interchangeable_order(&m).is_empty());
+}
+
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(40))]
 
@@ -349,6 +417,19 @@ proptest! {
         let inst = formats::parse_instance("rnd.sop", &text, Format::Sop).unwrap();
         check_instance(&inst, Objective::Matrix);
         check_qpath_along_optimum(&inst, Objective::Matrix);
+    }
+
+    #[test]
+    fn beam_exact_with_interchangeable_cells(
+        k in 4usize..=9,
+        costs in prop::collection::vec(0u32..50, 50),
+        prec in prop::collection::vec(prop::bool::weighted(0.3), 40),
+        triple in any::<bool>(),
+        skew in any::<bool>(),
+    ) {
+        let text = twin_sop_text(k, &costs, &prec, triple, skew);
+        let inst = formats::parse_instance("twins.sop", &text, Format::Sop).unwrap();
+        check_instance(&inst, Objective::Matrix);
     }
 
     #[test]

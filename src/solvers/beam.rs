@@ -80,6 +80,13 @@ pub static INFO: SolverInfo = SolverInfo {
                    (bound::qpath, multipliers from subgradient steps at the root)",
         },
         ParamSpec {
+            name: "twins",
+            default: "true",
+            kind: ParamKind::Bool,
+            help: "order interchangeable cells (same costs to and from every other cell, same \
+                   precedence) by index: symmetry breaking that keeps an optimum",
+        },
+        ParamSpec {
             name: "warm_evals",
             default: "2000000",
             kind: ParamKind::Int,
@@ -96,6 +103,7 @@ pub static INFO: SolverInfo = SolverInfo {
             potentials: p.bool("potentials"),
             warm_evals: p.int("warm_evals"),
             qpath: p.bool("qpath"),
+            twins: p.bool("twins"),
         })
     },
 };
@@ -118,6 +126,8 @@ pub struct Beam {
     pub warm_evals: u64,
     /// Bound prefixes with the position-indexed path relaxation too.
     pub qpath: bool,
+    /// Order interchangeable cells by index (symmetry breaking).
+    pub twins: bool,
 }
 
 /// Largest instance accepted (visited sets are fixed-size bitsets).
@@ -199,7 +209,7 @@ const QPATH_WORK: f64 = 4e8;
 /// Largest instance for which the root assignment (O(n³)) gives the potentials.
 const POTENTIAL_MAX_CELLS: usize = 600;
 
-fn tables(m: &CostModel, use_potentials: bool) -> Result<Tables> {
+fn tables(m: &CostModel, use_potentials: bool, twins: bool) -> Result<Tables> {
     let n = m.n();
     let words = n.div_ceil(64).max(1);
     let cl = Closure::new(&m.dag).ok_or_else(|| Error::Solver {
@@ -216,7 +226,7 @@ fn tables(m: &CostModel, use_potentials: bool) -> Result<Tables> {
         None => (vec![0.0; n + 1], vec![0.0; n + 1]),
     };
     let r = |i: usize, j: usize| g.c(i, j) - u[i] - v[j];
-    let pred_mask = (0..n)
+    let mut pred_mask: Vec<Vec<u64>> = (0..n)
         .map(|c| {
             let mut v = vec![0u64; words];
             for &p in &m.dag.preds[c] {
@@ -225,6 +235,11 @@ fn tables(m: &CostModel, use_potentials: bool) -> Result<Tables> {
             v
         })
         .collect();
+    if twins && n <= TWIN_MAX_CELLS {
+        for (a, b) in twin_order(m, &cl) {
+            pred_mask[b][a / 64] |= 1 << (a % 64);
+        }
+    }
     let fin = |x: f64| if x.is_finite() { x } else { 0.0 };
     let mut node_out = vec![0.0; m.nodes()];
     let mut node_in = vec![0.0; m.nodes()];
@@ -305,7 +320,7 @@ impl Beam {
         if n == 0 {
             return Ok(super::outcome_of(m, Vec::new()));
         }
-        let t = tables(m, self.potentials)?;
+        let t = tables(m, self.potentials, self.twins)?;
         let constant = m.constant();
         // the node bound at the first level (every possible first cell and mode) bounds the
         // optimum: reported as the lower bound when no proof is reached
@@ -644,6 +659,76 @@ impl Beam {
         let cost = m.evaluate(&seq);
         (Some((cost, seq)), truncated, false)
     }
+}
+
+/// Largest instance searched for interchangeable cells (O(n² · n · modes²)).
+const TWIN_MAX_CELLS: usize = 300;
+
+/// Whether cells `a` and `b` are interchangeable: same modes, same start and finish costs,
+/// same arc costs to and from every other cell (mode by mode), `arc(a, i, b, j) = arc(b, i, a,
+/// j)`, and the same ancestors and descendants apart from each other (and neither precedes
+/// the other). Swapping such cells (with their modes) in any sequence keeps it feasible and
+/// keeps its cost.
+fn twins(m: &CostModel, cl: &Closure, a: usize, b: usize) -> bool {
+    let k = m.modes(a);
+    if k != m.modes(b) || cl.before(a, b) || cl.before(b, a) {
+        return false;
+    }
+    for i in 0..k {
+        if m.start(a, i) != m.start(b, i) || m.finish(a, i) != m.finish(b, i) {
+            return false;
+        }
+        for j in 0..k {
+            if m.arc(a, i, b, j) != m.arc(b, i, a, j) {
+                return false;
+            }
+        }
+    }
+    for c in 0..m.n() {
+        if c == a || c == b {
+            continue;
+        }
+        if cl.before(c, a) != cl.before(c, b) || cl.before(a, c) != cl.before(b, c) {
+            return false;
+        }
+        for i in 0..k {
+            for j in 0..m.modes(c) {
+                if m.arc(a, i, c, j) != m.arc(b, i, c, j) || m.arc(c, j, a, i) != m.arc(c, j, b, i)
+                {
+                    return false;
+                }
+            }
+        }
+    }
+    true
+}
+
+/// Symmetry breaking: groups of pairwise interchangeable cells (same modes, start, finish,
+/// arc costs to and from every other cell, symmetric arcs between them, same precedence),
+/// each ordered by index. Returns (a, b) pairs: a must come right before b in the group's
+/// order (any optimum can be relabelled so that it holds). Empty when the precedence has a
+/// cycle.
+pub fn interchangeable_order(m: &CostModel) -> Vec<(usize, usize)> {
+    Closure::new(&m.dag)
+        .map(|cl| twin_order(m, &cl))
+        .unwrap_or_default()
+}
+
+fn twin_order(m: &CostModel, cl: &Closure) -> Vec<(usize, usize)> {
+    let mut groups: Vec<Vec<usize>> = Vec::new();
+    for b in 0..m.n() {
+        match groups
+            .iter_mut()
+            .find(|g| g.iter().all(|&a| twins(m, cl, a, b)))
+        {
+            Some(g) => g.push(b),
+            None => groups.push(vec![b]),
+        }
+    }
+    groups
+        .iter()
+        .flat_map(|g| g.windows(2).map(|w| (w[0], w[1])))
+        .collect()
 }
 
 /// Disjoint clusters of cells for the bound: subtours of the assignment relaxation, found
