@@ -349,7 +349,12 @@ impl Beam {
             ctx.report(*c);
         }
         let qp = if self.qpath {
-            let iters = qpath::affordable_iterations(m, QPATH_WORK, 1000);
+            // short runs (e.g. a portfolio phase) get a smaller share: ~10⁸ per second of limit
+            let work = match ctx.budget.time_limit {
+                Some(t) => QPATH_WORK.min(t.as_secs_f64() * 1e8),
+                None => QPATH_WORK,
+            };
+            let iters = qpath::affordable_iterations(m, work, 1000);
             (iters >= 10)
                 .then(|| QPath::new(m, best.as_ref().map(|b| b.0), iters))
                 .flatten()
