@@ -163,6 +163,63 @@ fn beam_proves_known_optima() {
 }
 
 #[test]
+fn qpath_bound_is_strong_under_dense_precedence() {
+    // rbg048a: optimum 351 (bks.csv); the assignment bound is 337
+    let inst = load("instances/tsplib-sop/rbg048a.sop");
+    let m = CostModel::new(&inst, Objective::Matrix);
+    let q = bound::qpath::QPath::new(&m, Some(351.0), 1000).expect("qpath bound");
+    assert!(q.root <= 351.0 + 1e-6, "qpath {} above the optimum", q.root);
+    assert!(q.root > 345.0, "qpath {} is weak", q.root);
+    let opts = BoundOptions {
+        upper: Some(351.0),
+        ..BoundOptions::default()
+    };
+    let b = bound::compute(&m, &opts);
+    assert_eq!(b.best_name, "qpath");
+    assert!(b.best <= 351.0);
+}
+
+/// The qpath completion bound of every prefix along an optimal sequence never exceeds the
+/// cost of the rest of that sequence.
+fn check_qpath_along_optimum(inst: &Instance, obj: Objective) {
+    let r = solvers::run(
+        "exact",
+        inst,
+        obj,
+        &BTreeMap::new(),
+        1,
+        Budget::default(),
+        &mut NoObserver,
+    )
+    .expect("exact solves");
+    let m = CostModel::new(inst, obj);
+    let seq = &r.outcome.sequence;
+    let opt = m.evaluate(seq);
+    for upper in [None, Some(opt)] {
+        let Some(q) = bound::qpath::QPath::new(&m, upper, 200) else {
+            continue;
+        };
+        assert!(q.root <= opt + 1e-6 * opt.abs().max(1.0));
+        let mut g = m.constant() + m.start(seq[0].cell, seq[0].mode);
+        let mut open = q.lambda_total();
+        for p in 1..=seq.len() {
+            let (c, md) = (seq[p - 1].cell, seq[p - 1].mode);
+            open -= q.lambda(c);
+            let node = m.node(c, md);
+            let lb = g + q.completion(p, node, open);
+            assert!(
+                lb <= opt + 1e-6 * opt.abs().max(1.0),
+                "qpath prefix bound {lb} above the optimum {opt} at position {p}"
+            );
+            if p < seq.len() {
+                let (d, mdd) = (seq[p].cell, seq[p].mode);
+                g += m.arc(c, md, d, mdd);
+            }
+        }
+    }
+}
+
+#[test]
 fn lagrangian_beats_assignment_on_ry48p() {
     let inst = load("instances/tsplib-sop/ry48p.1.sop");
     let b = all_bounds(&inst, Objective::Matrix);
@@ -254,6 +311,74 @@ fn pcglns_text(groups: usize, sizes: &[usize], costs: &[u32], prec: &[bool]) -> 
     s
 }
 
+/// A random TSPLIB SOP text on `k` cells where cell 2 is a copy of cell 1 (and cell 3 too
+/// when `triple`), so the beam's symmetry breaking applies; `skew` makes the arcs between
+/// the copies asymmetric (then they are not interchangeable).
+fn twin_sop_text(k: usize, costs: &[u32], prec: &[bool], triple: bool, skew: bool) -> String {
+    let n = k + 2;
+    let mut idx = 0;
+    let mut m: Vec<Vec<i64>> = (0..n)
+        .map(|i| {
+            (0..n)
+                .map(|j| {
+                    idx += 1;
+                    let forced = j == 0 || i == n - 1 || (j < i && i > 1 && prec[idx % prec.len()]);
+                    if i == j {
+                        0
+                    } else if forced {
+                        -1
+                    } else {
+                        costs[idx % costs.len()] as i64
+                    }
+                })
+                .collect()
+        })
+        .collect();
+    let copies: &[usize] = if triple { &[2, 3] } else { &[2] };
+    for &c in copies {
+        m[c] = m[1].clone();
+        for row in m.iter_mut() {
+            row[c] = row[1];
+        }
+        m[c][c] = 0;
+    }
+    for &a in &[1usize, 2, 3][..copies.len() + 1] {
+        for &b in &[1usize, 2, 3][..copies.len() + 1] {
+            if a != b {
+                m[a][b] = 7;
+            }
+        }
+    }
+    if skew {
+        m[1][2] = 9;
+    }
+    let mut s = format!(
+        "NAME: twins\nTYPE: SOP\nDIMENSION: {n}\nEDGE_WEIGHT_TYPE: EXPLICIT\n\
+         EDGE_WEIGHT_FORMAT: FULL_MATRIX\nEDGE_WEIGHT_SECTION\n{n}\n"
+    );
+    for row in &m {
+        let r: Vec<String> = row.iter().map(|v| v.to_string()).collect();
+        s += &r.join(" ");
+        s += "\n";
+    }
+    s += "EOF\n";
+    s
+}
+
+#[test]
+fn interchangeable_cells_are_found() {
+    let costs: Vec<u32> = (0..50).map(|i| (i * 37 % 41) as u32).collect();
+    let text = twin_sop_text(6, &costs, &[false], true, false);
+    let inst = formats::parse_instance("twins.sop", &text, Format::Sop).unwrap();
+    let m = CostModel::new(&inst, Objective::Matrix);
+    let pairs = solvers::beam::interchangeable_order(&m);
+    assert_eq!(pairs.len(), 2, "{pairs:?}");
+    let text = twin_sop_text(6, &costs, &[false], false, true);
+    let inst = formats::parse_instance("twins.sop", &text, Format::Sop).unwrap();
+    let m = CostModel::new(&inst, Objective::Matrix);
+    assert!(solvers::beam::interchangeable_order(&m).is_empty());
+}
+
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(40))]
 
@@ -278,6 +403,44 @@ proptest! {
         let text = clustered_sop_text(&group, &small, &big, &prec);
         let inst = formats::parse_instance("rnd.sop", &text, Format::Sop).unwrap();
         check_instance(&inst, Objective::Matrix);
+    }
+
+    #[test]
+    fn beam_exact_on_random_dense_precedence_sop(
+        small in prop::collection::vec(0u32..20, 40),
+        big in prop::collection::vec(0u32..60, 40),
+        prec in prop::collection::vec(prop::bool::weighted(0.5), 40),
+        k in 5usize..=10,
+    ) {
+        // one group: plain random costs, dense precedence (narrow qpath windows)
+        let text = clustered_sop_text(&vec![0; k], &small, &big, &prec);
+        let inst = formats::parse_instance("rnd.sop", &text, Format::Sop).unwrap();
+        check_instance(&inst, Objective::Matrix);
+        check_qpath_along_optimum(&inst, Objective::Matrix);
+    }
+
+    #[test]
+    fn beam_exact_with_interchangeable_cells(
+        k in 4usize..=9,
+        costs in prop::collection::vec(0u32..50, 50),
+        prec in prop::collection::vec(prop::bool::weighted(0.3), 40),
+        triple in any::<bool>(),
+        skew in any::<bool>(),
+    ) {
+        let text = twin_sop_text(k, &costs, &prec, triple, skew);
+        let inst = formats::parse_instance("twins.sop", &text, Format::Sop).unwrap();
+        check_instance(&inst, Objective::Matrix);
+    }
+
+    #[test]
+    fn qpath_prefix_bounds_valid_on_random_matrix(
+        sizes in prop::collection::vec(1usize..=3, 3..=7),
+        costs in prop::collection::vec(0u32..100, 64),
+        prec in prop::collection::vec(prop::bool::weighted(0.4), 32),
+    ) {
+        let text = pcglns_text(sizes.len(), &sizes, &costs, &prec);
+        let inst = formats::parse_instance("rnd.pcglns", &text, Format::Pcglns).unwrap();
+        check_qpath_along_optimum(&inst, Objective::Matrix);
     }
 
     #[test]

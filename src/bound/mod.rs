@@ -9,6 +9,8 @@
 //!   neighbours only (memory linear in n).
 //! - `assignment`: Hungarian method on the cell graph.
 //! - `lagrangian`: minimum spanning 1-arborescence with subgradient out-degree penalties.
+//! - `qpath`: position-indexed path relaxation (precedence windows, no 2-cycles) with
+//!   subgradient multipliers per cell ([`qpath`]).
 //!
 //! [`compute`] runs what is affordable for the instance size and reports each with its time.
 
@@ -17,6 +19,7 @@ pub mod assignment;
 pub mod cells;
 pub mod closure;
 pub mod knn;
+pub mod qpath;
 
 use crate::cost::CostModel;
 use cells::CellGraph;
@@ -35,6 +38,9 @@ pub struct BoundOptions {
     pub lagrangian_max_cells: usize,
     /// Subgradient iterations of the Lagrangian bound.
     pub lagrangian_iterations: usize,
+    /// Work budget of the `qpath` bound in arc evaluations (0 = skip it); it runs only when
+    /// at least 10 subgradient iterations fit.
+    pub qpath_work: f64,
     /// Neighbours per node in the K-nearest-neighbour degree bound.
     pub knn: usize,
     /// A known solution cost (with the constant), used to size subgradient steps.
@@ -48,6 +54,7 @@ impl Default for BoundOptions {
             assignment_max_cells: 1500,
             lagrangian_max_cells: 400,
             lagrangian_iterations: 300,
+            qpath_work: 1e8,
             knn: 16,
             upper: None,
         }
@@ -115,6 +122,17 @@ pub fn compute(m: &CostModel, opt: &BoundOptions) -> Bounds {
                 parts.push(BoundValue {
                     name: "lagrangian",
                     value: round(constant + l.bound),
+                    seconds: t.elapsed().as_secs_f64(),
+                });
+            }
+        }
+        let iters = qpath::affordable_iterations(m, opt.qpath_work, 300);
+        if iters >= 10 {
+            let t = Instant::now();
+            if let Some(q) = qpath::QPath::new(m, opt.upper, iters) {
+                parts.push(BoundValue {
+                    name: "qpath",
+                    value: round(q.root),
                     seconds: t.elapsed().as_secs_f64(),
                 });
             }

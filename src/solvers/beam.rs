@@ -12,7 +12,9 @@
 //! The incremental bound is the larger of two degree bounds over the part still to do, both
 //! maintained in O(1) per child: every unvisited cell (and home) is still to be entered once
 //! (Σ cheapest allowed in-arc), and the last node and every unvisited cell are still to be left
-//! once (Σ cheapest allowed out-arc). A root bound from [`crate::bound`] (Lagrangian
+//! once (Σ cheapest allowed out-arc). With `qpath` (default), the position-indexed path
+//! relaxation of [`crate::bound::qpath`] adds an O(1) table bound per (cells visited, last
+//! node), strong under dense precedence. A root bound from [`crate::bound`] (Lagrangian
 //! arborescence) may close the gap at once.
 
 use super::{
@@ -20,6 +22,7 @@ use super::{
 };
 use crate::bound::cells::CellGraph;
 use crate::bound::closure::Closure;
+use crate::bound::qpath::{self, QPath};
 use crate::bound::{self, BoundOptions, assignment};
 use crate::cost::CostModel;
 use crate::error::{Error, Result};
@@ -70,6 +73,20 @@ pub static INFO: SolverInfo = SolverInfo {
                    clusters that must be entered and left (n <= 600)",
         },
         ParamSpec {
+            name: "qpath",
+            default: "true",
+            kind: ParamKind::Bool,
+            help: "also bound prefixes with the position-indexed path relaxation \
+                   (bound::qpath, multipliers from subgradient steps at the root)",
+        },
+        ParamSpec {
+            name: "twins",
+            default: "true",
+            kind: ParamKind::Bool,
+            help: "order interchangeable cells (same costs to and from every other cell, same \
+                   precedence) by index: symmetry breaking that keeps an optimum",
+        },
+        ParamSpec {
             name: "warm_evals",
             default: "2000000",
             kind: ParamKind::Int,
@@ -85,6 +102,8 @@ pub static INFO: SolverInfo = SolverInfo {
             by_cost: p.word("guide") == "cost",
             potentials: p.bool("potentials"),
             warm_evals: p.int("warm_evals"),
+            qpath: p.bool("qpath"),
+            twins: p.bool("twins"),
         })
     },
 };
@@ -105,6 +124,10 @@ pub struct Beam {
     pub potentials: bool,
     /// Evaluation budget of the `ils` warm start (0 = none).
     pub warm_evals: u64,
+    /// Bound prefixes with the position-indexed path relaxation too.
+    pub qpath: bool,
+    /// Order interchangeable cells by index (symmetry breaking).
+    pub twins: bool,
 }
 
 /// Largest instance accepted (visited sets are fixed-size bitsets).
@@ -138,6 +161,8 @@ struct Prefix<const W: usize> {
     rem_in: f64,
     /// Σ cheapest out-arc over unvisited cells
     rem_out: f64,
+    /// Σ qpath multipliers over unvisited cells
+    lam_open: f64,
     f: f64,
 }
 
@@ -178,10 +203,13 @@ struct Tables {
     clusters: Vec<Vec<u32>>,
 }
 
+/// Work budget (arc evaluations) of the qpath multipliers' subgradient steps.
+const QPATH_WORK: f64 = 4e8;
+
 /// Largest instance for which the root assignment (O(n³)) gives the potentials.
 const POTENTIAL_MAX_CELLS: usize = 600;
 
-fn tables(m: &CostModel, use_potentials: bool) -> Result<Tables> {
+fn tables(m: &CostModel, use_potentials: bool, twins: bool) -> Result<Tables> {
     let n = m.n();
     let words = n.div_ceil(64).max(1);
     let cl = Closure::new(&m.dag).ok_or_else(|| Error::Solver {
@@ -198,7 +226,7 @@ fn tables(m: &CostModel, use_potentials: bool) -> Result<Tables> {
         None => (vec![0.0; n + 1], vec![0.0; n + 1]),
     };
     let r = |i: usize, j: usize| g.c(i, j) - u[i] - v[j];
-    let pred_mask = (0..n)
+    let mut pred_mask: Vec<Vec<u64>> = (0..n)
         .map(|c| {
             let mut v = vec![0u64; words];
             for &p in &m.dag.preds[c] {
@@ -207,6 +235,11 @@ fn tables(m: &CostModel, use_potentials: bool) -> Result<Tables> {
             v
         })
         .collect();
+    if twins && n <= TWIN_MAX_CELLS {
+        for (a, b) in twin_order(m, &cl) {
+            pred_mask[b][a / 64] |= 1 << (a % 64);
+        }
+    }
     let fin = |x: f64| if x.is_finite() { x } else { 0.0 };
     let mut node_out = vec![0.0; m.nodes()];
     let mut node_in = vec![0.0; m.nodes()];
@@ -287,7 +320,7 @@ impl Beam {
         if n == 0 {
             return Ok(super::outcome_of(m, Vec::new()));
         }
-        let t = tables(m, self.potentials)?;
+        let t = tables(m, self.potentials, self.twins)?;
         let constant = m.constant();
         // the node bound at the first level (every possible first cell and mode) bounds the
         // optimum: reported as the lower bound when no proof is reached
@@ -315,13 +348,42 @@ impl Beam {
         if let Some((c, _)) = &best {
             ctx.report(*c);
         }
+        let qp = if self.qpath {
+            // short runs (e.g. a portfolio phase) get a smaller share: ~10⁸ per second of limit
+            let work = match ctx.budget.time_limit {
+                Some(t) => QPATH_WORK.min(t.as_secs_f64() * 1e8),
+                None => QPATH_WORK,
+            };
+            let iters = qpath::affordable_iterations(m, work, 1000);
+            (iters >= 10)
+                .then(|| QPath::new(m, best.as_ref().map(|b| b.0), iters))
+                .flatten()
+        } else {
+            None
+        };
+        if let Some(q) = &qp {
+            let r = if t.integral {
+                (q.root - 1e-6).ceil()
+            } else {
+                q.root
+            };
+            if std::env::var_os("CELLSEQ_BEAM_TRACE").is_some() {
+                eprintln!(
+                    "beam: qpath root {} after {} iterations, {:.2}s",
+                    q.root,
+                    q.iterations,
+                    ctx.elapsed()
+                );
+            }
+            root_lb = root_lb.max(r);
+        }
         let mut proven = false;
         let prefix_bytes = (std::mem::size_of::<Prefix<W>>() + 24) as u64;
         let mut width = 1usize;
         loop {
             let ub = best.as_ref().map(|b| b.0).unwrap_or(f64::INFINITY);
             let (found, truncated, aborted) =
-                self.iteration::<W>(ctx, &t, width, cut(ub), best.is_some());
+                self.iteration::<W>(ctx, &t, qp.as_ref(), width, cut(ub), best.is_some());
             if let Some((c, seq)) = found
                 && best
                     .as_ref()
@@ -353,6 +415,7 @@ impl Beam {
                 let opts = BoundOptions {
                     assignment_max_cells: 0,
                     lagrangian_iterations: 150,
+                    qpath_work: 0.0,
                     upper: best.as_ref().map(|b| b.0),
                     ..BoundOptions::default()
                 };
@@ -414,6 +477,7 @@ impl Beam {
         &self,
         ctx: &mut Context,
         t: &Tables,
+        qp: Option<&QPath>,
         width: usize,
         cut: f64,
         may_abort: bool,
@@ -422,11 +486,22 @@ impl Beam {
         let n = m.n();
         let total_in: f64 = t.cell_in.iter().sum();
         let total_out: f64 = t.cell_out.iter().sum();
-        let bound = |p: &Prefix<W>| {
+        // `cells`: the prefix's number of cells
+        let bound = |p: &Prefix<W>, cells: usize| {
             let h_in = p.rem_in + t.node_in[p.node as usize];
             let h_out = p.rem_out + t.node_out[p.node as usize];
-            p.g + h_in.max(h_out)
+            let h = match qp {
+                // rounding slack: λ sums are kept incrementally
+                Some(q) => {
+                    let h_q = q.completion(cells, p.node as usize, p.lam_open);
+                    h_q - 1e-9 * h_q.abs().max(1.0)
+                }
+                None => f64::NEG_INFINITY,
+            };
+            p.g + h_in.max(h_out).max(h)
         };
+        let lam = |c: usize| qp.map_or(0.0, |q| q.lambda(c));
+        let lam_total = qp.map_or(0.0, |q| q.lambda_total());
         let mut scratch = vec![(0.0, 0.0); n + t.clusters.len()];
         let mut levels: Vec<Vec<Prefix<W>>> = Vec::with_capacity(n);
         let mut truncated = false;
@@ -446,9 +521,10 @@ impl Beam {
                     g: m.constant() + m.start(c, md),
                     rem_in: total_in - t.cell_in[c],
                     rem_out: total_out - t.cell_out[c],
+                    lam_open: lam_total - lam(c),
                     f: 0.0,
                 };
-                p.f = bound(&p);
+                p.f = bound(&p, 1);
                 if p.f <= cut {
                     cands.push(p);
                 }
@@ -467,7 +543,7 @@ impl Beam {
         truncated |= keep_best(&mut cands, width, self.by_cost);
         levels.push(cands);
         let mut index: FxHashMap<([u64; W], u32), u32> = FxHashMap::default();
-        for _k in 1..n {
+        for k in 1..n {
             let prev = levels.last().expect("a level");
             if prev.is_empty() {
                 break;
@@ -499,9 +575,10 @@ impl Beam {
                             g: p.g + m.arc(a, ma, v, mv),
                             rem_in: p.rem_in - t.cell_in[v],
                             rem_out: p.rem_out - t.cell_out[v],
+                            lam_open: p.lam_open - lam(v),
                             f: 0.0,
                         };
-                        c.f = bound(&c);
+                        c.f = bound(&c, k + 1);
                         if c.f > cut {
                             continue;
                         }
@@ -587,6 +664,76 @@ impl Beam {
         let cost = m.evaluate(&seq);
         (Some((cost, seq)), truncated, false)
     }
+}
+
+/// Largest instance searched for interchangeable cells (O(n² · n · modes²)).
+const TWIN_MAX_CELLS: usize = 300;
+
+/// Whether cells `a` and `b` are interchangeable: same modes, same start and finish costs,
+/// same arc costs to and from every other cell (mode by mode), `arc(a, i, b, j) = arc(b, i, a,
+/// j)`, and the same ancestors and descendants apart from each other (and neither precedes
+/// the other). Swapping such cells (with their modes) in any sequence keeps it feasible and
+/// keeps its cost.
+fn twins(m: &CostModel, cl: &Closure, a: usize, b: usize) -> bool {
+    let k = m.modes(a);
+    if k != m.modes(b) || cl.before(a, b) || cl.before(b, a) {
+        return false;
+    }
+    for i in 0..k {
+        if m.start(a, i) != m.start(b, i) || m.finish(a, i) != m.finish(b, i) {
+            return false;
+        }
+        for j in 0..k {
+            if m.arc(a, i, b, j) != m.arc(b, i, a, j) {
+                return false;
+            }
+        }
+    }
+    for c in 0..m.n() {
+        if c == a || c == b {
+            continue;
+        }
+        if cl.before(c, a) != cl.before(c, b) || cl.before(a, c) != cl.before(b, c) {
+            return false;
+        }
+        for i in 0..k {
+            for j in 0..m.modes(c) {
+                if m.arc(a, i, c, j) != m.arc(b, i, c, j) || m.arc(c, j, a, i) != m.arc(c, j, b, i)
+                {
+                    return false;
+                }
+            }
+        }
+    }
+    true
+}
+
+/// Symmetry breaking: groups of pairwise interchangeable cells (same modes, start, finish,
+/// arc costs to and from every other cell, symmetric arcs between them, same precedence),
+/// each ordered by index. Returns (a, b) pairs: a must come right before b in the group's
+/// order (any optimum can be relabelled so that it holds). Empty when the precedence has a
+/// cycle.
+pub fn interchangeable_order(m: &CostModel) -> Vec<(usize, usize)> {
+    Closure::new(&m.dag)
+        .map(|cl| twin_order(m, &cl))
+        .unwrap_or_default()
+}
+
+fn twin_order(m: &CostModel, cl: &Closure) -> Vec<(usize, usize)> {
+    let mut groups: Vec<Vec<usize>> = Vec::new();
+    for b in 0..m.n() {
+        match groups
+            .iter_mut()
+            .find(|g| g.iter().all(|&a| twins(m, cl, a, b)))
+        {
+            Some(g) => g.push(b),
+            None => groups.push(vec![b]),
+        }
+    }
+    groups
+        .iter()
+        .flat_map(|g| g.windows(2).map(|w| (w[0], w[1])))
+        .collect()
 }
 
 /// Disjoint clusters of cells for the bound: subtours of the assignment relaxation, found
@@ -909,6 +1056,7 @@ fn first_level_bound<const W: usize>(m: &CostModel, t: &Tables) -> f64 {
                 g: m.constant() + m.start(c, md),
                 rem_in: 0.0,
                 rem_out: 0.0,
+                lam_open: 0.0,
                 f: 0.0,
             };
             lb = lb.min(refined(m, t, &p, &mut scratch));
