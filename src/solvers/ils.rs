@@ -8,8 +8,8 @@
 //! `restart` kicks without a new best the walk restarts from the best solution. On instances
 //! whose costs read the same backwards (`lk=auto`; TSPLIB's prob.100) the repair and the
 //! polish of a new best also run Lin–Kernighan chains of feasible reversals
-//! ([`crate::engine::lk`]). Without a
-//! budget it stops after `stall` kicks without a new best.
+//! ([`crate::engine::lk`]). Without a budget it stops after `stall` kicks without a new
+//! best.
 
 use super::start::{greedy_solution, outcome};
 use super::{Context, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo};
