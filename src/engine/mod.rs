@@ -9,6 +9,7 @@
 //! layered shortest-path mode DP, [`search`] the variable neighbourhood descent.
 
 pub mod linked;
+pub mod lk;
 pub mod modes;
 pub mod moves;
 pub mod neighbours;

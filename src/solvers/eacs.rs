@@ -24,6 +24,7 @@
 use super::aco::{COLONY, Pheromone};
 use super::start::{greedy_solution, outcome};
 use super::{Context, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo};
+use crate::engine::lk::Lk;
 use crate::engine::modes::mode_dp;
 use crate::engine::search::Search;
 use crate::engine::sop3x::{TwoWay, sop3_two_way};
@@ -79,6 +80,12 @@ pub static INFO: SolverInfo = SolverInfo {
             kind: ParamKind::Int,
             help: "candidate neighbours per cell (Or-opt)",
         },
+        ParamSpec {
+            name: "lk",
+            default: "false",
+            kind: ParamKind::Choice(&["auto", "true", "false"]),
+            help: "the ants' local search also runs Lin-Kernighan chains of feasible reversals (engine::lk); auto = when costs are symmetric (off by default: slower per ant and worse in auto on prob.100)",
+        },
     ],
     make: |p: &Params| Box::new(from_params(p)),
 };
@@ -97,6 +104,11 @@ pub fn from_params(p: &Params) -> Eacs {
         k: p.int("k").max(1) as usize,
         two_opt: p.bool("two-opt"),
         two_way: p.bool("two-way"),
+        lk: match p.word("lk") {
+            "true" => Some(true),
+            "false" => Some(false),
+            _ => None,
+        },
     }
 }
 
@@ -124,6 +136,8 @@ pub struct Eacs {
     pub two_opt: bool,
     /// Backward as well as forward SOP-3-exchange.
     pub two_way: bool,
+    /// Lin-Kernighan chains in the ants' local search (`None`: when costs are symmetric).
+    pub lk: Option<bool>,
 }
 
 /// Scratch space of one construction.
@@ -331,6 +345,16 @@ impl Eacs {
         };
         let mut search = Search::new(c, self.k);
         search.vnd(&mut best, ctx);
+        let mut lk = match self.lk {
+            Some(false) => None,
+            _ => Some(Lk::new(&c, 12, 3)),
+        }
+        .filter(|l| self.lk == Some(true) || l.symmetric);
+        if let Some(lk) = lk.as_mut() {
+            while lk.improve_all(&c, &search.nb, &mut best, ctx) && !ctx.exhausted() {
+                search.vnd(&mut best, ctx);
+            }
+        }
         ctx.report(best.cost + m.constant());
         if n < 3 {
             return Ok(outcome(m, &best));
@@ -378,8 +402,27 @@ impl Eacs {
                     self.two_opt,
                     self.two_way,
                 );
+                if let Some(lk) = lk.as_mut() {
+                    while lk.improve(&c, &search.nb, &mut s, ctx, &seeds) && !ctx.exhausted() {
+                        focused_descent(
+                            &mut search,
+                            &mut w,
+                            &mut s,
+                            ctx,
+                            &seeds,
+                            multimode,
+                            self.two_opt,
+                            self.two_way,
+                        );
+                    }
+                }
                 if s.cost < best.cost - 1e-9 * best.cost.abs().max(1.0) {
                     search.vnd(&mut s, ctx);
+                    if let Some(lk) = lk.as_mut() {
+                        while lk.improve_all(&c, &search.nb, &mut s, ctx) && !ctx.exhausted() {
+                            search.vnd(&mut s, ctx);
+                        }
+                    }
                     best = s;
                     ctx.report(best.cost + m.constant());
                     improved = true;

@@ -5,11 +5,15 @@
 //! feasibility by labelling), repair with Or-opt and SOP-3-exchange started only from the cells
 //! the kick disturbed (don't-look bits everywhere else), re-choose modes, and accept the result
 //! when it lies within a record-to-record band above the best (`accept`, relative). After
-//! `restart` kicks without a new best the walk restarts from the best solution. Without a
-//! budget it stops after `stall` kicks without a new best.
+//! `restart` kicks without a new best the walk restarts from the best solution. On instances
+//! whose costs read the same backwards (`lk=auto`; TSPLIB's prob.100) the repair and the
+//! polish of a new best also run Lin–Kernighan chains of feasible reversals
+//! ([`crate::engine::lk`]). Without a budget it stops after `stall` kicks without a new
+//! best.
 
 use super::start::{greedy_solution, outcome};
 use super::{Context, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo};
+use crate::engine::lk::Lk;
 use crate::engine::moves::sop3_delta;
 use crate::engine::search::Search;
 use crate::engine::sop3x::{TwoWay, sop3_two_way};
@@ -66,6 +70,30 @@ pub static INFO: SolverInfo = SolverInfo {
             help: "the repair's SOP-3-exchange searches backward as well as forward",
         },
         ParamSpec {
+            name: "lk",
+            default: "auto",
+            kind: ParamKind::Choice(&["auto", "true", "false"]),
+            help: "the repair also runs Lin-Kernighan chains of feasible reversals (engine::lk); auto = when costs read the same backwards (symmetric matrix)",
+        },
+        ParamSpec {
+            name: "lk-depth",
+            default: "12",
+            kind: ParamKind::Int,
+            help: "longest Lin-Kernighan chain (reversals)",
+        },
+        ParamSpec {
+            name: "lk-breadth",
+            default: "3",
+            kind: ParamKind::Int,
+            help: "first steps tried from each cell by a Lin-Kernighan chain",
+        },
+        ParamSpec {
+            name: "sop3",
+            default: "true",
+            kind: ParamKind::Bool,
+            help: "the repair runs SOP-3-exchange (off: Or-opt, and LK when on, only)",
+        },
+        ParamSpec {
             name: "stall",
             default: "20000",
             kind: ParamKind::Int,
@@ -86,6 +114,14 @@ pub fn from_params(p: &Params) -> Ils {
         restart: p.int("restart").max(1),
         stall: p.int("stall").max(1),
         two_way: p.bool("two-way"),
+        lk: match p.word("lk") {
+            "true" => Some(true),
+            "false" => Some(false),
+            _ => None,
+        },
+        lk_depth: p.int("lk-depth").max(1) as usize,
+        lk_breadth: p.int("lk-breadth").max(1) as usize,
+        sop3: p.bool("sop3"),
     }
 }
 
@@ -107,6 +143,14 @@ pub struct Ils {
     pub stall: u64,
     /// Backward as well as forward SOP-3-exchange in the repair.
     pub two_way: bool,
+    /// Lin-Kernighan chains in the repair (`None`: when the costs are symmetric).
+    pub lk: Option<bool>,
+    /// Longest Lin-Kernighan chain.
+    pub lk_depth: usize,
+    /// First steps tried per Lin-Kernighan chain.
+    pub lk_breadth: usize,
+    /// SOP-3-exchange in the repair.
+    pub sop3: bool,
 }
 
 /// One random feasible segment swap on `s`: blocks `[h+1..=i]` and `[i+1..=j]` trade places.
@@ -264,6 +308,16 @@ impl Ils {
         };
         let mut search = Search::new(c, self.k);
         search.vnd(&mut cur, ctx);
+        let mut lk = match self.lk {
+            Some(false) => None,
+            _ => Some(Lk::new(&c, self.lk_depth, self.lk_breadth)),
+        }
+        .filter(|l| self.lk == Some(true) || l.symmetric);
+        if let Some(lk) = lk.as_mut() {
+            while lk.improve_all(&c, &search.nb, &mut cur, ctx) && !ctx.exhausted() {
+                search.vnd(&mut cur, ctx);
+            }
+        }
         let mut best = cur.clone();
         ctx.report(best.cost + m.constant());
         let multimode = (0..n).any(|x| m.modes(x) > 1);
@@ -305,12 +359,18 @@ impl Ils {
             }
             loop {
                 let a = search.or_opt_seeded(&mut trial, ctx, &seeds);
-                let b = if self.two_way {
+                let b = if !self.sop3 {
+                    false
+                } else if self.two_way {
                     sop3_two_way(&search, &mut w, &mut trial, ctx, &seeds)
                 } else {
                     search.sop3_seeded(&mut trial, ctx, &seeds)
                 };
-                if !(a || b) || ctx.exhausted() {
+                let l = match lk.as_mut() {
+                    Some(lk) => lk.improve(&c, &search.nb, &mut trial, ctx, &seeds),
+                    None => false,
+                };
+                if !(a || b || l) || ctx.exhausted() {
                     break;
                 }
             }
@@ -322,6 +382,11 @@ impl Ils {
             if trial.cost < best.cost - 1e-9 * best.cost.abs().max(1.0) {
                 // polish a new best with the full descent before keeping it
                 search.vnd(&mut trial, ctx);
+                if let Some(lk) = lk.as_mut() {
+                    while lk.improve_all(&c, &search.nb, &mut trial, ctx) && !ctx.exhausted() {
+                        search.vnd(&mut trial, ctx);
+                    }
+                }
                 best.clone_from(&trial);
                 ctx.report(best.cost + m.constant());
                 since_best = 0;

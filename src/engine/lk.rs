@@ -1,0 +1,504 @@
+//! Lin–Kernighan style variable-depth search (LK with 2-opt moves) on the open path,
+//! restricted to reversals that keep every precedence pair.
+//!
+//! The path is read as a cycle through a dummy node D (the home position before the first
+//! cell and the end after the last). A chain starts at a cell `t1` and one of its path
+//! neighbours `t2`: it breaks the link t1–t2, adds a link t2–t3 to a candidate t3 of t2,
+//! breaks the link t3–t4 that makes the result a path again and closes with t1–t4 — one
+//! reversal of a segment next to t1. The next step breaks the closing link t1–t4 again
+//! (t4 becomes the new t2), and so on, for up to `depth` steps. Every step must keep the
+//! LK gain criterion (the cost change so far, without the closing link, is a gain), may not
+//! break a link added earlier in the chain, and must reverse a segment that holds no
+//! precedence pair and whose cells can all be reversed ([`reversible_segment`]), so every
+//! intermediate path is feasible. The chain keeps its best prefix when that improves the
+//! path and is undone otherwise.
+//!
+//! On instances whose costs read the same backwards (a symmetric matrix: TSPLIB's prob.100)
+//! a step is evaluated in O(1); otherwise the segment's inner links are summed, O(length).
+
+use super::moves::reversible_segment;
+use super::search::improves;
+use super::solution::flip_mode;
+use super::{Costs, Neighbours, Slot, Solution};
+use crate::formats::tsplib::FORBIDDEN_ARC;
+use crate::solvers::Context;
+use std::collections::VecDeque;
+
+/// Instances with at most this many nodes are tested for symmetric costs (O(nodes²)).
+const SYMMETRY_TEST_NODES: usize = 2000;
+
+/// One candidate step of a chain.
+#[derive(Debug, Clone, Copy)]
+struct Step {
+    /// Reversed positions `i..=j`.
+    i: usize,
+    j: usize,
+    /// Cost change of the reversal.
+    delta: f64,
+    /// Cost change so far minus the closing link (lower is better).
+    score: f64,
+    /// Position of t1 and the side of its new t2 after the reversal.
+    pa: isize,
+    dir: isize,
+    /// The link t3–t4 the step breaks (as unordered cell pair, D = u32::MAX).
+    broken: (u32, u32),
+    /// The link t2–t3 the step adds.
+    added: (u32, u32),
+}
+
+/// The LK search: candidate lists, chain limits and scratch space.
+#[derive(Debug, Clone)]
+pub struct Lk {
+    /// Longest chain (number of reversals).
+    pub depth: usize,
+    /// First steps tried from each t1 (the rest of a chain takes the best step).
+    pub breadth: usize,
+    /// Costs read the same backwards (reversal deltas in O(1)).
+    pub symmetric: bool,
+    added: Vec<(u32, u32)>,
+    applied: Vec<(usize, usize, f64)>,
+    cands: Vec<Step>,
+}
+
+fn pair(a: u32, b: u32) -> (u32, u32) {
+    if a < b { (a, b) } else { (b, a) }
+}
+
+fn cell_at(s: &Solution, p: isize) -> u32 {
+    if p < 0 || p as usize >= s.n() {
+        u32::MAX
+    } else {
+        s.order[p as usize]
+    }
+}
+
+/// True when reversing any feasible segment leaves its inner link costs unchanged:
+/// `arc(a, ma, b, mb) == arc(b, turn(mb), a, turn(ma))` for all nodes of cells that may
+/// share a reversible segment (tested for at most [`SYMMETRY_TEST_NODES`] nodes; larger
+/// instances count as asymmetric). Pairs with a forbidden arc ([`FORBIDDEN_ARC`], TSPLIB's
+/// −1: a precedence pair) are skipped: a reversible segment never holds both cells.
+pub fn symmetric(c: &Costs) -> bool {
+    let m = c.m;
+    if m.nodes() > SYMMETRY_TEST_NODES {
+        return false;
+    }
+    for nd_a in 0..m.nodes() {
+        let (a, ma) = m.cell_mode(nd_a);
+        let Some(ta) = flip_mode(m, a, ma) else {
+            continue;
+        };
+        for nd_b in 0..m.nodes() {
+            let (b, mb) = m.cell_mode(nd_b);
+            if a == b {
+                continue;
+            }
+            let Some(tb) = flip_mode(m, b, mb) else {
+                continue;
+            };
+            let (ab, ba) = (m.arc(a, ma, b, mb), m.arc(b, tb, a, ta));
+            if ab >= FORBIDDEN_ARC || ba >= FORBIDDEN_ARC {
+                continue;
+            }
+            if ab != ba {
+                return false;
+            }
+        }
+    }
+    true
+}
+
+impl Lk {
+    /// A search with chains of at most `depth` reversals and `breadth` first steps.
+    pub fn new(c: &Costs, depth: usize, breadth: usize) -> Self {
+        Lk {
+            depth: depth.max(1),
+            breadth: breadth.max(1),
+            symmetric: symmetric(c),
+            added: Vec::new(),
+            applied: Vec::new(),
+            cands: Vec::new(),
+        }
+    }
+
+    /// Cost change of reversing `[i..=j]` (with mode flip).
+    fn reverse_delta(&self, c: &Costs, s: &Solution, i: usize, j: usize) -> f64 {
+        let m = c.m;
+        let fl = |p: isize| -> Slot {
+            s.at(p)
+                .map(|(cell, md)| (cell, flip_mode(m, cell, md).unwrap_or(md)))
+        };
+        let (ii, jj) = (i as isize, j as isize);
+        let mut d = c.link(s.at(ii - 1), fl(jj)) + c.link(fl(ii), s.at(jj + 1))
+            - s.link(c, ii - 1, ii)
+            - s.link(c, jj, jj + 1);
+        if !self.symmetric {
+            for q in ii..jj {
+                d += c.link(fl(q + 1), fl(q)) - s.link(c, q, q + 1);
+            }
+        }
+        d
+    }
+
+    /// The step that adds a link from t2 (next to t1 at `pa` on side `dir`) to the
+    /// position `pb`, if that position gives a proper reversal.
+    #[allow(clippy::too_many_arguments)]
+    fn step(
+        &self,
+        c: &Costs,
+        s: &Solution,
+        pa: isize,
+        dir: isize,
+        pb: isize,
+        cum: f64,
+        evals: &mut u64,
+    ) -> Option<Step> {
+        let n = s.n() as isize;
+        let t2 = cell_at(s, pa + dir);
+        let t3 = cell_at(s, pb);
+        // (i, j) reversed; t4's position before the move; t1 and new t2 after it
+        let (i, j, p4, new_pa, new_dir) = if dir > 0 {
+            if pb > pa + 2 {
+                (pa + 1, pb - 1, pb - 1, pa, 1)
+            } else if pb < pa && pb >= 0 {
+                (pb, pa, pb - 1, pb, -1)
+            } else {
+                return None;
+            }
+        } else if pb < pa - 2 {
+            (pb + 1, pa - 1, pb + 1, pa, -1)
+        } else if pb > pa && pb < n {
+            (pa, pb, pb + 1, pb, 1)
+        } else {
+            return None;
+        };
+        let t4 = cell_at(s, p4);
+        *evals += 1;
+        let delta = self.reverse_delta(c, s, i as usize, j as usize);
+        let new_cum = cum + delta;
+        // the closing link t1–t4 after the move, read in its direction on the path
+        let m = c.m;
+        let (i, j) = (i as usize, j as usize);
+        let t1_after = |q: isize| -> Slot {
+            // the slot at position q after reversing [i..=j]
+            if q >= i as isize && q <= j as isize {
+                let src = i as isize + j as isize - q;
+                s.at(src)
+                    .map(|(cell, md)| (cell, flip_mode(m, cell, md).unwrap_or(md)))
+            } else {
+                s.at(q)
+            }
+        };
+        let (x, y) = if new_dir > 0 {
+            (t1_after(new_pa), t1_after(new_pa + 1))
+        } else {
+            (t1_after(new_pa - 1), t1_after(new_pa))
+        };
+        let closing = c.link(x, y);
+        let score = new_cum - closing;
+        // gain criterion: without its closing link the chain must still gain
+        if score >= 0.0 {
+            return None;
+        }
+        Some(Step {
+            i,
+            j,
+            delta,
+            score,
+            pa: new_pa,
+            dir: new_dir,
+            broken: pair(t3, t4),
+            added: pair(t2, t3),
+        })
+    }
+
+    /// The feasible steps from t1 at `pa` (t2 on side `dir`), best first, at most `want`.
+    #[allow(clippy::too_many_arguments)]
+    fn steps(
+        &mut self,
+        c: &Costs,
+        nb: &Neighbours,
+        s: &Solution,
+        pa: isize,
+        dir: isize,
+        cum: f64,
+        want: usize,
+        evals: &mut u64,
+    ) -> Vec<Step> {
+        let n = s.n() as isize;
+        let p2 = pa + dir;
+        if p2 < 0 || p2 >= n {
+            return Vec::new();
+        }
+        let t2 = s.order[p2 as usize] as usize;
+        self.cands.clear();
+        let end = if dir > 0 { n } else { -1 };
+        let positions = nb.out[t2]
+            .iter()
+            .chain(nb.inn[t2].iter())
+            .map(|&w| s.pos[w as usize] as isize)
+            .chain([end]);
+        for pb in positions {
+            if let Some(st) = self.step(c, s, pa, dir, pb, cum, evals)
+                && !self.added.contains(&st.broken)
+            {
+                self.cands.push(st);
+            }
+        }
+        self.cands
+            .sort_by(|a, b| a.score.total_cmp(&b.score).then(a.i.cmp(&b.i)));
+        self.cands.dedup_by(|a, b| a.i == b.i && a.j == b.j);
+        let m = c.m;
+        self.cands
+            .iter()
+            .filter(|st| reversible_segment(m, s, st.i, st.j - st.i + 1))
+            .take(want)
+            .copied()
+            .collect()
+    }
+
+    /// Runs chains from t1 at `pa` towards side `dir`, trying the `breadth` best first
+    /// steps; keeps the best prefix of the first chain that improves `s` (returns true) and
+    /// undoes the others. Cells at the ends of the kept reversals go to `touched`.
+    #[allow(clippy::too_many_arguments)]
+    fn chain(
+        &mut self,
+        c: &Costs,
+        nb: &Neighbours,
+        s: &mut Solution,
+        pa: isize,
+        dir: isize,
+        evals: &mut u64,
+        touched: &mut Vec<u32>,
+    ) -> bool {
+        let n = s.n() as isize;
+        let m = c.m;
+        let start_cost = s.cost;
+        self.added.clear();
+        let firsts = self.steps(c, nb, s, pa, dir, 0.0, self.breadth, evals);
+        for first in firsts {
+            self.added.clear();
+            self.applied.clear();
+            let mut st = first;
+            let mut cum = 0.0;
+            let mut best = (0.0, 0usize);
+            loop {
+                s.reverse(m, st.i, st.j, st.delta);
+                self.applied.push((st.i, st.j, st.delta));
+                self.added.push(st.added);
+                cum += st.delta;
+                if cum < best.0 {
+                    best = (cum, self.applied.len());
+                }
+                if self.applied.len() >= self.depth {
+                    break;
+                }
+                match self.steps(c, nb, s, st.pa, st.dir, cum, 1, evals).first() {
+                    Some(&next) => st = next,
+                    None => break,
+                }
+            }
+            let keep = if improves(best.0, start_cost) {
+                best.1
+            } else {
+                0
+            };
+            while self.applied.len() > keep {
+                let (i, j, d) = self.applied.pop().expect("non-empty");
+                s.reverse(m, i, j, -d);
+            }
+            if keep == 0 {
+                s.cost = start_cost;
+                continue;
+            }
+            for &(i, j, _) in &self.applied {
+                for p in [i as isize - 1, i as isize, j as isize, j as isize + 1] {
+                    if p >= 0 && p < n {
+                        touched.push(s.order[p as usize]);
+                    }
+                }
+            }
+            return true;
+        }
+        false
+    }
+
+    /// LK to a local optimum starting from the cells `seeds` (don't-look bits on all
+    /// others; cells next to an applied chain are looked at again). Returns true on any
+    /// improvement.
+    pub fn improve(
+        &mut self,
+        c: &Costs,
+        nb: &Neighbours,
+        s: &mut Solution,
+        ctx: &mut Context,
+        seeds: &[u32],
+    ) -> bool {
+        let n = s.n();
+        if n < 4 {
+            return false;
+        }
+        let mut on = vec![false; n];
+        let mut queue: VecDeque<u32> = VecDeque::with_capacity(seeds.len());
+        for &x in seeds {
+            if !on[x as usize] {
+                on[x as usize] = true;
+                queue.push_back(x);
+            }
+        }
+        let mut touched = Vec::new();
+        let mut improved = false;
+        while let Some(x) = queue.pop_front() {
+            on[x as usize] = false;
+            if ctx.exhausted() {
+                break;
+            }
+            let mut evals = 0;
+            let mut found = false;
+            for dir in [1, -1] {
+                let pa = s.pos[x as usize] as isize;
+                touched.clear();
+                if self.chain(c, nb, s, pa, dir, &mut evals, &mut touched) {
+                    found = true;
+                    break;
+                }
+            }
+            ctx.count(evals);
+            if found {
+                improved = true;
+                touched.push(x);
+                for &t in &touched {
+                    if !on[t as usize] {
+                        on[t as usize] = true;
+                        queue.push_back(t);
+                    }
+                }
+            }
+        }
+        improved
+    }
+
+    /// LK to a local optimum from every cell.
+    pub fn improve_all(
+        &mut self,
+        c: &Costs,
+        nb: &Neighbours,
+        s: &mut Solution,
+        ctx: &mut Context,
+    ) -> bool {
+        let all: Vec<u32> = s.order.clone();
+        self.improve(c, nb, s, ctx, &all)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::cost::CostModel;
+    use crate::engine::search::Search;
+    use crate::model::{Instance, Objective, Sequence, Visit};
+    use crate::solvers::{Budget, NoObserver, Params};
+    use rand::{RngExt, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+
+    /// A random TSPLIB SOP instance (symmetric or not): each pair a < b is ordered with
+    /// probability 0.03 (so the identity order is feasible).
+    fn instance(n: usize, seed: u64, sym: bool) -> Instance {
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        let mut w = vec![vec![0i64; n]; n];
+        for i in 0..n {
+            for j in 0..n {
+                if i != j {
+                    w[i][j] = rng.random_range(1..500);
+                }
+            }
+        }
+        for i in 0..n {
+            for j in 0..i {
+                if sym {
+                    w[j][i] = w[i][j];
+                }
+                if rng.random_bool(0.03) {
+                    w[i][j] = -1;
+                }
+            }
+        }
+        let mut text = format!(
+            "NAME: t\nTYPE: SOP\nDIMENSION: {n}\nEDGE_WEIGHT_TYPE: EXPLICIT\nEDGE_WEIGHT_FORMAT: FULL_MATRIX\nEDGE_WEIGHT_SECTION\n{n}\n"
+        );
+        for row in &w {
+            for v in row {
+                text.push_str(&format!("{v} "));
+            }
+            text.push('\n');
+        }
+        text.push_str("EOF\n");
+        crate::formats::tsplib::parse_sop("t.sop", &text).expect("valid instance")
+    }
+
+    fn descend(inst: &Instance, depth: usize) -> (f64, f64, Vec<u32>, bool) {
+        let m = CostModel::new(inst, Objective::Matrix);
+        let c = Costs::open(&m);
+        let params = Params::new("t", &[], &Default::default()).expect("params");
+        let mut obs = NoObserver;
+        let mut ctx = Context::new(inst, &m, &params, 1, Budget::default(), &mut obs);
+        let seq: Sequence = (0..inst.n()).map(|c| Visit::new(c, 0)).collect();
+        let mut s = Solution::new(&c, &seq);
+        let start = s.cost;
+        let search = Search::new(c, 8);
+        let mut lk = Lk::new(&c, depth, 3);
+        let mut rounds = 0;
+        while lk.improve_all(&c, &search.nb, &mut s, &mut ctx) {
+            // every kept chain: feasible, and the cached cost equals a full re-evaluation
+            assert!(s.feasible(&m));
+            assert!((s.cost - s.evaluate(&c)).abs() < 1e-6);
+            rounds += 1;
+            assert!(rounds < 1000);
+        }
+        assert!(s.feasible(&m));
+        assert!((s.cost - s.evaluate(&c)).abs() < 1e-6);
+        (start, s.cost, s.order.clone(), lk.symmetric)
+    }
+
+    #[test]
+    fn symmetry_is_detected() {
+        let m = CostModel::new(&instance(30, 1, true), Objective::Matrix);
+        assert!(symmetric(&Costs::open(&m)));
+        let m = CostModel::new(&instance(30, 1, false), Objective::Matrix);
+        assert!(!symmetric(&Costs::open(&m)));
+    }
+
+    #[test]
+    fn chains_stay_feasible_consistent_and_improve() {
+        for seed in 0..4 {
+            for sym in [true, false] {
+                let inst = instance(60, seed, sym);
+                let (start, end, _, detected) = descend(&inst, 10);
+                assert_eq!(detected, sym);
+                // a random order of random costs is far from any LK optimum
+                assert!(end < 0.7 * start, "seed {seed} sym {sym}: {start} -> {end}");
+            }
+        }
+    }
+
+    #[test]
+    fn undone_chains_leave_the_solution_untouched_and_runs_repeat() {
+        let inst = instance(50, 7, true);
+        let a = descend(&inst, 8);
+        let b = descend(&inst, 8);
+        assert_eq!(a.2, b.2);
+        assert_eq!(a.1, b.1);
+        // at an LK optimum a further pass changes nothing
+        let m = CostModel::new(&inst, Objective::Matrix);
+        let c = Costs::open(&m);
+        let params = Params::new("t", &[], &Default::default()).expect("params");
+        let mut obs = NoObserver;
+        let mut ctx = Context::new(&inst, &m, &params, 1, Budget::default(), &mut obs);
+        let seq: Sequence = a.2.iter().map(|&c| Visit::new(c as usize, 0)).collect();
+        let mut s = Solution::new(&c, &seq);
+        let before = s.clone();
+        let search = Search::new(c, 8);
+        let mut lk = Lk::new(&c, 8, 3);
+        assert!(!lk.improve_all(&c, &search.nb, &mut s, &mut ctx));
+        assert_eq!(s, before);
+    }
+}
