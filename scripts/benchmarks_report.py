@@ -382,7 +382,7 @@ def main():
                 f"{air:.0f} | {ga:.0f} | {air / ga:.3f} | {float(r['elapsed_s']):.2f} | "
                 f"{float(r['solver_s']):.2f} | {float(r['peak_rss_mib']):.0f} |"
             )
-            if r["n"] == "1000000" and r["solver"] != "greedy":
+            if r["n"] == "1000000" and r["solver"] == "local-search":
                 t, m = float(r["solver_s"]), float(r["peak_rss_mib"])
                 targets.append(
                     (

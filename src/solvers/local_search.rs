@@ -38,6 +38,12 @@ pub static INFO: SolverInfo = SolverInfo {
             help: "random feasible Or-opt moves per kick",
         },
         ParamSpec {
+            name: "vnd",
+            default: "true",
+            kind: ParamKind::Bool,
+            help: "false = stop after the start and the linked-list Or-opt pass (where it applies): greedy plus one O(1)-per-move improvement pass",
+        },
+        ParamSpec {
             name: "max-block",
             default: "0",
             kind: ParamKind::Int,
@@ -52,6 +58,7 @@ pub static INFO: SolverInfo = SolverInfo {
             strength,
             k: p.int("k").max(1) as usize,
             max_block: p.int("max-block") as usize,
+            vnd: p.bool("vnd"),
         })
     },
 };
@@ -70,6 +77,8 @@ pub struct LocalSearch {
     pub kicks: u64,
     /// Random Or-opt moves per kick.
     pub strength: usize,
+    /// Run the VND (false: only the start and the linked-list Or-opt pass).
+    pub vnd: bool,
 }
 
 impl Solver for LocalSearch {
@@ -88,6 +97,9 @@ impl Solver for LocalSearch {
             // O(1) Or-opt moves first: on the array every move shifts the cells in between
             linked::or_opt(&c, &search.nb, &mut s, ctx);
             ctx.report(s.cost + m.constant());
+        }
+        if !self.vnd {
+            return Ok(outcome(m, &s));
         }
         search.vnd(&mut s, ctx);
         ctx.report(s.cost + m.constant());
