@@ -12,6 +12,33 @@ use cellseq::solvers::greedy;
 use proptest::prelude::*;
 use std::collections::BTreeMap;
 
+/// A `uniform` instance: 30 % closed cells, two layers.
+fn instance(
+    seed: u64,
+    n: usize,
+    modes: usize,
+    tools: usize,
+    density: f64,
+    reversible: bool,
+    return_home: bool,
+) -> cellseq::model::Instance {
+    let kv: BTreeMap<String, String> = [
+        ("n", n.to_string()),
+        ("modes", modes.to_string()),
+        ("closed", "0.3".to_string()),
+        ("tools", tools.to_string()),
+        ("layers", "2".to_string()),
+        ("density", density.to_string()),
+        ("reversible", reversible.to_string()),
+    ]
+    .into_iter()
+    .map(|(k, v)| (k.to_string(), v))
+    .collect();
+    let mut inst = generate("uniform", &kv, seed).unwrap();
+    inst.machine.return_home = return_home;
+    inst
+}
+
 fn model(
     seed: u64,
     n: usize,
@@ -20,19 +47,7 @@ fn model(
     density: f64,
     return_home: bool,
 ) -> CostModel {
-    let kv: BTreeMap<String, String> = [
-        ("n", n.to_string()),
-        ("modes", modes.to_string()),
-        ("closed", "0.3".to_string()),
-        ("tools", tools.to_string()),
-        ("layers", "2".to_string()),
-        ("density", density.to_string()),
-    ]
-    .into_iter()
-    .map(|(k, v)| (k.to_string(), v))
-    .collect();
-    let mut inst = generate("uniform", &kv, seed).unwrap();
-    inst.machine.return_home = return_home;
+    let inst = instance(seed, n, modes, tools, density, true, return_home);
     CostModel::new(&inst, inst.default_objective())
 }
 
@@ -196,19 +211,7 @@ proptest! {
                               shuffle in prop::collection::vec(any::<u64>(), 50)) {
         use cellseq::engine::{Neighbours, linked};
         use cellseq::solvers::{Budget, Context, NoObserver};
-        let kv: BTreeMap<String, String> = [
-            ("n", n.to_string()),
-            ("modes", modes.to_string()),
-            ("closed", "0.3".to_string()),
-            ("tools", tools.to_string()),
-            ("layers", "2".to_string()),
-            ("reversible", reversible.to_string()),
-        ]
-        .into_iter()
-        .map(|(k, v)| (k.to_string(), v))
-        .collect();
-        let mut inst = generate("uniform", &kv, seed).unwrap();
-        inst.machine.return_home = rh;
+        let inst = instance(seed, n, modes, tools, 0.0, reversible, rh);
         let m = CostModel::new(&inst, inst.default_objective());
         let c = Costs::open(&m);
         prop_assert!(linked::applies(&c));

@@ -49,6 +49,22 @@ impl List {
     }
 }
 
+/// Cells v after which a segment entered at `head` and left at `tail` may be inserted
+/// (between v and its successor): candidate predecessors of `head`, the predecessors of
+/// candidate successors of `tail`, and the sentinel (insertion at the start).
+fn insertion_points<'a>(
+    nb: &'a Neighbours,
+    l: &'a List,
+    head: u32,
+    tail: u32,
+) -> impl Iterator<Item = u32> + 'a {
+    nb.inn[head as usize]
+        .iter()
+        .copied()
+        .chain(nb.out[tail as usize].iter().map(|&w| l.prev[w as usize]))
+        .chain([l.mode.len() as u32])
+}
+
 /// A move found for a looked-at cell.
 #[derive(Clone, Copy)]
 struct Found {
@@ -146,12 +162,7 @@ pub fn or_opt(c: &Costs, nb: &Neighbours, s: &mut Solution, ctx: &mut Context) -
             let (rf, rl) = (seg_modes[0], seg_modes[len - 1]);
             // candidate insertion edges (v, w = next v), forward: v → f … lst → w;
             // reversed: v → lst' … f' → w
-            let fwd = nb.inn[f as usize]
-                .iter()
-                .copied()
-                .chain(nb.out[lst as usize].iter().map(|&w| l.prev[w as usize]))
-                .chain([d]);
-            for v in fwd {
+            for v in insertion_points(nb, &l, f, lst) {
                 let w = l.next[v as usize];
                 if inside(v) || inside(w) || v == p {
                     continue;
@@ -172,12 +183,7 @@ pub fn or_opt(c: &Costs, nb: &Neighbours, s: &mut Solution, ctx: &mut Context) -
                 }
             }
             if can_rev && (len > 1 || rf != mf) {
-                let bwd = nb.inn[lst as usize]
-                    .iter()
-                    .copied()
-                    .chain(nb.out[f as usize].iter().map(|&w| l.prev[w as usize]))
-                    .chain([d]);
-                for v in bwd {
+                for v in insertion_points(nb, &l, lst, f) {
                     let w = l.next[v as usize];
                     // v == p (then w == f) reverses the segment in place
                     if inside(v) || (v != p && inside(w)) {
@@ -217,7 +223,7 @@ pub fn or_opt(c: &Costs, nb: &Neighbours, s: &mut Solution, ctx: &mut Context) -
         }
         improved = true;
         s.cost += best.delta;
-        let mut touched = [d; 9];
+        let mut touched = [d; 7];
         if best.v == u32::MAX {
             l.mode[x as usize] = best.w;
             touched[..3].copy_from_slice(&[l.prev[x as usize], x, l.next[x as usize]]);
@@ -244,13 +250,12 @@ pub fn or_opt(c: &Costs, nb: &Neighbours, s: &mut Solution, ctx: &mut Context) -
             };
             l.next[p as usize] = q;
             l.prev[q as usize] = p;
-            let order: Vec<u32> = if best.rev {
-                cells[..k].iter().rev().copied().collect()
-            } else {
-                cells[..k].to_vec()
-            };
+            let mut order = cells;
+            if best.rev {
+                order[..k].reverse();
+            }
             let mut a = v;
-            for &z in &order {
+            for &z in &order[..k] {
                 if best.rev {
                     let md = l.mode[z as usize] as usize;
                     l.mode[z as usize] = m.turned(z as usize, md).unwrap_or(md) as u32;

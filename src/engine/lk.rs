@@ -16,8 +16,8 @@
 //! On instances whose costs read the same backwards (a symmetric matrix: TSPLIB's prob.100)
 //! a step is evaluated in O(1); otherwise the segment's inner links are summed, O(length).
 
-use super::moves::reversible_segment;
-use super::search::improves;
+use super::moves::{reverse_delta_direct, reverse_delta_ends, reversible_segment};
+use super::search::{Search, improves};
 use super::solution::flip_mode;
 use super::{Costs, Neighbours, Slot, Solution};
 use crate::formats::tsplib::FORBIDDEN_ARC;
@@ -108,6 +108,25 @@ pub fn symmetric(c: &Costs) -> bool {
 }
 
 impl Lk {
+    /// The search a solver's `lk` parameter asks for: `Some(false)` none, `Some(true)` always,
+    /// `None` (auto) only on symmetric costs.
+    pub fn when(mode: Option<bool>, c: &Costs, depth: usize, breadth: usize) -> Option<Self> {
+        match mode {
+            Some(false) => None,
+            _ => Some(Lk::new(c, depth, breadth)),
+        }
+        .filter(|l| mode == Some(true) || l.symmetric)
+    }
+
+    /// Alternates LK from every cell with `search`'s VND until LK finds nothing or the budget
+    /// ends (the polish of a new best).
+    pub fn alternate_with_vnd(&mut self, search: &mut Search, s: &mut Solution, ctx: &mut Context) {
+        let c = search.c;
+        while self.improve_all(&c, &search.nb, s, ctx) && !ctx.exhausted() {
+            search.vnd(s, ctx);
+        }
+    }
+
     /// A search with chains of at most `depth` reversals and `breadth` first steps.
     pub fn new(c: &Costs, depth: usize, breadth: usize) -> Self {
         Lk {
@@ -120,23 +139,14 @@ impl Lk {
         }
     }
 
-    /// Cost change of reversing `[i..=j]` (with mode flip).
+    /// Cost change of reversing `[i..=j]` (with mode flip): only the two boundary links
+    /// change on symmetric costs, else the segment's inner links are summed.
     fn reverse_delta(&self, c: &Costs, s: &Solution, i: usize, j: usize) -> f64 {
-        let m = c.m;
-        let fl = |p: isize| -> Slot {
-            s.at(p)
-                .map(|(cell, md)| (cell, flip_mode(m, cell, md).unwrap_or(md)))
-        };
-        let (ii, jj) = (i as isize, j as isize);
-        let mut d = c.link(s.at(ii - 1), fl(jj)) + c.link(fl(ii), s.at(jj + 1))
-            - s.link(c, ii - 1, ii)
-            - s.link(c, jj, jj + 1);
-        if !self.symmetric {
-            for q in ii..jj {
-                d += c.link(fl(q + 1), fl(q)) - s.link(c, q, q + 1);
-            }
+        if self.symmetric {
+            reverse_delta_ends(c, s, i, j)
+        } else {
+            reverse_delta_direct(c, s, i, j)
         }
-        d
     }
 
     /// The step that adds a link from t2 (next to t1 at `pa` on side `dir`) to the

@@ -352,17 +352,24 @@ pub fn mode_delta(c: &Costs, s: &Solution, p: usize, mode: usize) -> f64 {
 /// Delta of reversing `[i..=j]` with mode flip, computed over the segment, O(j − i).
 /// Valid when [`reversible_segment`] holds for the segment.
 pub fn reverse_delta_direct(c: &Costs, s: &Solution, i: usize, j: usize) -> f64 {
-    let m = c.m;
-    let fl = |p: isize| -> Slot {
-        s.at(p)
-            .map(|(cell, md)| (cell, flip_mode(m, cell, md).unwrap_or(md)))
-    };
-    let (ii, jj) = (i as isize, j as isize);
-    let mut d = c.link(s.at(ii - 1), fl(jj)) + c.link(fl(ii), s.at(jj + 1))
-        - s.link(c, ii - 1, ii)
-        - s.link(c, jj, jj + 1);
-    for q in ii..jj {
-        d += c.link(fl(q + 1), fl(q)) - s.link(c, q, q + 1);
+    let mut d = reverse_delta_ends(c, s, i, j);
+    for q in i as isize..j as isize {
+        d += c.link(flipped_at(c, s, q + 1), flipped_at(c, s, q)) - s.link(c, q, q + 1);
     }
     d
+}
+
+/// The part of [`reverse_delta_direct`] at the segment's two boundary links: the whole delta
+/// when reversal leaves inner link costs unchanged (symmetric costs).
+pub fn reverse_delta_ends(c: &Costs, s: &Solution, i: usize, j: usize) -> f64 {
+    let (ii, jj) = (i as isize, j as isize);
+    c.link(s.at(ii - 1), flipped_at(c, s, jj)) + c.link(flipped_at(c, s, ii), s.at(jj + 1))
+        - s.link(c, ii - 1, ii)
+        - s.link(c, jj, jj + 1)
+}
+
+/// The (cell, mode) at position `p` cut the other way (its mode unchanged if it has none).
+fn flipped_at(c: &Costs, s: &Solution, p: isize) -> Slot {
+    s.at(p)
+        .map(|(cell, md)| (cell, flip_mode(c.m, cell, md).unwrap_or(md)))
 }

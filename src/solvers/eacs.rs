@@ -345,15 +345,9 @@ impl Eacs {
         };
         let mut search = Search::new(c, self.k);
         search.vnd(&mut best, ctx);
-        let mut lk = match self.lk {
-            Some(false) => None,
-            _ => Some(Lk::new(&c, 12, 3)),
-        }
-        .filter(|l| self.lk == Some(true) || l.symmetric);
+        let mut lk = Lk::when(self.lk, &c, 12, 3);
         if let Some(lk) = lk.as_mut() {
-            while lk.improve_all(&c, &search.nb, &mut best, ctx) && !ctx.exhausted() {
-                search.vnd(&mut best, ctx);
-            }
+            lk.alternate_with_vnd(&mut search, &mut best, ctx);
         }
         ctx.report(best.cost + m.constant());
         if n < 3 {
@@ -419,9 +413,7 @@ impl Eacs {
                 if s.cost < best.cost - 1e-9 * best.cost.abs().max(1.0) {
                     search.vnd(&mut s, ctx);
                     if let Some(lk) = lk.as_mut() {
-                        while lk.improve_all(&c, &search.nb, &mut s, ctx) && !ctx.exhausted() {
-                            search.vnd(&mut s, ctx);
-                        }
+                        lk.alternate_with_vnd(&mut search, &mut s, ctx);
                     }
                     best = s;
                     ctx.report(best.cost + m.constant());

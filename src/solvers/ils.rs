@@ -308,15 +308,9 @@ impl Ils {
         };
         let mut search = Search::new(c, self.k);
         search.vnd(&mut cur, ctx);
-        let mut lk = match self.lk {
-            Some(false) => None,
-            _ => Some(Lk::new(&c, self.lk_depth, self.lk_breadth)),
-        }
-        .filter(|l| self.lk == Some(true) || l.symmetric);
+        let mut lk = Lk::when(self.lk, &c, self.lk_depth, self.lk_breadth);
         if let Some(lk) = lk.as_mut() {
-            while lk.improve_all(&c, &search.nb, &mut cur, ctx) && !ctx.exhausted() {
-                search.vnd(&mut cur, ctx);
-            }
+            lk.alternate_with_vnd(&mut search, &mut cur, ctx);
         }
         let mut best = cur.clone();
         ctx.report(best.cost + m.constant());
@@ -383,9 +377,7 @@ impl Ils {
                 // polish a new best with the full descent before keeping it
                 search.vnd(&mut trial, ctx);
                 if let Some(lk) = lk.as_mut() {
-                    while lk.improve_all(&c, &search.nb, &mut trial, ctx) && !ctx.exhausted() {
-                        search.vnd(&mut trial, ctx);
-                    }
+                    lk.alternate_with_vnd(&mut search, &mut trial, ctx);
                 }
                 best.clone_from(&trial);
                 ctx.report(best.cost + m.constant());
