@@ -2,7 +2,7 @@
 //!
 //! [`CostModel`] flattens the modes of all cells into *nodes* and answers `start`, `arc` and
 //! `finish` costs for the chosen [`Objective`], for geometric and matrix instances alike.
-//! It is the solvers' incremental evaluator; the independent checker in [`crate::check`]
+//! It is the solvers' incremental evaluator; the independent checker in [`crate::check()`]
 //! recomputes everything from the raw instance without using this module.
 
 use crate::geom::Point3;

@@ -229,6 +229,10 @@ pub struct CostMatrix {
 }
 
 impl CostMatrix {
+    /// Cost stored for arcs that precedence forbids (TSPLIB files mark them −1). Any cost at
+    /// or above it is an arc no feasible sequence uses.
+    pub const FORBIDDEN: f64 = 1.0e9;
+
     /// Cost from node `a` to node `b`.
     #[inline]
     pub fn get(&self, a: usize, b: usize) -> f64 {

@@ -20,7 +20,7 @@ use super::moves::{reverse_delta_direct, reverse_delta_ends, reversible_segment}
 use super::search::{Search, improves};
 use super::solution::flip_mode;
 use super::{Costs, Neighbours, Slot, Solution};
-use crate::formats::tsplib::FORBIDDEN_ARC;
+use crate::model::CostMatrix;
 use crate::solvers::Context;
 use std::collections::VecDeque;
 
@@ -74,8 +74,8 @@ fn cell_at(s: &Solution, p: isize) -> u32 {
 
 /// True when reversing any feasible segment leaves its inner link costs unchanged:
 /// `arc(a, ma, b, mb) == arc(b, turn(mb), a, turn(ma))` for all nodes of cells that may
-/// share a reversible segment (tested for at most [`SYMMETRY_TEST_NODES`] nodes; larger
-/// instances count as asymmetric). Pairs with a forbidden arc ([`FORBIDDEN_ARC`], TSPLIB's
+/// share a reversible segment (tested for at most `SYMMETRY_TEST_NODES` nodes; larger
+/// instances count as asymmetric). Pairs with a forbidden arc ([`CostMatrix::FORBIDDEN`], TSPLIB's
 /// −1: a precedence pair) are skipped: a reversible segment never holds both cells.
 pub fn symmetric(c: &Costs) -> bool {
     let m = c.m;
@@ -96,7 +96,7 @@ pub fn symmetric(c: &Costs) -> bool {
                 continue;
             };
             let (ab, ba) = (m.arc(a, ma, b, mb), m.arc(b, tb, a, ta));
-            if ab >= FORBIDDEN_ARC || ba >= FORBIDDEN_ARC {
+            if ab >= CostMatrix::FORBIDDEN || ba >= CostMatrix::FORBIDDEN {
                 continue;
             }
             if ab != ba {

@@ -5,7 +5,7 @@ use crate::model::{Cell, CostMatrix, Instance, Metadata, Mode};
 use std::collections::BTreeSet;
 
 /// Cost stored for arcs that precedence forbids (the files mark them −1).
-pub const FORBIDDEN_ARC: f64 = 1.0e9;
+pub const FORBIDDEN_ARC: f64 = CostMatrix::FORBIDDEN;
 
 /// A whitespace token with its 1-based line number.
 struct Tokens<'a> {

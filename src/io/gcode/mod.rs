@@ -3,7 +3,7 @@
 //!
 //! Pipeline: [`lex`] tokenizes lines, [`interp`] executes them with full modal state and lists
 //! every cutting move, [`cells`] splits the program (header, tool blocks, cells, footer) and
-//! derives the default precedence, [`write`] re-emits it, [`verify`] compares the cutting moves
+//! derives the default precedence, [`write`](mod@write) re-emits it, [`verify`] compares the cutting moves
 //! of two programs as multisets and measures air travel.
 
 pub mod cells;

@@ -2,8 +2,8 @@
 //! stroke colour) with a registry solver, optionally reversing them, write the drawing back
 //! in the new order and verify that it draws exactly the same segments.
 //!
-//! [`read`] parses the file (every subpath of every shape is one [`Stroke`], curves flattened
-//! within a tolerance, transforms applied), [`optimize`] sequences, [`write`] emits one
+//! [`read()`] parses the file (every subpath of every shape is one [`Stroke`], curves flattened
+//! within a tolerance, transforms applied), [`optimize`] sequences, [`write()`] emits one
 //! `<path>` per stroke grouped per layer, [`verify`] compares the multisets of segments
 //! (direction-insensitive, per layer label, stroke colour and width).
 
