@@ -5,11 +5,12 @@
 #   --quick    experiments/sop-quick.toml (auto, 1 s, 1 seed), pcgtsp-quick.toml (auto, 2 s,
 #              1 seed), scale.toml and the 10^6 probes: ~5 min on 2 cores.
 #   --session  (default) what the committed results/benchmarks.md was made from: --quick plus
-#              sop-auto-10s.toml (auto, 10 s, 1 seed, ~7 min): ~12 min.
+#              sop-auto-10s.toml (auto, 10 s, 1 seed, ~7 min) and sop-solvers-1s.toml (auto,
+#              local-search, aco, ils, eacs; 1 s; 3 seeds; ~10 min): ~30 min.
 #   --median   --session plus sop-auto-5x10s.toml (auto, 10 s, median of 5 seeds, ~35 min):
-#              the protocol for the default solver: ~47 min.
-#   --full     the protocol: sop.toml (auto, local-search, aco, ils; 10 s; 5 seeds;
-#              ~2.3 h), pcgtsp.toml (auto; 10 s; 5 seeds; ~30 min), scale.toml, probes.
+#              the protocol for the default solver: ~65 min.
+#   --full     the protocol: sop.toml (auto, local-search, aco, ils, eacs; 10 s;
+#              5 seeds; ~2.8 h), pcgtsp.toml (auto; 10 s; 5 seeds; ~30 min), scale.toml, probes.
 #   --report-only  do not run anything; rewrite results/benchmarks.md from existing results.
 # Every plan runs with `cellseq run PLAN --threads 1` (one trial at a time, one thread each).
 # Finished trials are skipped on a rerun (the harness resumes), so a rerun only fills gaps;
@@ -32,8 +33,8 @@ for a in "$@"; do
 done
 case "$mode" in
   quick) plans=(sop-quick pcgtsp-quick scale) ;;
-  session) plans=(sop-auto-10s sop-quick pcgtsp-quick scale) ;;
-  median) plans=(sop-auto-5x10s sop-auto-10s sop-quick pcgtsp-quick scale) ;;
+  session) plans=(sop-auto-10s sop-quick sop-solvers-1s pcgtsp-quick scale) ;;
+  median) plans=(sop-auto-5x10s sop-auto-10s sop-quick sop-solvers-1s pcgtsp-quick scale) ;;
   full) plans=(sop sop-quick pcgtsp scale) ;;
 esac
 py=${PYTHON:-python3}
