@@ -26,7 +26,18 @@ fn plans_parse_and_bad_plans_are_rejected() {
     assert_eq!(p[1].solver, "eacs");
     assert!(p[1].chained && !p[0].chained);
     assert!((p[0].share - 0.3).abs() < 1e-12);
+    assert!(p[0].params.is_empty());
+    let p = parse_plan("local-search[kicks=0; k=8]:0.3,ils[accept=0.01]*:1").unwrap();
+    assert_eq!(p[0].solver, "local-search");
+    assert_eq!(p[0].params.get("kicks").map(String::as_str), Some("0"));
+    assert_eq!(p[0].params.get("k").map(String::as_str), Some("8"));
+    assert!(p[1].chained && p[1].solver == "ils");
+    assert_eq!(p[1].params.get("accept").map(String::as_str), Some("0.01"));
     for bad in [
+        "local-search[kicks=0:0.3",
+        "local-search[kicks]:0.3",
+        "local-search[nosuch=1]:0.3",
+        "local-search[kicks=x]:0.3",
         "",
         "ils",
         "ils:0",

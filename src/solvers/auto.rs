@@ -55,7 +55,7 @@ pub static INFO: SolverInfo = SolverInfo {
             name: "plan",
             default: PLAN,
             kind: ParamKind::Text,
-            help: "phases after the beam: solver:share,... (share of what is left; a '*' after the name starts ils/eacs from the best so far)",
+            help: "phases after the beam: solver[key=value;...]:share,... (share of what is left; optional parameters in brackets; a '*' after the name starts ils/eacs from the best so far)",
         },
     ],
     make: |p: &Params| {
@@ -77,7 +77,7 @@ pub struct Auto {
     pub beam_share: f64,
     /// Largest instance for the beam phase.
     pub beam_max_cells: usize,
-    /// Phases after the beam (`solver[*]:share,...`).
+    /// Phases after the beam (`solver[key=value;...][*]:share,...`).
     pub plan: String,
     /// Shortest wall-clock budget that gets a beam phase.
     pub beam_min_seconds: f64,
@@ -95,9 +95,12 @@ pub struct Phase {
     pub share: f64,
     /// Start from the best sequence so far (ils and eacs only).
     pub chained: bool,
+    /// The phase's own solver parameters (`solver[key=value;...]`), validated.
+    pub params: BTreeMap<String, String>,
 }
 
-/// Parses a plan `solver[*]:share,...`.
+/// Parses a plan `solver[key=value;...][*]:share,...` (parameters in brackets are optional and
+/// checked against the solver's declared parameters).
 pub fn parse_plan(plan: &str) -> Result<Vec<Phase>> {
     let bad = |msg: String| Error::Solver {
         solver: "auto".to_string(),
@@ -115,14 +118,33 @@ pub fn parse_plan(plan: &str) -> Result<Vec<Phase>> {
             .filter(|v: &f64| v.is_finite() && *v > 0.0 && *v <= 1.0)
             .ok_or_else(|| bad(format!("plan phase '{part}': share must be in (0, 1]")))?;
         let name = name.trim();
-        let (solver, chained) = match name.strip_suffix('*') {
-            Some(b) => (b.to_string(), true),
-            None => (name.to_string(), false),
+        let (name, chained) = match name.strip_suffix('*') {
+            Some(b) => (b.trim_end(), true),
+            None => (name, false),
+        };
+        let (solver, params) = match name.split_once('[') {
+            Some((solver, rest)) => {
+                let body = rest.strip_suffix(']').ok_or_else(|| {
+                    bad(format!(
+                        "plan phase '{part}': parameters are written solver[key=value;...]"
+                    ))
+                })?;
+                let mut params = BTreeMap::new();
+                for kv in body.split(';').map(str::trim).filter(|kv| !kv.is_empty()) {
+                    let (k, v) = kv.split_once('=').ok_or_else(|| {
+                        bad(format!("plan phase '{part}': '{kv}' is not key=value"))
+                    })?;
+                    params.insert(k.trim().to_string(), v.trim().to_string());
+                }
+                (solver.trim().to_string(), params)
+            }
+            None => (name.to_string(), BTreeMap::new()),
         };
         if solver == "auto" {
             return Err(bad("a plan cannot contain auto itself".to_string()));
         }
-        super::find(&solver)?;
+        let info = super::find(&solver)?;
+        Params::new(&solver, info.params, &params)?;
         if chained && solver != "ils" && solver != "eacs" {
             return Err(bad(format!(
                 "plan phase '{part}': only ils and eacs can start from the best so far"
@@ -132,6 +154,7 @@ pub fn parse_plan(plan: &str) -> Result<Vec<Phase>> {
             solver,
             share,
             chained,
+            params,
         });
     }
     if out.is_empty() {
@@ -157,11 +180,12 @@ impl Auto {
         &self,
         ctx: &mut Context,
         name: &str,
+        given: &BTreeMap<String, String>,
         budget: Budget,
         start: Option<&Outcome>,
     ) -> Result<Outcome> {
         let info = super::find(name)?;
-        let params = Params::new(name, info.params, &BTreeMap::new())?;
+        let params = Params::new(name, info.params, given)?;
         let solver = (info.make)(&params);
         let mut quiet = NoObserver;
         let mut sub = ctx.sub(&params, budget, &mut quiet);
@@ -199,7 +223,7 @@ impl Solver for Auto {
             .is_some_and(|t| t.as_secs_f64() < self.beam_min_seconds);
         if ctx.model.n() <= self.beam_max_cells && self.beam_share > 0.0 && !short {
             let b = share(budget, 0, 0.0, self.beam_share);
-            if let Ok(o) = self.phase(ctx, "beam", b, None) {
+            if let Ok(o) = self.phase(ctx, "beam", &BTreeMap::new(), b, None) {
                 if o.proven_optimal {
                     return Ok(o);
                 }
@@ -209,7 +233,7 @@ impl Solver for Auto {
         for ph in &plan {
             let b = share(budget, ctx.evaluations(), ctx.elapsed(), ph.share);
             let start = if ph.chained { best.as_ref() } else { None };
-            let o = self.phase(ctx, &ph.solver, b, start)?;
+            let o = self.phase(ctx, &ph.solver, &ph.params, b, start)?;
             keep(&mut best, o);
         }
         let mut out = best.expect("at least one phase ran");
