@@ -245,3 +245,100 @@ proptest! {
         prop_assert!(close(r.cost, s.cost + m.constant()));
     }
 }
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(40))]
+    /// The two-level list applies reversals and block swaps exactly as the array form does.
+    #[test]
+    fn two_level_matches_array(seed in 0u64..1000, n in 2usize..80, reversible in any::<bool>(),
+                               ops in prop::collection::vec((0u8..2, any::<u64>(), any::<u64>(), any::<u64>()), 1..120)) {
+        use cellseq::engine::twolevel::TwoLevel;
+        let inst = instance(seed, n, 2, 1, 0.0, reversible, false);
+        let m = CostModel::new(&inst, inst.default_objective());
+        let c = Costs::open(&m);
+        let seq = greedy::geometric(&m, &mut |_| {});
+        let mut s = Solution::new(&c, &seq);
+        let mut t = TwoLevel::new(&s);
+        for (kind, a, b, d) in ops {
+            if kind == 0 {
+                let i = (a % n as u64) as usize;
+                let j = i + (b % (n - i) as u64) as usize;
+                s.reverse(&m, i, j, 0.0);
+                t.reverse(&m, i, j, 0.0);
+            } else if n >= 2 {
+                let h = (a % (n as u64 - 1)) as isize - 1;
+                let i = h + 1 + (b % (n as isize - 1 - h) as u64) as isize;
+                if i as usize + 1 >= n {
+                    continue;
+                }
+                let j = i + 1 + (d % (n as isize - 1 - i) as u64) as isize;
+                s.swap_blocks(h, i as usize, j as usize, 0.0);
+                t.swap_blocks(&m, h, i as usize, j as usize, 0.0);
+            }
+            for p in 0..n {
+                let x = s.order[p];
+                prop_assert_eq!(t.cell_at(p), x);
+                prop_assert_eq!(t.pos(x), p);
+                prop_assert_eq!(t.mode(&m, x), s.mode[x as usize]);
+                prop_assert_eq!(t.next(x), s.order.get(p + 1).copied());
+                prop_assert_eq!(t.prev(x), p.checked_sub(1).map(|q| s.order[q]));
+            }
+        }
+        let mut u = s.clone();
+        t.write(&m, &mut u);
+        prop_assert_eq!(&u.order, &s.order);
+        prop_assert_eq!(&u.pos, &s.pos);
+        prop_assert_eq!(&u.mode, &s.mode);
+    }
+
+    /// The two-level search keeps an exact cost and a feasible permutation, with and without
+    /// precedence, through the descent and the kicks with their undo.
+    #[test]
+    fn two_level_search_is_exact(seed in 0u64..1000, n in 2usize..60, modes in 1usize..4, tools in 1usize..3,
+                                 density in prop_oneof![Just(0.0), 0.0f64..0.1], reversible in any::<bool>(),
+                                 rh in any::<bool>(), k in 1usize..8, rev_max in 1usize..20,
+                                 shuffle in prop::collection::vec(any::<u64>(), 60)) {
+        use cellseq::engine::{Neighbours, large::{self, Large}};
+        use cellseq::solvers::{Budget, Context, NoObserver};
+        let inst = instance(seed, n, modes, tools, density, reversible, rh);
+        let m = CostModel::new(&inst, inst.default_objective());
+        let c = Costs::open(&m);
+        prop_assert!(large::applies(&c));
+        let mut seq = greedy::geometric(&m, &mut |_| {});
+        if density == 0.0 {
+            // a scrambled start, so that there is much to improve
+            for (i, r) in shuffle.iter().enumerate().take(n) {
+                seq.swap(i, (*r % n as u64) as usize);
+            }
+        }
+        let mut s = Solution::new(&c, &seq);
+        let start = s.cost;
+        let nb = Neighbours::new(&m, k);
+        let params = cellseq::params::Params::new("t", &[], &BTreeMap::new()).unwrap();
+        let mut obs = NoObserver;
+        // an evaluation budget, so that a wrong delta that cycles still ends (and fails below)
+        let budget = Budget { max_evals: Some(400_000), ..Budget::default() };
+        let mut ctx = Context::new(&inst, &m, &params, 1, budget, &mut obs);
+        let mut l = Large::new(c, &nb, &s);
+        l.rev_max = rev_max;
+        l.optimize(&mut ctx);
+        l.write(&mut s);
+        prop_assert!(close(s.cost, s.evaluate(&c)), "descent: tracked {} vs evaluated {}", s.cost, s.evaluate(&c));
+        prop_assert!(s.cost <= start + 1e-9 * start.abs().max(1.0));
+        let after = s.cost;
+        l.kicks(&mut ctx, seed, 4, 200);
+        l.write(&mut s);
+        prop_assert!(close(s.cost, s.evaluate(&c)), "kicks: tracked {} vs evaluated {}", s.cost, s.evaluate(&c));
+        prop_assert!(s.cost <= after + 1e-9 * after.abs().max(1.0));
+        let mut seen = vec![false; n];
+        for (p, &cell) in s.order.iter().enumerate() {
+            prop_assert!(!seen[cell as usize]);
+            seen[cell as usize] = true;
+            prop_assert_eq!(s.pos[cell as usize] as usize, p);
+            prop_assert!((s.mode[cell as usize] as usize) < m.modes(cell as usize));
+        }
+        prop_assert!(s.feasible(&m));
+        let r = cellseq::check(&inst, &s.sequence(), inst.default_objective()).unwrap();
+        prop_assert!(close(r.cost, s.cost + m.constant()));
+    }
+}

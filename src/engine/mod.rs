@@ -8,6 +8,7 @@
 //! for SOP-3-exchange). [`neighbours`] builds K-nearest candidate lists, [`modes`] the
 //! layered shortest-path mode DP, [`search`] the variable neighbourhood descent.
 
+pub mod large;
 pub mod linked;
 pub mod lk;
 pub mod modes;
@@ -16,6 +17,7 @@ pub mod neighbours;
 pub mod search;
 pub mod solution;
 pub mod sop3x;
+pub mod twolevel;
 
 pub use neighbours::Neighbours;
 pub use solution::Solution;
