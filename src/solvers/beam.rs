@@ -96,6 +96,12 @@ pub static INFO: SolverInfo = SolverInfo {
                    precedence) by index: symmetry breaking that keeps an optimum",
         },
         ParamSpec {
+            name: "growth",
+            default: "4",
+            kind: ParamKind::Int,
+            help: "factor by which the beam width grows from width 1024 on (doubling before)",
+        },
+        ParamSpec {
             name: "warm_evals",
             default: "2000000",
             kind: ParamKind::Int,
@@ -113,6 +119,7 @@ pub static INFO: SolverInfo = SolverInfo {
             warm_evals: p.int("warm_evals"),
             qpath: p.bool("qpath"),
             sec: p.bool("sec"),
+            growth: p.int("growth").max(2) as usize,
             twins: p.bool("twins"),
         })
     },
@@ -140,7 +147,12 @@ pub struct Beam {
     pub twins: bool,
     /// Potentials from the subtour-elimination Lagrangian, with its set multipliers.
     pub sec: bool,
+    /// Width growth factor from width 1024 on.
+    pub growth: usize,
 }
+
+/// Width from which the beam grows by the `growth` factor instead of doubling.
+const GROWTH_FROM: usize = 1024;
 
 /// Largest instance accepted (visited sets are fixed-size bitsets).
 pub const MAX_CELLS: usize = 1024;
@@ -232,7 +244,8 @@ struct Tables {
     cell_in: Vec<f64>,
     /// per cell: u + v + cheapest reduced out-arc
     cell_out: Vec<f64>,
-    /// per node: u(cell) + v(home) + cheapest reduced arc out of the node
+    /// per node: u(cell) + v(home) + cheapest reduced arc out of the node (μ excluded: the
+    /// sets' multipliers are charged separately)
     node_out: Vec<f64>,
     /// per node: u(cell) + v(home) + cheapest reduced arc into home
     node_in: Vec<f64>,
@@ -263,6 +276,19 @@ struct Tables {
 }
 
 impl Tables {
+    /// Σ μ_S over the subtour-elimination sets that the rest of a path must still leave:
+    /// those holding the last cell `l` or an unvisited cell (`bits`: the visited set).
+    #[inline]
+    fn active_mu(&self, bits: &[u64], l: usize) -> f64 {
+        let mut sum = 0.0;
+        for (set, mu) in &self.sec_sets {
+            if set[l / 64] >> (l % 64) & 1 == 1 || set.iter().zip(bits).any(|(s, b)| s & !b != 0) {
+                sum += mu;
+            }
+        }
+        sum
+    }
+
     /// `μ(i, j)`: Σ multipliers of the sets that the arc i → j leaves (home = n).
     #[inline]
     fn mu(&self, n: usize, i: usize, j: usize) -> f64 {
@@ -370,14 +396,14 @@ fn tables(
     for (nd, slot) in node_out.iter_mut().enumerate() {
         let (a, ma) = m.cell_mode(nd);
         let mut best = if cl.can_be_last(a) {
-            m.finish(a, ma) - u[a] - v[n]
+            m.finish(a, ma) - u[a] - v[n] - mu(a, n)
         } else {
             f64::INFINITY
         };
         for b in 0..n {
             if cl.arc_allowed(a, b) {
                 for mb in 0..m.modes(b) {
-                    best = best.min(m.arc(a, ma, b, mb) - u[a] - v[b]);
+                    best = best.min(m.arc(a, ma, b, mb) - u[a] - v[b] - mu(a, b));
                 }
             }
         }
@@ -500,7 +526,18 @@ impl Beam {
             };
             let iters = qpath::affordable_iterations(m, work, 1000);
             (iters >= 10)
-                .then(|| QPath::new(m, best.as_ref().map(|b| b.0), iters))
+                .then(|| {
+                    let upper = best.as_ref().map(|b| b.0);
+                    if t.mu_arc.is_empty() {
+                        QPath::new(m, upper, iters)
+                    } else {
+                        // on the costs net of the subtour-elimination multipliers: a walk no
+                        // longer gains by looping inside an expensive-to-leave set
+                        let total: f64 = t.sec_sets.iter().map(|s| s.1).sum();
+                        let l0 = vec![0.0; n];
+                        QPath::shifted(m, upper, iters, Some((&t.mu_arc, total, &l0)))
+                    }
+                })
                 .flatten()
         } else {
             None
@@ -574,7 +611,14 @@ impl Beam {
             if aborted || ctx.exhausted() || width >= self.max_width {
                 break;
             }
-            width *= 2;
+            // doubling, then faster: a pass that is not truncated stores only what survives
+            // the bound, so a wider-than-needed final pass costs little, while every narrower
+            // pass is repeated work
+            width = if width < GROWTH_FROM {
+                width * 2
+            } else {
+                width.saturating_mul(self.growth)
+            };
             let need = prefix_bytes * width as u64 * (n as u64 + 1) * 2;
             if need > self.memory_mb.saturating_mul(1 << 20) {
                 break;
@@ -632,15 +676,18 @@ impl Beam {
         let bound = |p: &Prefix<W>, cells: usize| {
             let h_in = p.rem_in + t.node_in[p.node as usize];
             let h_out = p.rem_out + t.node_out[p.node as usize];
+            let act = t.active_mu(&p.bits, m.cell_mode(p.node as usize).0);
             let h = match qp {
                 // rounding slack: λ sums are kept incrementally
                 Some(q) => {
-                    let h_q = q.completion(cells, p.node as usize, p.lam_open);
+                    // shifted costs: the sets still to leave are charged on top
+                    let h_q = q.completion(cells, p.node as usize, p.lam_open)
+                        + if t.mu_arc.is_empty() { 0.0 } else { act };
                     h_q - 1e-9 * h_q.abs().max(1.0)
                 }
                 None => f64::NEG_INFINITY,
             };
-            p.g + h_in.max(h_out).max(h)
+            p.g + (h_in.max(h_out) + act).max(h)
         };
         let lam = |c: usize| qp.map_or(0.0, |q| q.lambda(c));
         let lam_total = qp.map_or(0.0, |q| q.lambda_total());
@@ -1159,13 +1206,7 @@ fn refined<const W: usize>(
     }
     let _ = nc;
     // every set holding the last cell or an unvisited one must still be left
-    for (set, mu) in &t.sec_sets {
-        let active =
-            set[l / 64] >> (l % 64) & 1 == 1 || set.iter().zip(&p.bits).any(|(s, b)| s & !b != 0);
-        if active {
-            pot += mu;
-        }
-    }
+    pot += t.active_mu(&p.bits, l);
     p.g + pot + (h_in + home_in).max(h_out + last_out)
 }
 
