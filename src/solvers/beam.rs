@@ -722,6 +722,12 @@ impl Beam {
             index.clear();
             let mut evals = 0u64;
             for (pi, p) in prev.iter().enumerate() {
+                // a wide level takes seconds: honour the time limit inside it too (the
+                // evaluation count is only updated per level, so evaluation budgets stay
+                // deterministic)
+                if may_abort && pi % 1024 == 1023 && ctx.exhausted() {
+                    return (None, true, true);
+                }
                 let (a, ma) = m.cell_mode(p.node as usize);
                 for v in 0..n {
                     if p.bits[v / 64] >> (v % 64) & 1 == 1 {
@@ -776,6 +782,9 @@ impl Beam {
                 let mut done = 0u64;
                 for mut c in cands.drain(..) {
                     done += 1;
+                    if may_abort && done.is_multiple_of(4096) && ctx.exhausted() {
+                        return (None, true, true);
+                    }
                     c.f = c.f.max(refined(m, t, &c, &mut scratch));
                     if c.f <= cut {
                         kept.push(c);
