@@ -14,7 +14,9 @@
 //! (Σ cheapest allowed in-arc), and the last node and every unvisited cell are still to be left
 //! once (Σ cheapest allowed out-arc). With `qpath` (default), the position-indexed path
 //! relaxation of [`crate::bound::qpath`] adds an O(1) table bound per (cells visited, last
-//! node), strong under dense precedence. A root bound from [`crate::bound`] (Lagrangian
+//! node), strong under dense precedence. With `sec` (default), the potentials come from the
+//! assignment with subtour-elimination multipliers ([`crate::bound::sec`]) and every prefix
+//! is also charged the multipliers of the sets it must still leave. A root bound from [`crate::bound`] (Lagrangian
 //! arborescence) may close the gap at once.
 
 use super::{
