@@ -219,6 +219,86 @@ fn check_qpath_along_optimum(inst: &Instance, obj: Objective) {
     }
 }
 
+/// The beam's node bound (assignment potentials, subtour-elimination multipliers, degree
+/// sums, cluster surcharges) of every prefix of an optimal sequence never exceeds the
+/// optimum, with and without a known upper value for the subgradient steps; neither does the
+/// `sec` root bound.
+fn check_node_bounds_along_optimum(inst: &Instance, obj: Objective) {
+    let r = solvers::run(
+        "exact",
+        inst,
+        obj,
+        &BTreeMap::new(),
+        1,
+        Budget::default(),
+        &mut NoObserver,
+    )
+    .expect("exact solves");
+    let m = CostModel::new(inst, obj);
+    let seq = &r.outcome.sequence;
+    let opt = m.evaluate(seq);
+    let tol = 1e-6 * opt.abs().max(1.0);
+    for upper in [None, Some(opt)] {
+        let lbs = solvers::beam::prefix_bounds(&m, seq, upper).expect("node bounds");
+        assert_eq!(lbs.len(), seq.len());
+        for (p, lb) in lbs.iter().enumerate() {
+            assert!(
+                *lb <= opt + tol,
+                "node bound {lb} above the optimum {opt} after {} cells (upper {upper:?})",
+                p + 1
+            );
+        }
+        let cl = bound::closure::Closure::new(&m.dag).expect("acyclic");
+        let g = bound::cells::CellGraph::new(&m, &cl);
+        if let Some(s) =
+            bound::sec::sec_bound(&g, Some(&cl), upper.map(|u| u - m.constant()), 200, 64)
+        {
+            assert!(
+                s.value + m.constant() <= opt + tol,
+                "sec bound {} above the optimum {opt}",
+                s.value + m.constant()
+            );
+        }
+    }
+}
+
+#[test]
+fn sec_bound_is_strong_on_p43() {
+    // p43.1: optimum 28140 (bks.csv); the plain assignment bound is 900, the cluster
+    // surcharges of the beam gave 27810
+    let inst = load("instances/tsplib-sop/p43.1.sop");
+    let m = CostModel::new(&inst, Objective::Matrix);
+    let b = bound::compute(&m, &BoundOptions::default());
+    let sec = b.parts.iter().find(|p| p.name == "sec").expect("sec bound");
+    assert!(sec.value <= 28140.0, "sec {} above the optimum", sec.value);
+    assert!(sec.value > 28000.0, "sec {} is weak", sec.value);
+    let seq = &load_solution_p43_1(&inst);
+    let lbs = solvers::beam::prefix_bounds(&m, seq, Some(28140.0)).expect("node bounds");
+    assert!(lbs.iter().all(|&lb| lb <= 28140.0 + 1e-6));
+}
+
+/// A sequence of p43.1 of cost 28140 (optimal), found by `beam` and checked here.
+fn load_solution_p43_1(inst: &Instance) -> Vec<cellseq::model::Visit> {
+    let labels = [
+        1, 5, 38, 8, 31, 30, 35, 34, 14, 13, 15, 42, 41, 43, 39, 40, 26, 22, 24, 23, 25, 27, 18,
+        16, 17, 20, 21, 19, 10, 11, 12, 9, 32, 33, 7, 6, 3, 28, 29, 2, 4, 37, 36, 44,
+    ];
+    let seq: Vec<cellseq::model::Visit> = labels
+        .iter()
+        .map(|l| {
+            let c = inst
+                .cells
+                .iter()
+                .position(|c| c.id == l.to_string())
+                .expect("cell label");
+            cellseq::model::Visit::new(c, 0)
+        })
+        .collect();
+    let m = CostModel::new(inst, Objective::Matrix);
+    assert_eq!(m.evaluate(&seq), 28140.0);
+    seq
+}
+
 #[test]
 fn lagrangian_beats_assignment_on_ry48p() {
     let inst = load("instances/tsplib-sop/ry48p.1.sop");
@@ -403,6 +483,7 @@ proptest! {
         let text = clustered_sop_text(&group, &small, &big, &prec);
         let inst = formats::parse_instance("rnd.sop", &text, Format::Sop).unwrap();
         check_instance(&inst, Objective::Matrix);
+        check_node_bounds_along_optimum(&inst, Objective::Matrix);
     }
 
     #[test]
@@ -417,6 +498,7 @@ proptest! {
         let inst = formats::parse_instance("rnd.sop", &text, Format::Sop).unwrap();
         check_instance(&inst, Objective::Matrix);
         check_qpath_along_optimum(&inst, Objective::Matrix);
+        check_node_bounds_along_optimum(&inst, Objective::Matrix);
     }
 
     #[test]
@@ -441,6 +523,7 @@ proptest! {
         let text = pcglns_text(sizes.len(), &sizes, &costs, &prec);
         let inst = formats::parse_instance("rnd.pcglns", &text, Format::Pcglns).unwrap();
         check_qpath_along_optimum(&inst, Objective::Matrix);
+        check_node_bounds_along_optimum(&inst, Objective::Matrix);
     }
 
     #[test]

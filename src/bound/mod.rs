@@ -9,6 +9,7 @@
 //!   neighbours only (memory linear in n).
 //! - `assignment`: Hungarian method on the cell graph.
 //! - `lagrangian`: minimum spanning 1-arborescence with subgradient out-degree penalties.
+//! - `sec`: assignment with Lagrangian subtour-elimination multipliers ([`sec`]).
 //! - `qpath`: position-indexed path relaxation (precedence windows, no 2-cycles) with
 //!   subgradient multipliers per cell ([`qpath`]).
 //!
@@ -20,6 +21,7 @@ pub mod cells;
 pub mod closure;
 pub mod knn;
 pub mod qpath;
+pub mod sec;
 
 use crate::cost::CostModel;
 use cells::CellGraph;
@@ -41,6 +43,9 @@ pub struct BoundOptions {
     /// Work budget of the `qpath` bound in arc evaluations (0 = skip it); it runs only when
     /// at least 10 subgradient iterations fit.
     pub qpath_work: f64,
+    /// Work budget of the `sec` bound (d³ per subgradient iteration; 0 = skip it); it runs
+    /// only when at least 10 iterations fit.
+    pub sec_work: f64,
     /// Neighbours per node in the K-nearest-neighbour degree bound.
     pub knn: usize,
     /// A known solution cost (with the constant), used to size subgradient steps.
@@ -55,6 +60,7 @@ impl Default for BoundOptions {
             lagrangian_max_cells: 400,
             lagrangian_iterations: 300,
             qpath_work: 1e8,
+            sec_work: 1e8,
             knn: 16,
             upper: None,
         }
@@ -122,6 +128,18 @@ pub fn compute(m: &CostModel, opt: &BoundOptions) -> Bounds {
                 parts.push(BoundValue {
                     name: "lagrangian",
                     value: round(constant + l.bound),
+                    seconds: t.elapsed().as_secs_f64(),
+                });
+            }
+        }
+        let iters = sec::affordable_iterations(n, opt.sec_work, 300);
+        if n <= opt.assignment_max_cells && iters >= 10 {
+            let t = Instant::now();
+            let upper = opt.upper.map(|u| u - constant);
+            if let Some(s) = sec::sec_bound(&g, Some(&cl), upper, iters, 4 * n + 16) {
+                parts.push(BoundValue {
+                    name: "sec",
+                    value: round(constant + s.value),
                     seconds: t.elapsed().as_secs_f64(),
                 });
             }

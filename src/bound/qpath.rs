@@ -57,7 +57,8 @@ struct Dp {
 }
 
 impl Graph {
-    fn new(m: &CostModel, cl: &Closure) -> Graph {
+    /// `shift(i, j)` (cells, home = n) is subtracted from every arc cost.
+    fn new(m: &CostModel, cl: &Closure, shift: &dyn Fn(usize, usize) -> f64) -> Graph {
         let n = m.n();
         let nodes = m.nodes();
         let cell: Vec<u32> = (0..nodes).map(|nd| m.cell_mode(nd).0 as u32).collect();
@@ -70,14 +71,14 @@ impl Graph {
                 start[a] = m.start(ca, ma);
             }
             if cl.can_be_last(ca) {
-                finish[a] = m.finish(ca, ma);
+                finish[a] = m.finish(ca, ma) - shift(ca, n);
             }
             for cb in 0..n {
                 if !cl.arc_allowed(ca, cb) {
                     continue;
                 }
                 for mb in 0..m.modes(cb) {
-                    let c = m.arc(ca, ma, cb, mb);
+                    let c = m.arc(ca, ma, cb, mb) - shift(ca, cb);
                     if c.is_finite() {
                         out.push((m.node(cb, mb) as u32, cb as u32, c));
                     }
@@ -189,12 +190,32 @@ impl QPath {
     /// known solution with the constant, when given) and keeps the table of the best
     /// multipliers. `None` when the precedence has a cycle or the instance is empty.
     pub fn new(m: &CostModel, upper: Option<f64>, iterations: usize) -> Option<QPath> {
+        QPath::shifted(m, upper, iterations, None)
+    }
+
+    /// Like [`QPath::new`] on the arc costs `c(i, j) − μ(i, j)`, where `shift = (μ, Σ μ_S,
+    /// λ₀)` comes from [`super::sec::SecBound`]: `μ` is its dense arc-multiplier matrix
+    /// (cells and home, `n + 1` columns) and `Σ μ_S` is added to the root value (every set
+    /// must be left). The subgradient starts from the multipliers `λ₀`. A prefix's completion
+    /// ([`QPath::completion`]) then bounds the rest in the shifted costs only: add `Σ μ_S`
+    /// over the sets that the rest must still leave.
+    pub fn shifted(
+        m: &CostModel,
+        upper: Option<f64>,
+        iterations: usize,
+        shift: Option<(&[f64], f64, &[f64])>,
+    ) -> Option<QPath> {
         let n = m.n();
         if n == 0 {
             return None;
         }
         let cl = Closure::new(&m.dag)?;
-        let g = Graph::new(m, &cl);
+        let d = n + 1;
+        let g = match shift {
+            Some((mu, _, _)) => Graph::new(m, &cl, &|i, j| mu[i * d + j]),
+            None => Graph::new(m, &cl, &|_, _| 0.0),
+        };
+        let base = shift.map_or(0.0, |s| s.1);
         let nn = g.nodes;
         let size = n * nn;
         let mut dp = Dp {
@@ -203,9 +224,12 @@ impl QPath {
             h2: vec![0.0; size],
             n2: vec![NONE; size],
         };
-        let constant = m.constant();
+        let constant = m.constant() + base;
         let upper = upper.map(|u| u - constant);
-        let mut lambda = vec![0.0; n];
+        let mut lambda = match shift {
+            Some((_, _, l0)) if l0.len() == n => l0.to_vec(),
+            _ => vec![0.0; n],
+        };
         let mut best_lambda = lambda.clone();
         let mut best = f64::NEG_INFINITY;
         let mut count = vec![0i32; n];

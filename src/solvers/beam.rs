@@ -14,7 +14,9 @@
 //! (Σ cheapest allowed in-arc), and the last node and every unvisited cell are still to be left
 //! once (Σ cheapest allowed out-arc). With `qpath` (default), the position-indexed path
 //! relaxation of [`crate::bound::qpath`] adds an O(1) table bound per (cells visited, last
-//! node), strong under dense precedence. A root bound from [`crate::bound`] (Lagrangian
+//! node), strong under dense precedence. With `sec` (default), the potentials come from the
+//! assignment with subtour-elimination multipliers ([`crate::bound::sec`]) and every prefix
+//! is also charged the multipliers of the sets it must still leave. A root bound from [`crate::bound`] (Lagrangian
 //! arborescence) may close the gap at once.
 
 use super::{
@@ -23,6 +25,7 @@ use super::{
 use crate::bound::cells::CellGraph;
 use crate::bound::closure::Closure;
 use crate::bound::qpath::{self, QPath};
+use crate::bound::sec::{self, SecBound};
 use crate::bound::{self, BoundOptions, assignment};
 use crate::cost::CostModel;
 use crate::error::{Error, Result};
@@ -73,6 +76,14 @@ pub static INFO: SolverInfo = SolverInfo {
                    clusters that must be entered and left (n <= 600)",
         },
         ParamSpec {
+            name: "sec",
+            default: "true",
+            kind: ParamKind::Bool,
+            help: "take the potentials from the assignment with subtour-elimination multipliers \
+                   (bound::sec) and charge each set's multiplier while the path must still \
+                   leave it (with potentials=true)",
+        },
+        ParamSpec {
             name: "qpath",
             default: "true",
             kind: ParamKind::Bool,
@@ -85,6 +96,12 @@ pub static INFO: SolverInfo = SolverInfo {
             kind: ParamKind::Bool,
             help: "order interchangeable cells (same costs to and from every other cell, same \
                    precedence) by index: symmetry breaking that keeps an optimum",
+        },
+        ParamSpec {
+            name: "growth",
+            default: "4",
+            kind: ParamKind::Int,
+            help: "factor by which the beam width grows from width 1024 on (doubling before)",
         },
         ParamSpec {
             name: "warm_evals",
@@ -103,6 +120,8 @@ pub static INFO: SolverInfo = SolverInfo {
             potentials: p.bool("potentials"),
             warm_evals: p.int("warm_evals"),
             qpath: p.bool("qpath"),
+            sec: p.bool("sec"),
+            growth: p.int("growth").max(2) as usize,
             twins: p.bool("twins"),
         })
     },
@@ -128,7 +147,14 @@ pub struct Beam {
     pub qpath: bool,
     /// Order interchangeable cells by index (symmetry breaking).
     pub twins: bool,
+    /// Potentials from the subtour-elimination Lagrangian, with its set multipliers.
+    pub sec: bool,
+    /// Width growth factor from width 1024 on.
+    pub growth: usize,
 }
+
+/// Width from which the beam grows by the `growth` factor instead of doubling.
+const GROWTH_FROM: usize = 1024;
 
 /// Largest instance accepted (visited sets are fixed-size bitsets).
 pub const MAX_CELLS: usize = 1024;
@@ -166,6 +192,40 @@ struct Prefix<const W: usize> {
     f: f64,
 }
 
+impl<const W: usize> Prefix<W> {
+    /// The one-cell prefix of cell `c` in mode `md` with its incremental bound terms
+    /// (`lam_open`: Σ qpath multipliers over the other cells); `f` is left at 0.
+    fn first(m: &CostModel, t: &Tables, c: usize, md: usize, lam_open: f64) -> Self {
+        let mut bits = [0u64; W];
+        bits[c / 64] |= 1 << (c % 64);
+        Prefix {
+            bits,
+            node: m.node(c, md) as u32,
+            parent: u32::MAX,
+            g: m.constant() + m.start(c, md),
+            rem_in: t.total_in - t.cell_in[c],
+            rem_out: t.total_out - t.cell_out[c],
+            lam_open,
+            f: 0.0,
+        }
+    }
+}
+
+/// Every one-cell prefix: each cell that may come first (no predecessor, twins included), in
+/// each mode; `lam_total` = Σ qpath multipliers, `lam(c)` the multiplier of cell `c`.
+fn first_prefixes<const W: usize>(
+    m: &CostModel,
+    t: &Tables,
+    lam_total: f64,
+    lam: impl Fn(usize) -> f64,
+) -> Vec<Prefix<W>> {
+    (0..m.n())
+        .filter(|&c| t.pred_mask[c].iter().all(|&w| w == 0))
+        .flat_map(|c| (0..m.modes(c)).map(move |md| (c, md)))
+        .map(|(c, md)| Prefix::first(m, t, c, md, lam_total - lam(c)))
+        .collect()
+}
+
 /// Static data of the incremental bound.
 ///
 /// All bound terms are written with the dual potentials `u`, `v` of the root assignment
@@ -174,13 +234,20 @@ struct Prefix<const W: usize> {
 /// unvisited set `U` to home costs exactly `u_l + v_home + Σ_{U} (u + v) + Σ r` over its arcs,
 /// and `Σ r` is bounded below by degree arguments on reduced costs (valid for any potentials;
 /// the assignment duals make them strong).
+///
+/// With `sec` the split is `c(i, j) = u_i + v_j + μ(i, j) + r(i, j)` where `μ(i, j)` sums
+/// the multipliers `μ_S ≥ 0` of the sets `S` that the arc leaves ([`crate::bound::sec`]):
+/// the rest of the path leaves every set that holds an unvisited cell or the last cell, so it
+/// pays at least Σ μ_S over those on top of `Σ r` (and dropping `μ(i, j) ≥ 0` keeps the
+/// O(1) incremental terms valid).
 struct Tables {
     pred_mask: Vec<Vec<u64>>,
     /// per cell: u + v + cheapest reduced in-arc
     cell_in: Vec<f64>,
     /// per cell: u + v + cheapest reduced out-arc
     cell_out: Vec<f64>,
-    /// per node: u(cell) + v(home) + cheapest reduced arc out of the node
+    /// per node: u(cell) + v(home) + cheapest reduced arc out of the node (μ excluded: the
+    /// sets' multipliers are charged separately)
     node_out: Vec<f64>,
     /// per node: u(cell) + v(home) + cheapest reduced arc into home
     node_in: Vec<f64>,
@@ -201,6 +268,38 @@ struct Tables {
     cluster: Vec<u32>,
     /// the clusters' cells
     clusters: Vec<Vec<u32>>,
+    /// Σ cell_in, Σ cell_out over all cells
+    total_in: f64,
+    total_out: f64,
+    /// `μ(i, j)` over cells and home, row-major with n + 1 columns (empty: all zero)
+    mu_arc: Vec<f64>,
+    /// subtour-elimination sets as cell bitsets (words of 64) with their multipliers
+    sec_sets: Vec<(Vec<u64>, f64)>,
+}
+
+impl Tables {
+    /// Σ μ_S over the subtour-elimination sets that the rest of a path must still leave:
+    /// those holding the last cell `l` or an unvisited cell (`bits`: the visited set).
+    #[inline]
+    fn active_mu(&self, bits: &[u64], l: usize) -> f64 {
+        let mut sum = 0.0;
+        for (set, mu) in &self.sec_sets {
+            if set[l / 64] >> (l % 64) & 1 == 1 || set.iter().zip(bits).any(|(s, b)| s & !b != 0) {
+                sum += mu;
+            }
+        }
+        sum
+    }
+
+    /// `μ(i, j)`: Σ multipliers of the sets that the arc i → j leaves (home = n).
+    #[inline]
+    fn mu(&self, n: usize, i: usize, j: usize) -> f64 {
+        if self.mu_arc.is_empty() {
+            0.0
+        } else {
+            self.mu_arc[i * (n + 1) + j]
+        }
+    }
 }
 
 /// Work budget (arc evaluations) of the qpath multipliers' subgradient steps.
@@ -209,7 +308,17 @@ const QPATH_WORK: f64 = 4e8;
 /// Largest instance for which the root assignment (O(n³)) gives the potentials.
 const POTENTIAL_MAX_CELLS: usize = 600;
 
-fn tables(m: &CostModel, use_potentials: bool, twins: bool) -> Result<Tables> {
+/// Work budget (d³ per iteration) of the subtour-elimination multipliers' subgradient steps.
+const SEC_WORK: f64 = 2e8;
+
+/// `upper`: cost of a known solution (constant included), for the subgradient steps.
+fn tables(
+    m: &CostModel,
+    use_potentials: bool,
+    use_sec: bool,
+    twins: bool,
+    upper: Option<f64>,
+) -> Result<Tables> {
     let n = m.n();
     let words = n.div_ceil(64).max(1);
     let cl = Closure::new(&m.dag).ok_or_else(|| Error::Solver {
@@ -217,15 +326,57 @@ fn tables(m: &CostModel, use_potentials: bool, twins: bool) -> Result<Tables> {
         msg: "precedence has a cycle".into(),
     })?;
     let g = CellGraph::new(m, &cl);
-    let asg = (use_potentials && n <= POTENTIAL_MAX_CELLS)
-        .then(|| assignment::hungarian_duals(g.size(), |i, j| g.c(i, j)))
+    let with_potentials = use_potentials && n <= POTENTIAL_MAX_CELLS;
+    let sec: Option<SecBound> = (with_potentials && use_sec)
+        .then(|| {
+            let iters = sec::affordable_iterations(n, SEC_WORK, 1000);
+            let upper = upper.map(|x| x - m.constant());
+            sec::sec_bound(&g, Some(&cl), upper, iters, 4 * n + 16)
+        })
         .flatten()
-        .filter(|a| a.u.iter().chain(&a.v).all(|x| x.is_finite()));
-    let (u, v) = match &asg {
-        Some(a) => (a.u.clone(), a.v.clone()),
-        None => (vec![0.0; n + 1], vec![0.0; n + 1]),
+        .filter(|s| s.u.iter().chain(&s.v).chain(&s.mu).all(|x| x.is_finite()));
+    let asg = if sec.is_some() {
+        None
+    } else {
+        with_potentials
+            .then(|| assignment::hungarian_duals(g.size(), |i, j| g.c(i, j)))
+            .flatten()
+            .filter(|a| a.u.iter().chain(&a.v).all(|x| x.is_finite()))
     };
-    let r = |i: usize, j: usize| g.c(i, j) - u[i] - v[j];
+    let (u, v) = match (&sec, &asg) {
+        (Some(s), _) => (s.u.clone(), s.v.clone()),
+        (None, Some(a)) => (a.u.clone(), a.v.clone()),
+        _ => (vec![0.0; n + 1], vec![0.0; n + 1]),
+    };
+    let mu_arc = sec
+        .as_ref()
+        .map(|s| s.arc_multipliers(n))
+        .unwrap_or_default();
+    let sec_sets: Vec<(Vec<u64>, f64)> = sec
+        .as_ref()
+        .map(|s| {
+            s.sets
+                .iter()
+                .zip(&s.mu)
+                .map(|(cells, &mu)| {
+                    let mut w = vec![0u64; words];
+                    for &c in cells {
+                        w[c as usize / 64] |= 1 << (c % 64);
+                    }
+                    (w, mu)
+                })
+                .collect()
+        })
+        .unwrap_or_default();
+    let d = n + 1;
+    let mu = |i: usize, j: usize| {
+        if mu_arc.is_empty() {
+            0.0
+        } else {
+            mu_arc[i * d + j]
+        }
+    };
+    let r = |i: usize, j: usize| g.c(i, j) - u[i] - v[j] - mu(i, j);
     let mut pred_mask: Vec<Vec<u64>> = (0..n)
         .map(|c| {
             let mut v = vec![0u64; words];
@@ -247,14 +398,14 @@ fn tables(m: &CostModel, use_potentials: bool, twins: bool) -> Result<Tables> {
     for (nd, slot) in node_out.iter_mut().enumerate() {
         let (a, ma) = m.cell_mode(nd);
         let mut best = if cl.can_be_last(a) {
-            m.finish(a, ma) - u[a] - v[n]
+            m.finish(a, ma) - u[a] - v[n] - mu(a, n)
         } else {
             f64::INFINITY
         };
         for b in 0..n {
             if cl.arc_allowed(a, b) {
                 for mb in 0..m.modes(b) {
-                    best = best.min(m.arc(a, ma, b, mb) - u[a] - v[b]);
+                    best = best.min(m.arc(a, ma, b, mb) - u[a] - v[b] - mu(a, b));
                 }
             }
         }
@@ -278,7 +429,7 @@ fn tables(m: &CostModel, use_potentials: bool, twins: bool) -> Result<Tables> {
         l.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
     }
     let first = |l: &Vec<(f64, u32)>| l.first().map(|e| e.0).unwrap_or(0.0);
-    let clusters = if asg.is_some() {
+    let clusters = if asg.is_some() || sec.is_some() {
         choose_clusters(&g, &r)
     } else {
         Vec::new()
@@ -289,6 +440,14 @@ fn tables(m: &CostModel, use_potentials: bool, twins: bool) -> Result<Tables> {
             asg.as_ref().map(|a| a.value),
             clusters
         );
+        if let Some(s) = &sec {
+            eprintln!(
+                "beam: sec bound {} after {} iterations, {} sets with a multiplier",
+                s.value + m.constant(),
+                s.iterations,
+                s.sets.len()
+            );
+        }
     }
     let mut cluster = vec![u32::MAX; n];
     for (k, cs) in clusters.iter().enumerate() {
@@ -296,10 +455,17 @@ fn tables(m: &CostModel, use_potentials: bool, twins: bool) -> Result<Tables> {
             cluster[c as usize] = k as u32;
         }
     }
+    let cell_in: Vec<f64> = (0..n).map(|c| u[c] + v[c] + first(&in_list[c])).collect();
+    let cell_out: Vec<f64> = (0..n).map(|c| u[c] + v[c] + first(&out_list[c])).collect();
+    let r_home: Vec<f64> = (0..n).map(|i| r(i, n)).collect();
     Ok(Tables {
-        cell_in: (0..n).map(|c| u[c] + v[c] + first(&in_list[c])).collect(),
-        cell_out: (0..n).map(|c| u[c] + v[c] + first(&out_list[c])).collect(),
-        r_home: (0..n).map(|i| r(i, n)).collect(),
+        total_in: cell_in.iter().sum(),
+        total_out: cell_out.iter().sum(),
+        cell_in,
+        cell_out,
+        mu_arc,
+        sec_sets,
+        r_home,
         in_list,
         out_list,
         pred_mask,
@@ -320,7 +486,17 @@ impl Beam {
         if n == 0 {
             return Ok(super::outcome_of(m, Vec::new()));
         }
-        let t = tables(m, self.potentials, self.twins)?;
+        let mut best: Option<(f64, Sequence)> = self.warm_start(ctx)?;
+        if let Some((c, _)) = &best {
+            ctx.report(*c);
+        }
+        let t = tables(
+            m,
+            self.potentials,
+            self.sec,
+            self.twins,
+            best.as_ref().map(|b| b.0),
+        )?;
         let constant = m.constant();
         // the node bound at the first level (every possible first cell and mode) bounds the
         // optimum: reported as the lower bound when no proof is reached
@@ -344,10 +520,6 @@ impl Beam {
                 ub - 1e-9 * ub.abs().max(1.0)
             }
         };
-        let mut best: Option<(f64, Sequence)> = self.warm_start(ctx)?;
-        if let Some((c, _)) = &best {
-            ctx.report(*c);
-        }
         let qp = if self.qpath {
             // short runs (e.g. a portfolio phase) get a smaller share: ~10⁸ per second of limit
             let work = match ctx.budget.time_limit {
@@ -356,7 +528,18 @@ impl Beam {
             };
             let iters = qpath::affordable_iterations(m, work, 1000);
             (iters >= 10)
-                .then(|| QPath::new(m, best.as_ref().map(|b| b.0), iters))
+                .then(|| {
+                    let upper = best.as_ref().map(|b| b.0);
+                    if t.mu_arc.is_empty() {
+                        QPath::new(m, upper, iters)
+                    } else {
+                        // on the costs net of the subtour-elimination multipliers: a walk no
+                        // longer gains by looping inside an expensive-to-leave set
+                        let total: f64 = t.sec_sets.iter().map(|s| s.1).sum();
+                        let l0 = vec![0.0; n];
+                        QPath::shifted(m, upper, iters, Some((&t.mu_arc, total, &l0)))
+                    }
+                })
                 .flatten()
         } else {
             None
@@ -430,7 +613,14 @@ impl Beam {
             if aborted || ctx.exhausted() || width >= self.max_width {
                 break;
             }
-            width *= 2;
+            // doubling, then faster: a pass that is not truncated stores only what survives
+            // the bound, so a wider-than-needed final pass costs little, while every narrower
+            // pass is repeated work
+            width = if width < GROWTH_FROM {
+                width * 2
+            } else {
+                width.saturating_mul(self.growth)
+            };
             let need = prefix_bytes * width as u64 * (n as u64 + 1) * 2;
             if need > self.memory_mb.saturating_mul(1 << 20) {
                 break;
@@ -484,21 +674,22 @@ impl Beam {
     ) -> (Option<(f64, Sequence)>, bool, bool) {
         let m = ctx.model;
         let n = m.n();
-        let total_in: f64 = t.cell_in.iter().sum();
-        let total_out: f64 = t.cell_out.iter().sum();
         // `cells`: the prefix's number of cells
         let bound = |p: &Prefix<W>, cells: usize| {
             let h_in = p.rem_in + t.node_in[p.node as usize];
             let h_out = p.rem_out + t.node_out[p.node as usize];
+            let act = t.active_mu(&p.bits, m.cell_mode(p.node as usize).0);
             let h = match qp {
                 // rounding slack: λ sums are kept incrementally
                 Some(q) => {
-                    let h_q = q.completion(cells, p.node as usize, p.lam_open);
+                    // shifted costs: the sets still to leave are charged on top
+                    let h_q = q.completion(cells, p.node as usize, p.lam_open)
+                        + if t.mu_arc.is_empty() { 0.0 } else { act };
                     h_q - 1e-9 * h_q.abs().max(1.0)
                 }
                 None => f64::NEG_INFINITY,
             };
-            p.g + h_in.max(h_out).max(h)
+            p.g + (h_in.max(h_out) + act).max(h)
         };
         let lam = |c: usize| qp.map_or(0.0, |q| q.lambda(c));
         let lam_total = qp.map_or(0.0, |q| q.lambda_total());
@@ -506,30 +697,11 @@ impl Beam {
         let mut levels: Vec<Vec<Prefix<W>>> = Vec::with_capacity(n);
         let mut truncated = false;
         // level 1: every cell that may come first, in every mode
-        let mut cands: Vec<Prefix<W>> = Vec::new();
-        for c in 0..n {
-            if t.pred_mask[c].iter().any(|&w| w != 0) {
-                continue;
-            }
-            for md in 0..m.modes(c) {
-                let mut bits = [0u64; W];
-                bits[c / 64] |= 1 << (c % 64);
-                let mut p = Prefix {
-                    bits,
-                    node: m.node(c, md) as u32,
-                    parent: u32::MAX,
-                    g: m.constant() + m.start(c, md),
-                    rem_in: total_in - t.cell_in[c],
-                    rem_out: total_out - t.cell_out[c],
-                    lam_open: lam_total - lam(c),
-                    f: 0.0,
-                };
-                p.f = bound(&p, 1);
-                if p.f <= cut {
-                    cands.push(p);
-                }
-            }
+        let mut cands: Vec<Prefix<W>> = first_prefixes(m, t, lam_total, lam);
+        for p in cands.iter_mut() {
+            p.f = bound(p, 1);
         }
+        cands.retain(|p| p.f <= cut);
         ctx.count(cands.len() as u64);
         if self.refine {
             for c in cands.iter_mut() {
@@ -552,6 +724,12 @@ impl Beam {
             index.clear();
             let mut evals = 0u64;
             for (pi, p) in prev.iter().enumerate() {
+                // a wide level takes seconds: honour the time limit inside it too (the
+                // evaluation count is only updated per level, so evaluation budgets stay
+                // deterministic)
+                if may_abort && pi % 1024 == 1023 && ctx.exhausted() {
+                    return (None, true, true);
+                }
                 let (a, ma) = m.cell_mode(p.node as usize);
                 for v in 0..n {
                     if p.bits[v / 64] >> (v % 64) & 1 == 1 {
@@ -606,6 +784,9 @@ impl Beam {
                 let mut done = 0u64;
                 for mut c in cands.drain(..) {
                     done += 1;
+                    if may_abort && done.is_multiple_of(4096) && ctx.exhausted() {
+                        return (None, true, true);
+                    }
                     c.f = c.f.max(refined(m, t, &c, &mut scratch));
                     if c.f <= cut {
                         kept.push(c);
@@ -909,8 +1090,9 @@ fn refined<const W: usize>(
         h_out += o;
         scratch[j] = (i, o);
         home_in = home_in.min(t.r_home[j]);
+        let mu = t.mu(n, l, j);
         for mj in 0..m.modes(j) {
-            last_out = last_out.min(m.arc(l, lm, j, mj) - t.u[l] - t.v[j]);
+            last_out = last_out.min(m.arc(l, lm, j, mj) - t.u[l] - t.v[j] - mu);
         }
     }
     if !any {
@@ -1034,35 +1216,58 @@ fn refined<const W: usize>(
         }
     }
     let _ = nc;
+    // every set holding the last cell or an unvisited one must still be left
+    pot += t.active_mu(&p.bits, l);
     p.g + pot + (h_in + home_in).max(h_out + last_out)
+}
+
+/// The node bound (`refined`: potentials, subtour-elimination multipliers, degree sums and
+/// cluster surcharges) of every prefix of `seq`, in order, with the tables built as the beam
+/// builds them (`upper`: a known solution cost for the subgradient steps; no symmetry
+/// breaking). For tests: along an optimal sequence every value is at most the optimum.
+pub fn prefix_bounds(m: &CostModel, seq: &[Visit], upper: Option<f64>) -> Result<Vec<f64>> {
+    fn go<const W: usize>(m: &CostModel, seq: &[Visit], upper: Option<f64>) -> Result<Vec<f64>> {
+        let t = tables(m, true, true, false, upper)?;
+        let mut scratch = vec![(0.0, 0.0); m.n() + t.clusters.len()];
+        let mut out = Vec::with_capacity(seq.len());
+        let Some(v0) = seq.first() else {
+            return Ok(out);
+        };
+        let mut p = Prefix::<W>::first(m, &t, v0.cell, v0.mode, 0.0);
+        out.push(refined(m, &t, &p, &mut scratch));
+        for w in seq.windows(2) {
+            let (a, b) = (w[0], w[1]);
+            p.bits[b.cell / 64] |= 1 << (b.cell % 64);
+            p.node = m.node(b.cell, b.mode) as u32;
+            p.g += m.arc(a.cell, a.mode, b.cell, b.mode);
+            out.push(refined(m, &t, &p, &mut scratch));
+        }
+        Ok(out)
+    }
+    match m.n().div_ceil(64) {
+        0 | 1 => go::<1>(m, seq, upper),
+        2 => go::<2>(m, seq, upper),
+        3 | 4 => go::<4>(m, seq, upper),
+        5..=8 => go::<8>(m, seq, upper),
+        9..=16 => go::<16>(m, seq, upper),
+        _ => Err(Error::Solver {
+            solver: "beam".into(),
+            msg: format!(
+                "instance has {} cells; beam accepts at most {MAX_CELLS}",
+                m.n()
+            ),
+        }),
+    }
 }
 
 /// The smallest refined bound over all one-cell prefixes: a lower bound on the optimum.
 fn first_level_bound<const W: usize>(m: &CostModel, t: &Tables) -> f64 {
     let n = m.n();
     let mut scratch = vec![(0.0, 0.0); n + t.clusters.len()];
-    let mut lb = f64::INFINITY;
-    for c in 0..n {
-        if t.pred_mask[c].iter().any(|&w| w != 0) {
-            continue;
-        }
-        for md in 0..m.modes(c) {
-            let mut bits = [0u64; W];
-            bits[c / 64] |= 1 << (c % 64);
-            let p = Prefix {
-                bits,
-                node: m.node(c, md) as u32,
-                parent: u32::MAX,
-                g: m.constant() + m.start(c, md),
-                rem_in: 0.0,
-                rem_out: 0.0,
-                lam_open: 0.0,
-                f: 0.0,
-            };
-            lb = lb.min(refined(m, t, &p, &mut scratch));
-        }
-    }
-    lb
+    first_prefixes::<W>(m, t, 0.0, |_| 0.0)
+        .iter()
+        .map(|p| refined(m, t, p, &mut scratch))
+        .fold(f64::INFINITY, f64::min)
 }
 
 /// Order by bound, then cost, last node and visited set (a total order on distinct prefixes).
