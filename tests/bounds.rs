@@ -4,7 +4,7 @@
 use cellseq::bound::{self, BoundOptions};
 use cellseq::cost::CostModel;
 use cellseq::formats::{self, Format};
-use cellseq::model::{Instance, Objective};
+use cellseq::model::{Instance, Objective, Sequence};
 use cellseq::solvers::{self, Budget, NoObserver};
 use proptest::prelude::*;
 use std::collections::BTreeMap;
@@ -179,9 +179,8 @@ fn qpath_bound_is_strong_under_dense_precedence() {
     assert!(b.best <= 351.0);
 }
 
-/// The qpath completion bound of every prefix along an optimal sequence never exceeds the
-/// cost of the rest of that sequence.
-fn check_qpath_along_optimum(inst: &Instance, obj: Objective) {
+/// The cost model, an optimal sequence (by the exact solver) and its cost.
+fn optimum(inst: &Instance, obj: Objective) -> (CostModel, Sequence, f64) {
     let r = solvers::run(
         "exact",
         inst,
@@ -193,8 +192,15 @@ fn check_qpath_along_optimum(inst: &Instance, obj: Objective) {
     )
     .expect("exact solves");
     let m = CostModel::new(inst, obj);
-    let seq = &r.outcome.sequence;
-    let opt = m.evaluate(seq);
+    let opt = m.evaluate(&r.outcome.sequence);
+    (m, r.outcome.sequence, opt)
+}
+
+/// The qpath completion bound of every prefix along an optimal sequence never exceeds the
+/// cost of the rest of that sequence.
+fn check_qpath_along_optimum(inst: &Instance, obj: Objective) {
+    let (m, seq, opt) = optimum(inst, obj);
+    let seq = &seq;
     for upper in [None, Some(opt)] {
         let Some(q) = bound::qpath::QPath::new(&m, upper, 200) else {
             continue;
@@ -224,19 +230,8 @@ fn check_qpath_along_optimum(inst: &Instance, obj: Objective) {
 /// optimum, with and without a known upper value for the subgradient steps; neither does the
 /// `sec` root bound.
 fn check_node_bounds_along_optimum(inst: &Instance, obj: Objective) {
-    let r = solvers::run(
-        "exact",
-        inst,
-        obj,
-        &BTreeMap::new(),
-        1,
-        Budget::default(),
-        &mut NoObserver,
-    )
-    .expect("exact solves");
-    let m = CostModel::new(inst, obj);
-    let seq = &r.outcome.sequence;
-    let opt = m.evaluate(seq);
+    let (m, seq, opt) = optimum(inst, obj);
+    let seq = &seq;
     let tol = 1e-6 * opt.abs().max(1.0);
     for upper in [None, Some(opt)] {
         let lbs = solvers::beam::prefix_bounds(&m, seq, upper).expect("node bounds");

@@ -13,6 +13,7 @@
 //! [`Large::rev_max`] cells (longer ones are skipped when the instance has precedence); kicks
 //! check their blocks the same way.
 
+use super::moves::or_as_swap;
 use super::search::improves;
 use super::twolevel::{TwoLevel, turn};
 use super::{Costs, Neighbours, Slot, Solution};
@@ -397,20 +398,14 @@ impl<'a> Large<'a> {
             }
             Move::Rev(i, j) => self.apply_reverse(i, j, d),
             Move::Or(i, len, p, rev) => {
-                let e = i + len - 1;
                 // the cells next to the insertion point (they get new links)
                 let v = (p >= 0).then(|| self.t.cell_at(p as usize));
                 let w = match v {
                     Some(v) => self.t.next(v),
                     None => self.t.first(),
                 };
-                let (start, end) = if p > e as isize {
-                    self.apply_swap(i as isize - 1, e, p as usize, d);
-                    (p as usize + 1 - len, p as usize)
-                } else {
-                    self.apply_swap(p, i - 1, e, d);
-                    ((p + 1) as usize, (p + 1) as usize + len - 1)
-                };
+                let ((h, a, b), (start, end)) = or_as_swap(i, len, p);
+                self.apply_swap(h, a, b, d);
                 if rev {
                     self.apply_reverse(start, end, 0.0);
                 }

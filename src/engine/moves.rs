@@ -136,16 +136,34 @@ pub fn apply_segment(
     reversed: bool,
     delta: f64,
 ) {
-    let e = i + len - 1;
-    let (start, end) = if p > e as isize {
-        s.swap_blocks(i as isize - 1, e, p as usize, delta);
-        (p as usize + 1 - len, p as usize)
-    } else {
-        s.swap_blocks(p, i - 1, e, delta);
-        ((p + 1) as usize, (p + 1) as usize + len - 1)
-    };
+    let ((h, a, b), (start, end)) = or_as_swap(i, len, p);
+    s.swap_blocks(h, a, b, delta);
     if reversed {
         s.reverse(m, start, end, 0.0);
+    }
+}
+
+/// An Or-opt move (the segment of `len` cells at `i` goes after position `p`) as the swap of
+/// two adjacent blocks `(h, i, j)` (blocks `[h+1..=i]` and `[i+1..=j]`, as in
+/// [`Solution::swap_blocks`]) and the positions `(start, end)` the segment occupies afterwards
+/// (what a reversed insertion then reverses).
+#[inline]
+pub(crate) fn or_as_swap(
+    i: usize,
+    len: usize,
+    p: isize,
+) -> ((isize, usize, usize), (usize, usize)) {
+    let e = i + len - 1;
+    if p > e as isize {
+        (
+            (i as isize - 1, e, p as usize),
+            (p as usize + 1 - len, p as usize),
+        )
+    } else {
+        (
+            (p, i - 1, e),
+            ((p + 1) as usize, (p + 1) as usize + len - 1),
+        )
     }
 }
 
