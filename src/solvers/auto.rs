@@ -1,7 +1,7 @@
 //! `auto`: the default solver — a portfolio chosen by measurement on TSPLIB SOP.
 //!
 //! 1. `beam` (iterative beam search with dominance and bounds) for a small share of the
-//!    budget (`beam-share`, 5 %) on instances of at most `beam-max-cells` cells, and only
+//!    budget (`beam-share`, 10 %) on instances of at most `beam-max-cells` cells, and only
 //!    when the wall-clock budget is at least `beam-min-seconds`: it proves small and densely
 //!    constrained instances optimal in milliseconds, and then `auto` stops.
 //! 2. The phases of `plan`, each with a share of what is left. The default
@@ -35,7 +35,7 @@ pub static INFO: SolverInfo = SolverInfo {
         },
         ParamSpec {
             name: "beam-share",
-            default: "0.05",
+            default: "0.1",
             kind: ParamKind::Float,
             help: "share of the budget given to the beam proof attempt",
         },
