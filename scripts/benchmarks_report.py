@@ -239,7 +239,7 @@ def main():
         for plan, sid, budget, runs, st in summary_rows:
             if sid != "auto":
                 continue
-            proto = "(issue protocol: median of 5 seeds)" if runs >= 5 else f"({runs} seed only; the issue asks for the median of 5)"
+            proto = "(issue protocol: median of 5 seeds)" if runs >= 5 else f"({'median of ' + str(runs) + ' seeds' if runs > 1 else '1 seed'} only; the issue asks for the median of 5)"
             if st["count"] != 41:
                 proto += f" [only {st['count']} of 41 instances in the results]"
             if "seconds=10" in budget:
