@@ -194,8 +194,8 @@ impl CostModel {
             .map(|cell| {
                 let k = cm.modes(cell);
                 let x = cm.turned(cell, 0).unwrap_or(0);
-                let fits = x < u8::MAX as usize
-                    && (0..k).all(|md| cm.turned(cell, md).unwrap_or(md) == md ^ x);
+                let fits =
+                    x < u8::MAX as usize && (0..k).all(|md| cm.turned_or_same(cell, md) == md ^ x);
                 if fits { x as u8 } else { u8::MAX }
             })
             .collect();
@@ -220,6 +220,13 @@ impl CostModel {
     pub fn turned(&self, cell: usize, mode: usize) -> Option<usize> {
         let t = self.turn[self.node(cell, mode)];
         (t != u32::MAX).then(|| t as usize - self.offsets[cell] as usize)
+    }
+
+    /// [`CostModel::turned`], or `mode` itself where the cell cannot be cut the other way (what
+    /// a reversal does to a cell).
+    #[inline]
+    pub fn turned_or_same(&self, cell: usize, mode: usize) -> usize {
+        self.turned(cell, mode).unwrap_or(mode)
     }
 
     /// The objective costs are expressed in.

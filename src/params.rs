@@ -93,6 +93,15 @@ impl Params {
     pub fn word(&self, name: &str) -> &str {
         self.raw(name)
     }
+    /// A three-way switch (a `Choice` of `auto` and on/off words): `Some(true)` for `true` or
+    /// `on`, `Some(false)` for `false` or `off`, `None` (decide automatically) otherwise.
+    pub fn switch(&self, name: &str) -> Option<bool> {
+        match self.raw(name) {
+            "true" | "on" => Some(true),
+            "false" | "off" => Some(false),
+            _ => None,
+        }
+    }
 }
 
 fn check_value(owner: &str, spec: &ParamSpec, v: &str) -> Result<()> {

@@ -33,6 +33,11 @@ impl Dag {
         self.preds.len()
     }
 
+    /// True when there is no precedence at all (no cell has a successor).
+    pub fn is_empty(&self) -> bool {
+        self.succs.iter().all(|v| v.is_empty())
+    }
+
     /// The DAG with only the edges of its transitive reduction. For large sparse graphs
     /// (more than `max_n` cells) the graph is returned unchanged.
     pub fn reduced(&self, max_n: usize) -> Dag {

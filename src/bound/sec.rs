@@ -24,7 +24,7 @@
 use super::assignment;
 use super::cells::CellGraph;
 use super::closure::Closure;
-use rustc_hash::FxHashSet;
+use rustc_hash::FxHashMap;
 
 /// Multipliers, sets and duals of the subtour-elimination Lagrangian.
 #[derive(Debug, Clone)]
@@ -99,7 +99,8 @@ pub fn sec_bound(
     let d = n + 1;
     let mut sets: Vec<Vec<u32>> = Vec::new();
     let mut pi: Vec<Vec<u32>> = Vec::new();
-    let mut known: FxHashSet<Vec<u32>> = FxHashSet::default();
+    // each set's index in `sets`
+    let mut known: FxHashMap<Vec<u32>, usize> = FxHashMap::default();
     let mut member: Vec<Vec<bool>> = Vec::new();
     let mut mu: Vec<f64> = Vec::new();
     let mut best: Option<SecBound> = None;
@@ -153,7 +154,12 @@ pub fn sec_bound(
                 continue;
             }
             cyc.sort_unstable();
-            let k = if known.insert(cyc.clone()) {
+            let k = if let Some(&k) = known.get(&cyc) {
+                if !ascent {
+                    continue;
+                }
+                k
+            } else {
                 // `mem`: S ∪ π(S), the heads that do not count as leaving S
                 let mut mem = vec![false; d];
                 for &c in &cyc {
@@ -172,16 +178,10 @@ pub fn sec_bound(
                 }
                 member.push(mem);
                 pi.push(p);
+                known.insert(cyc.clone(), sets.len());
                 sets.push(cyc);
                 mu.push(0.0);
                 sets.len() - 1
-            } else if ascent {
-                match sets.iter().position(|s| *s == cyc) {
-                    Some(k) => k,
-                    None => continue,
-                }
-            } else {
-                continue;
             };
             if ascent {
                 // cheapest reduced cost of leaving the subtour

@@ -78,7 +78,7 @@ impl<'a> Large<'a> {
     /// The search from `s` (call only when [`applies`] holds).
     pub fn new(c: Costs<'a>, nb: &'a Neighbours, s: &Solution) -> Self {
         let m = c.m;
-        let free = m.dag.succs.iter().all(|v| v.is_empty())
+        let free = m.dag.is_empty()
             && (0..m.n()).all(|cell| (0..m.modes(cell)).all(|md| m.turned(cell, md).is_some()));
         Large {
             c,
@@ -498,12 +498,16 @@ impl<'a> Large<'a> {
                 fails += 1;
             }
         }
-        // leave no cell queued
+        self.clear_queue();
+        self.logging = false;
+        kicks
+    }
+
+    /// Leaves no cell queued.
+    fn clear_queue(&mut self) {
         while let Some(x) = self.queue.pop_front() {
             self.on[x as usize] = false;
         }
-        self.logging = false;
-        kicks
     }
 
     /// True when blocks `[h+1..=i]` and `[i+1..=j]` may swap: no cell of the first block
@@ -538,8 +542,6 @@ impl<'a> Large<'a> {
                 Op::Mode(x, md) => self.t.set_mode(m, x, md, 0.0),
             }
         }
-        while let Some(x) = self.queue.pop_front() {
-            self.on[x as usize] = false;
-        }
+        self.clear_queue();
     }
 }

@@ -15,7 +15,7 @@ use std::collections::VecDeque;
 
 /// True when [`or_opt`] may run: the instance has no precedence.
 pub fn applies(c: &Costs) -> bool {
-    c.m.dag.succs.iter().all(|v| v.is_empty())
+    c.m.dag.is_empty()
 }
 
 /// The path as a cyclic doubly linked list through a sentinel (index n: before the first
@@ -258,7 +258,7 @@ pub fn or_opt(c: &Costs, nb: &Neighbours, s: &mut Solution, ctx: &mut Context) -
             for &z in &order[..k] {
                 if best.rev {
                     let md = l.mode[z as usize] as usize;
-                    l.mode[z as usize] = m.turned(z as usize, md).unwrap_or(md) as u32;
+                    l.mode[z as usize] = m.turned_or_same(z as usize, md) as u32;
                 }
                 l.next[a as usize] = z;
                 l.prev[z as usize] = a;

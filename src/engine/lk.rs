@@ -16,7 +16,7 @@
 //! On instances whose costs read the same backwards (a symmetric matrix: TSPLIB's prob.100)
 //! a step is evaluated in O(1); otherwise the segment's inner links are summed, O(length).
 
-use super::moves::{reverse_delta_direct, reverse_delta_ends, reversible_segment};
+use super::moves::{flipped_at, reverse_delta_direct, reverse_delta_ends, reversible_segment};
 use super::search::{Search, improves};
 use super::solution::flip_mode;
 use super::{Costs, Neighbours, Slot, Solution};
@@ -186,14 +186,10 @@ impl Lk {
         let delta = self.reverse_delta(c, s, i as usize, j as usize);
         let new_cum = cum + delta;
         // the closing link t1–t4 after the move, read in its direction on the path
-        let m = c.m;
-        let (i, j) = (i as usize, j as usize);
         let t1_after = |q: isize| -> Slot {
             // the slot at position q after reversing [i..=j]
-            if q >= i as isize && q <= j as isize {
-                let src = i as isize + j as isize - q;
-                s.at(src)
-                    .map(|(cell, md)| (cell, flip_mode(m, cell, md).unwrap_or(md)))
+            if q >= i && q <= j {
+                flipped_at(c, s, i + j - q)
             } else {
                 s.at(q)
             }
@@ -210,8 +206,8 @@ impl Lk {
             return None;
         }
         Some(Step {
-            i,
-            j,
+            i: i as usize,
+            j: j as usize,
             delta,
             score,
             pa: new_pa,

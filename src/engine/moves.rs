@@ -99,11 +99,7 @@ impl SegmentMove {
             flast: None,
         };
         if reversible {
-            let m = c.m;
-            let flipped = |q: isize| -> Slot {
-                s.at(q)
-                    .map(|(cell, md)| (cell, flip_mode(m, cell, md).unwrap_or(md)))
-            };
+            let flipped = |q: isize| flipped_at(c, s, q);
             for q in ii..e {
                 mv.inner_rev += c.link(flipped(q + 1), flipped(q)) - s.link(c, q, q + 1);
             }
@@ -243,7 +239,7 @@ impl Reversal {
         self.nonzero = self.asym.iter().filter(|&&v| v != 0.0).count();
         self.prefix_ok = false;
         let all_flip = (0..n).all(|p| flipped_slot(m, s, p).is_some());
-        let no_prec = m.dag.succs.iter().all(|v| v.is_empty());
+        let no_prec = m.dag.is_empty();
         self.mode = if all_flip && no_prec {
             Reach::All
         } else if n <= self.lazy_above {
@@ -331,7 +327,7 @@ impl Reversal {
         let fl = |p: usize| -> Slot {
             let cell = s.order[p] as usize;
             let md = s.mode[cell] as usize;
-            Some((cell, flip_mode(m, cell, md).unwrap_or(md)))
+            Some((cell, m.turned_or_same(cell, md)))
         };
         let (ii, jj) = (i as isize, j as isize);
         let inner = if self.nonzero == 0 {
@@ -387,7 +383,8 @@ pub fn reverse_delta_ends(c: &Costs, s: &Solution, i: usize, j: usize) -> f64 {
 }
 
 /// The (cell, mode) at position `p` cut the other way (its mode unchanged if it has none).
-fn flipped_at(c: &Costs, s: &Solution, p: isize) -> Slot {
+#[inline]
+pub(crate) fn flipped_at(c: &Costs, s: &Solution, p: isize) -> Slot {
     s.at(p)
-        .map(|(cell, md)| (cell, flip_mode(c.m, cell, md).unwrap_or(md)))
+        .map(|(cell, md)| (cell, c.m.turned_or_same(cell, md)))
 }

@@ -135,7 +135,7 @@ impl Solution {
                 Some(x) => self.mode[c] ^ x,
                 None => {
                     let md = self.mode[c] as usize;
-                    flip_mode(m, c, md).unwrap_or(md) as u32
+                    m.turned_or_same(c, md) as u32
                 }
             };
         }

@@ -44,7 +44,7 @@ impl Seg {
 /// The mode of `cell` cut the other way (itself where it has no reversal mode); an involution.
 #[inline]
 pub fn turn(m: &CostModel, cell: usize, mode: u32) -> u32 {
-    m.turned(cell, mode as usize).map_or(mode, |t| t as u32)
+    m.turned_or_same(cell, mode as usize) as u32
 }
 
 /// The path of all cells as a two-level list (see the module documentation).

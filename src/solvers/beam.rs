@@ -294,11 +294,17 @@ impl Tables {
     /// `μ(i, j)`: Σ multipliers of the sets that the arc i → j leaves (home = n).
     #[inline]
     fn mu(&self, n: usize, i: usize, j: usize) -> f64 {
-        if self.mu_arc.is_empty() {
-            0.0
-        } else {
-            self.mu_arc[i * (n + 1) + j]
-        }
+        arc_mu(&self.mu_arc, n, i, j)
+    }
+}
+
+/// `μ(i, j)` read from the dense multiplier matrix `mu_arc` (n + 1 columns; empty: all zero).
+#[inline]
+fn arc_mu(mu_arc: &[f64], n: usize, i: usize, j: usize) -> f64 {
+    if mu_arc.is_empty() {
+        0.0
+    } else {
+        mu_arc[i * (n + 1) + j]
     }
 }
 
@@ -368,14 +374,7 @@ fn tables(
                 .collect()
         })
         .unwrap_or_default();
-    let d = n + 1;
-    let mu = |i: usize, j: usize| {
-        if mu_arc.is_empty() {
-            0.0
-        } else {
-            mu_arc[i * d + j]
-        }
-    };
+    let mu = |i: usize, j: usize| arc_mu(&mu_arc, n, i, j);
     let r = |i: usize, j: usize| g.c(i, j) - u[i] - v[j] - mu(i, j);
     let mut pred_mask: Vec<Vec<u64>> = (0..n)
         .map(|c| {

@@ -104,11 +104,7 @@ pub fn from_params(p: &Params) -> Eacs {
         k: p.int("k").max(1) as usize,
         two_opt: p.bool("two-opt"),
         two_way: p.bool("two-way"),
-        lk: match p.word("lk") {
-            "true" => Some(true),
-            "false" => Some(false),
-            _ => None,
-        },
+        lk: p.switch("lk"),
     }
 }
 

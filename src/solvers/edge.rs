@@ -65,10 +65,7 @@ impl Solver for GreedyEdge {
 /// True when greedy matching applies: a geometric instance without precedence whose cells
 /// all use one tool.
 pub fn applicable(m: &CostModel) -> bool {
-    m.is_geometric()
-        && m.n() > 0
-        && m.dag.succs.iter().all(|v| v.is_empty())
-        && (0..m.n()).all(|c| m.tool(c) == m.tool(0))
+    m.is_geometric() && m.n() > 0 && m.dag.is_empty() && (0..m.n()).all(|c| m.tool(c) == m.tool(0))
 }
 
 const NONE: u32 = u32::MAX;
@@ -113,7 +110,7 @@ impl<'a> Level<'a> {
         Level { m, items, vars }
     }
     fn flip(&self, v: Visit) -> Visit {
-        Visit::new(v.cell, flip_mode(self.m, v.cell, v.mode).unwrap_or(v.mode))
+        Visit::new(v.cell, self.m.turned_or_same(v.cell, v.mode))
     }
     /// First and last (cell, mode) of an item used in variant v.
     fn ends(&self, i: u32, v: u32) -> (Visit, Visit) {

@@ -114,11 +114,7 @@ pub fn from_params(p: &Params) -> Ils {
         restart: p.int("restart").max(1),
         stall: p.int("stall").max(1),
         two_way: p.bool("two-way"),
-        lk: match p.word("lk") {
-            "true" => Some(true),
-            "false" => Some(false),
-            _ => None,
-        },
+        lk: p.switch("lk"),
         lk_depth: p.int("lk-depth").max(1) as usize,
         lk_breadth: p.int("lk-breadth").max(1) as usize,
         sop3: p.bool("sop3"),

@@ -77,11 +77,7 @@ pub static INFO: SolverInfo = SolverInfo {
             k: p.int("k").max(1) as usize,
             max_block: p.int("max-block") as usize,
             vnd: p.bool("vnd"),
-            two_level: match p.word("two-level") {
-                "on" => Some(true),
-                "off" => Some(false),
-                _ => None,
-            },
+            two_level: p.switch("two-level"),
             kick_block: p.int("kick-block").max(1) as usize,
         })
     },
