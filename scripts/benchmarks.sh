@@ -60,9 +60,9 @@ if [ "$run" = 1 ]; then
     "$bin" run "experiments/$p.toml" --threads 1
   done
   # 10^6 cells: greedy (no budget); greedy + one improvement pass (the linked-list Or-opt pass,
-  # local-search vnd=false, no budget: does it finish within 60 s?); greedy + the VND capped at
-  # the 60 s (plus greedy at 10^5 for the memory growth), one process each so that the
-  # peak resident memory is that run's.
+  # local-search vnd=false, no budget: does it finish within 60 s?); greedy + the search capped at
+  # the 60 s (the two-level search where it applies, else the VND; plus greedy at 10^5
+  # for the memory growth), one process each so that the peak resident memory is that run's.
   if [ ! -s results/scale-1e6.csv ]; then
     for pl in "0 0" "0 7" "1 7"; do
       set -- $pl
