@@ -144,7 +144,8 @@ pub fn parse_plan(plan: &str) -> Result<Vec<Phase>> {
             return Err(bad("a plan cannot contain auto itself".to_string()));
         }
         let info = super::find(&solver)?;
-        Params::new(&solver, info.params, &params)?;
+        Params::new(&solver, info.params, &params)
+            .map_err(|e| bad(format!("plan phase '{part}': {e}")))?;
         if chained && solver != "ils" && solver != "eacs" {
             return Err(bad(format!(
                 "plan phase '{part}': only ils and eacs can start from the best so far"
