@@ -362,37 +362,43 @@ impl CostModel {
     }
 
     /// Cost of going from (a, ma) to (b, mb).
-    #[inline]
+    #[inline(always)]
     pub fn arc(&self, a: usize, ma: usize, b: usize, mb: usize) -> f64 {
         let na = self.node(a, ma);
         let nb = self.node(b, mb);
         match &self.geo {
+            // the matrix case stays small enough to inline into every move's delta
             None => match &self.matrix {
                 Some(m) => m.get(na, nb),
                 None => 0.0,
             },
-            Some(g) => {
-                let ex = g.exit[na];
-                let en = g.entry[nb];
-                if self.tools[a] == self.tools[b] {
-                    let dxy = ex.dist_xy(&en);
-                    if (ex.z - en.z).abs() <= 1e-9 && dxy <= g.link_distance + 1e-9 {
-                        // linked at cutting feed, no lift
-                        return match self.objective {
-                            Objective::Time => dxy * self.cut_rate[b],
-                            _ => dxy,
-                        };
-                    }
-                    let air = (g.clearance - ex.z) + dxy + (g.clearance - en.z);
-                    self.scale(g, air, 1, 0, 0.0)
-                } else {
-                    let air = (g.clearance - ex.z)
-                        + ex.at_z(g.clearance).dist(&g.tool_change)
-                        + g.tool_change.dist(&en.at_z(g.clearance))
-                        + (g.clearance - en.z);
-                    self.scale(g, air, 1, 1, 0.0)
-                }
+            Some(g) => self.geo_arc(g, a, na, b, nb),
+        }
+    }
+
+    /// [`CostModel::arc`] on a geometric instance, between nodes `na` (of cell `a`) and `nb`
+    /// (of cell `b`).
+    #[inline]
+    fn geo_arc(&self, g: &Geo, a: usize, na: usize, b: usize, nb: usize) -> f64 {
+        let ex = g.exit[na];
+        let en = g.entry[nb];
+        if self.tools[a] == self.tools[b] {
+            let dxy = ex.dist_xy(&en);
+            if (ex.z - en.z).abs() <= 1e-9 && dxy <= g.link_distance + 1e-9 {
+                // linked at cutting feed, no lift
+                return match self.objective {
+                    Objective::Time => dxy * self.cut_rate[b],
+                    _ => dxy,
+                };
             }
+            let air = (g.clearance - ex.z) + dxy + (g.clearance - en.z);
+            self.scale(g, air, 1, 0, 0.0)
+        } else {
+            let air = (g.clearance - ex.z)
+                + ex.at_z(g.clearance).dist(&g.tool_change)
+                + g.tool_change.dist(&en.at_z(g.clearance))
+                + (g.clearance - en.z);
+            self.scale(g, air, 1, 1, 0.0)
         }
     }
 

@@ -43,25 +43,29 @@ impl<'a> Costs<'a> {
         Costs { m, closed: false }
     }
     /// Cost of going from `a` to `b`; `None` on the left is the start, on the right the end.
-    #[inline]
+    #[inline(always)]
     pub fn link(&self, a: Slot, b: Slot) -> f64 {
         match (a, b) {
             (Some((a, ma)), Some((b, mb))) => self.m.arc(a, ma, b, mb),
             (None, Some((b, mb))) => self.m.start(b, mb),
-            (Some((a, ma)), None) => {
-                let f = self.m.finish(a, ma);
-                if self.closed && self.m.is_geometric() && f == 0.0 {
-                    let ex = self.m.exit(self.m.node(a, ma));
-                    let air = ex.dist(&self.m.home_point());
-                    match self.m.objective() {
-                        crate::model::Objective::Time => air * self.m.rapid_rate(),
-                        _ => air,
-                    }
-                } else {
-                    f
-                }
-            }
+            (Some((a, ma)), None) => self.finish(a, ma),
             (None, None) => 0.0,
+        }
+    }
+
+    /// Cost of ending the path with (a, ma), with the closed loop's return home.
+    #[inline]
+    fn finish(&self, a: usize, ma: usize) -> f64 {
+        let f = self.m.finish(a, ma);
+        if self.closed && self.m.is_geometric() && f == 0.0 {
+            let ex = self.m.exit(self.m.node(a, ma));
+            let air = ex.dist(&self.m.home_point());
+            match self.m.objective() {
+                crate::model::Objective::Time => air * self.m.rapid_rate(),
+                _ => air,
+            }
+        } else {
+            f
         }
     }
 }

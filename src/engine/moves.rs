@@ -11,10 +11,22 @@ use crate::cost::CostModel;
 /// (no reversal), for −1 ≤ h < i < j < n.
 #[inline]
 pub fn sop3_delta(c: &Costs, s: &Solution, h: isize, i: isize, j: isize) -> f64 {
-    s.link(c, h, i + 1) + s.link(c, j, h + 1) + s.link(c, i, j + 1)
-        - s.link(c, h, h + 1)
-        - s.link(c, i, i + 1)
-        - s.link(c, j, j + 1)
+    sop3_sum(
+        s.link(c, h, i + 1),
+        s.link(c, j, h + 1),
+        s.link(c, i, j + 1),
+        s.link(c, h, h + 1),
+        s.link(c, i, i + 1),
+        s.link(c, j, j + 1),
+    )
+}
+
+/// [`sop3_delta`] from its six links — new (h→i+1, j→h+1, i→j+1) and old (h→h+1, i→i+1,
+/// j→j+1) — summed in one fixed order, so that searches which keep the links that do not
+/// change along a scan get bit-identical deltas.
+#[inline(always)]
+pub(crate) fn sop3_sum(a: f64, b: f64, cc: f64, d: f64, e: f64, f: f64) -> f64 {
+    a + b + cc - d - e - f
 }
 
 /// The insertion window of segment `[i..i+len)`: it may go after any position p with

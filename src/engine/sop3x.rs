@@ -10,7 +10,7 @@
 //! The transitive reduction suffices, as in the forward search: a chain from a cell of L to a
 //! cell of R enters R from a cell of L, and that cell is stamped.
 
-use super::moves::sop3_delta;
+use super::moves::sop3_sum;
 use super::search::{Search, improves};
 use super::{Costs, Solution};
 use crate::solvers::Context;
@@ -73,18 +73,32 @@ pub(crate) fn forward(
         }
         let label = w.next_label(n as usize);
         let imax = (h + max_block as isize).min(n - 2);
+        // the links that stay fixed while j (and i) scan
+        let old_h = s.link(c, h, h + 1);
+        let first_l = s.at(h + 1);
         for i in (h + 1)..=imax {
             for &q in &m.dag.succs[s.order[i as usize] as usize] {
                 w.stamp[q as usize] = label;
             }
             let jmax = (i + max_block as isize).min(n - 1);
             let mut best = (0.0, 0isize);
+            let new_h = s.link(c, h, i + 1);
+            let old_i = s.link(c, i, i + 1);
+            let last_l = s.at(i);
             for j in (i + 1)..=jmax {
                 if w.stamp[s.order[j as usize] as usize] == label {
                     break;
                 }
                 *evals += 1;
-                let d = sop3_delta(c, s, h, i, j);
+                let (sj, sj1) = (s.at(j), s.at(j + 1));
+                let d = sop3_sum(
+                    new_h,
+                    c.link(sj, first_l),
+                    c.link(last_l, sj1),
+                    old_h,
+                    old_i,
+                    c.link(sj, sj1),
+                );
                 if d < best.0 {
                     best = (d, j);
                 }
@@ -115,6 +129,9 @@ fn backward(
         }
         let label = w.next_label(n as usize);
         let imin = (j - max_block as isize).max(0);
+        // the links that stay fixed while h (and i) scan
+        let old_j = s.link(c, j, j + 1);
+        let last_r = s.at(j);
         // R = [i+1..=j] grows leftwards
         let mut i = j - 1;
         while i >= imin {
@@ -123,6 +140,9 @@ fn backward(
             }
             let hmin = (i - max_block as isize).max(-1);
             let mut best = (0.0, 0isize);
+            let new_i = s.link(c, i, j + 1);
+            let old_i = s.link(c, i, i + 1);
+            let first_r = s.at(i + 1);
             // L = [h+1..=i] grows leftwards
             let mut h = i - 1;
             while h >= hmin {
@@ -130,7 +150,15 @@ fn backward(
                     break;
                 }
                 *evals += 1;
-                let d = sop3_delta(c, s, h, i, j);
+                let (sh, sh1) = (s.at(h), s.at(h + 1));
+                let d = sop3_sum(
+                    c.link(sh, first_r),
+                    c.link(last_r, sh1),
+                    new_i,
+                    c.link(sh, sh1),
+                    old_i,
+                    old_j,
+                );
                 if d < best.0 {
                     best = (d, h);
                 }
