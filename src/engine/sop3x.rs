@@ -20,6 +20,9 @@ use crate::solvers::Context;
 pub(crate) struct Labels {
     stamp: Vec<u32>,
     label: u32,
+    /// Links of the current path along a scan (`links[k]`: from the k-th scanned position to
+    /// the next), filled as the scan first reaches them and reused for every block.
+    links: Vec<f64>,
 }
 
 impl Labels {
@@ -73,9 +76,10 @@ pub(crate) fn forward(
         }
         let label = w.next_label(n as usize);
         let imax = (h + max_block as isize).min(n - 2);
-        // the links that stay fixed while j (and i) scan
+        // the links that stay fixed while j (and i) scan; w.links[k] = link(h+2+k, h+3+k)
         let old_h = s.link(c, h, h + 1);
         let first_l = s.at(h + 1);
+        w.links.clear();
         for i in (h + 1)..=imax {
             for &q in &m.dag.succs[s.order[i as usize] as usize] {
                 w.stamp[q as usize] = label;
@@ -91,13 +95,18 @@ pub(crate) fn forward(
                 }
                 *evals += 1;
                 let (sj, sj1) = (s.at(j), s.at(j + 1));
+                let k = (j - h - 2) as usize;
+                while w.links.len() <= k {
+                    let p = h + 2 + w.links.len() as isize;
+                    w.links.push(s.link(c, p, p + 1));
+                }
                 let d = sop3_sum(
                     new_h,
                     c.link(sj, first_l),
                     c.link(last_l, sj1),
                     old_h,
                     old_i,
-                    c.link(sj, sj1),
+                    w.links[k],
                 );
                 if d < best.0 {
                     best = (d, j);
@@ -129,9 +138,10 @@ fn backward(
         }
         let label = w.next_label(n as usize);
         let imin = (j - max_block as isize).max(0);
-        // the links that stay fixed while h (and i) scan
+        // the links that stay fixed while h (and i) scan; w.links[k] = link(j-2-k, j-1-k)
         let old_j = s.link(c, j, j + 1);
         let last_r = s.at(j);
+        w.links.clear();
         // R = [i+1..=j] grows leftwards
         let mut i = j - 1;
         while i >= imin {
@@ -151,11 +161,16 @@ fn backward(
                 }
                 *evals += 1;
                 let (sh, sh1) = (s.at(h), s.at(h + 1));
+                let k = (j - 2 - h) as usize;
+                while w.links.len() <= k {
+                    let p = j - 2 - w.links.len() as isize;
+                    w.links.push(s.link(c, p, p + 1));
+                }
                 let d = sop3_sum(
                     c.link(sh, first_r),
                     c.link(last_r, sh1),
                     new_i,
-                    c.link(sh, sh1),
+                    w.links[k],
                     old_i,
                     old_j,
                 );
