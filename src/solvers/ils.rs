@@ -1,8 +1,9 @@
 //! `ils`: iterated local search over the shared engine — cellseq's strongest general solver.
 //!
 //! Start from the greedy sequence and descend with the full VND. Then repeat: kick the
-//! current solution with random feasible segment swaps (SOP-3-exchange moves chosen at random,
-//! feasibility by labelling), repair with Or-opt and SOP-3-exchange started only from the cells
+//! current solution (`perturb`: a random feasible reorder of a window, the default; random
+//! feasible segment swaps; or ruin and recreate, [`crate::engine::ruin`], whose O(n) kick
+//! suits instances of up to a few thousand cells), repair with Or-opt and SOP-3-exchange started only from the cells
 //! the kick disturbed (don't-look bits everywhere else), re-choose modes, and accept the result
 //! when it lies within a record-to-record band above the best (`accept`, relative). After
 //! `restart` kicks without a new best the walk restarts from the best solution. On instances
@@ -15,6 +16,7 @@ use super::start::{greedy_solution, outcome};
 use super::{Context, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo};
 use crate::engine::lk::Lk;
 use crate::engine::moves::sop3_delta;
+use crate::engine::ruin::Ruin;
 use crate::engine::search::Search;
 use crate::engine::sop3x::{TwoWay, sop3_two_way};
 use crate::engine::{Costs, Solution};
@@ -42,8 +44,20 @@ pub static INFO: SolverInfo = SolverInfo {
         ParamSpec {
             name: "perturb",
             default: "shuffle",
-            kind: ParamKind::Choice(&["shuffle", "swap"]),
-            help: "kick: random feasible reorder of a window, or random segment swaps",
+            kind: ParamKind::Choice(&["shuffle", "swap", "ruin"]),
+            help: "kick: random feasible reorder of a window, random segment swaps, or ruin and recreate (strings of cells around a random cell removed and inserted again at their cheapest places; engine::ruin)",
+        },
+        ParamSpec {
+            name: "ruin-size",
+            default: "10",
+            kind: ParamKind::Int,
+            help: "perturb=ruin: average number of removed cells",
+        },
+        ParamSpec {
+            name: "ruin-string",
+            default: "10",
+            kind: ParamKind::Int,
+            help: "perturb=ruin: longest removed string of consecutive cells",
         },
         ParamSpec {
             name: "max-seg",
@@ -108,7 +122,13 @@ pub fn from_params(p: &Params) -> Ils {
     Ils {
         k: p.int("k").max(1) as usize,
         kicks: p.int("kicks").max(1) as usize,
-        shuffle: p.word("perturb") == "shuffle",
+        perturb: match p.word("perturb") {
+            "shuffle" => Perturb::Shuffle,
+            "swap" => Perturb::Swap,
+            _ => Perturb::Ruin,
+        },
+        ruin_size: p.int("ruin-size").max(1) as usize,
+        ruin_string: p.int("ruin-string").max(1) as usize,
         max_seg: p.int("max-seg") as usize,
         accept: p.float("accept").max(0.0),
         restart: p.int("restart").max(1),
@@ -127,8 +147,12 @@ pub struct Ils {
     pub k: usize,
     /// Segment swaps per kick.
     pub kicks: usize,
-    /// Window shuffles (true) or segment swaps (false).
-    pub shuffle: bool,
+    /// The kick.
+    pub perturb: Perturb,
+    /// Ruin and recreate: average number of removed cells.
+    pub ruin_size: usize,
+    /// Ruin and recreate: longest removed string.
+    pub ruin_string: usize,
     /// Longest segment in a kick (0 = automatic).
     pub max_seg: usize,
     /// Record-to-record band.
@@ -147,6 +171,17 @@ pub struct Ils {
     pub lk_breadth: usize,
     /// SOP-3-exchange in the repair.
     pub sop3: bool,
+}
+
+/// The kick of [`Ils`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Perturb {
+    /// A random feasible reorder of a window of positions.
+    Shuffle,
+    /// Random feasible segment swaps.
+    Swap,
+    /// Ruin and recreate ([`crate::engine::ruin`]).
+    Ruin,
 }
 
 /// One random feasible segment swap on `s`: blocks `[h+1..=i]` and `[i+1..=j]` trade places.
@@ -321,6 +356,7 @@ impl Ils {
         let mut label = 0u32;
         let mut seeds: Vec<u32> = Vec::new();
         let mut scratch = Shuffle::default();
+        let mut ruin = Ruin::new(self.ruin_size, self.ruin_string, 0.01);
         let mut w = TwoWay::default();
         let bounded = ctx.budget.max_evals.is_some() || ctx.budget.time_limit.is_some();
         let mut since_best = 0u64;
@@ -334,12 +370,22 @@ impl Ils {
             seeds.clear();
             let mut kicked = false;
             for _ in 0..self.kicks {
-                kicked |= if self.shuffle {
-                    shuffle(&c, &mut trial, &mut rng, max_seg, &mut scratch, &mut seeds)
-                } else {
-                    kick(
+                kicked |= match self.perturb {
+                    Perturb::Shuffle => {
+                        shuffle(&c, &mut trial, &mut rng, max_seg, &mut scratch, &mut seeds)
+                    }
+                    Perturb::Swap => kick(
                         &c, &mut trial, &mut rng, max_seg, &mut stamp, &mut label, &mut seeds,
-                    )
+                    ),
+                    Perturb::Ruin => {
+                        match ruin.kick(&c, &search.nb, &mut trial, &mut rng, &mut seeds) {
+                            Some(e) => {
+                                ctx.count(e);
+                                true
+                            }
+                            None => false,
+                        }
+                    }
                 };
             }
             ctx.count(seeds.len() as u64 + 1);
