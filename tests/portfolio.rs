@@ -148,3 +148,36 @@ fn ils_lin_kernighan_chains_help_on_a_symmetric_instance_and_stay_deterministic(
         off.report.cost
     );
 }
+
+#[test]
+fn auto_gives_ils_more_time_on_symmetric_matrix_costs_only() {
+    use cellseq::cost::CostModel;
+    use cellseq::solvers::auto::{Auto, PLAN, SYMMETRIC_PLAN};
+    let auto = |plan: &str| Auto {
+        seconds: 1.0,
+        beam_share: 0.1,
+        beam_max_cells: 400,
+        plan: plan.to_string(),
+        symmetric_plan: SYMMETRIC_PLAN.to_string(),
+        beam_min_seconds: 2.0,
+    };
+    let model = |name: &str| {
+        let inst = sop(name);
+        CostModel::new(&inst, inst.default_objective())
+    };
+    // prob.42's matrix reads the same backwards; ESC25's does not
+    assert_eq!(auto(PLAN).plan_for(&model("prob.42")), SYMMETRIC_PLAN);
+    assert_eq!(auto(PLAN).plan_for(&model("ESC25")), PLAN);
+    // a plan the user chose is kept
+    let own = "local-search:0.5,ils*:1";
+    assert_eq!(auto(own).plan_for(&model("prob.42")), own);
+    // geometric instances keep the default plan
+    let kv: BTreeMap<String, String> = [("n", "30"), ("modes", "2"), ("reversible", "true")]
+        .into_iter()
+        .map(|(k, v)| (k.to_string(), v.to_string()))
+        .collect();
+    let inst = cellseq::generate::generate("uniform", &kv, 3).unwrap();
+    let m = CostModel::new(&inst, inst.default_objective());
+    assert_eq!(auto(PLAN).plan_for(&m), PLAN);
+    assert!(parse_plan(SYMMETRIC_PLAN).is_ok());
+}
