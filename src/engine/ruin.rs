@@ -38,6 +38,10 @@ pub struct Ruin {
     at: Vec<u32>,
     missing: Vec<u32>,
     ready: Vec<u32>,
+    /// Search scratch of [`Ruin::upper`]: a visit label per cell and the current label.
+    visited: Vec<u32>,
+    label: u32,
+    stack: Vec<u32>,
 }
 
 impl Ruin {
@@ -53,6 +57,9 @@ impl Ruin {
             at: Vec::new(),
             missing: Vec::new(),
             ready: Vec::new(),
+            visited: Vec::new(),
+            label: 0,
+            stack: Vec::new(),
         }
     }
 
@@ -133,22 +140,38 @@ impl Ruin {
         );
         self.at.clear();
         self.at.resize(n, u32::MAX);
+        if self.visited.len() != n {
+            self.visited = vec![0; n];
+            self.label = 0;
+        }
         for (i, &z) in self.seq.iter().enumerate() {
             self.at[z as usize] = i as u32;
         }
     }
 
-    /// The latest index a removed cell may be inserted at (before the kept cell there):
-    /// its kept successors' indices and, through removed successors, theirs.
-    fn upper(&self, c: &Costs, x: u32) -> usize {
+    /// The latest index a removed cell may be inserted at (before the cell there): the
+    /// smallest index of a cell in the sequence that `x` reaches directly or through removed
+    /// cells not yet back. One search over those cells, each visited once (following every
+    /// path instead would be exponential on dense precedence).
+    fn upper(&mut self, c: &Costs, x: u32) -> usize {
+        self.label = self.label.wrapping_add(1);
+        if self.label == 0 {
+            self.visited.fill(0);
+            self.label = 1;
+        }
         let mut hi = self.seq.len();
-        for &y in &c.m.dag.succs[x as usize] {
-            let h = if self.at[y as usize] != u32::MAX {
-                self.at[y as usize] as usize
-            } else {
-                self.upper(c, y)
-            };
-            hi = hi.min(h);
+        self.stack.clear();
+        self.stack.push(x);
+        while let Some(y) = self.stack.pop() {
+            for &z in &c.m.dag.succs[y as usize] {
+                let zs = z as usize;
+                if self.at[zs] != u32::MAX {
+                    hi = hi.min(self.at[zs] as usize);
+                } else if self.visited[zs] != self.label {
+                    self.visited[zs] = self.label;
+                    self.stack.push(z);
+                }
+            }
         }
         hi
     }

@@ -222,9 +222,7 @@ impl Auto {
         ctx.report(out.cost);
         Ok(out)
     }
-}
 
-impl Auto {
     /// The phases for model `m`: `symmetric_plan` when `plan` is the default and `m` is a
     /// matrix instance whose costs read the same backwards, else `plan`.
     pub fn plan_for(&self, m: &CostModel) -> &str {

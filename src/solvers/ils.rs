@@ -3,10 +3,11 @@
 //! Start from the greedy sequence and descend with the full VND. Then repeat: kick the
 //! current solution (`perturb`: a random feasible reorder of a window, the default; random
 //! feasible segment swaps; or ruin and recreate, [`crate::engine::ruin`], whose O(n) kick
-//! suits instances of up to a few thousand cells), repair with Or-opt and SOP-3-exchange started only from the cells
-//! the kick disturbed (don't-look bits everywhere else), re-choose modes, and accept the result
-//! when it lies within a record-to-record band above the best (`accept`, relative). After
-//! `restart` kicks without a new best the walk restarts from the best solution. On instances
+//! suits instances of up to a few thousand cells), repair with Or-opt and SOP-3-exchange
+//! started only from the cells the kick disturbed (don't-look bits everywhere else),
+//! re-choose modes, and accept the result when it lies within a record-to-record band above
+//! the best (`accept`, relative). After `restart` kicks without a new best the walk
+//! restarts from the best solution. On instances
 //! whose costs read the same backwards (`lk=auto`; TSPLIB's prob.100) the repair and the
 //! polish of a new best also run Lin–Kernighan chains of feasible reversals
 //! ([`crate::engine::lk`]). Without a budget it stops after `stall` kicks without a new
