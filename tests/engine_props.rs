@@ -55,6 +55,30 @@ fn close(a: f64, b: f64) -> bool {
     (a - b).abs() <= 1e-7 * a.abs().max(b.abs()).max(1.0)
 }
 
+/// `s` is a permutation of the model's cells, `pos` inverts `order`, and every mode exists.
+fn well_formed(m: &CostModel, s: &Solution) -> Result<(), TestCaseError> {
+    prop_assert_eq!(s.n(), m.n());
+    let mut seen = vec![false; s.n()];
+    for (p, &cell) in s.order.iter().enumerate() {
+        prop_assert!(!seen[cell as usize]);
+        seen[cell as usize] = true;
+        prop_assert_eq!(s.pos[cell as usize] as usize, p);
+        prop_assert!((s.mode[cell as usize] as usize) < m.modes(cell as usize));
+    }
+    Ok(())
+}
+
+/// Greedy's sequence scrambled by the swaps `shuffle` names (a start with much to improve;
+/// feasible only without precedence).
+fn scrambled(m: &CostModel, shuffle: &[u64]) -> cellseq::model::Sequence {
+    let n = m.n();
+    let mut seq = greedy::geometric(m, &mut |_| {});
+    for (i, r) in shuffle.iter().enumerate().take(n) {
+        seq.swap(i, (*r % n as u64) as usize);
+    }
+    seq
+}
+
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(40))]
     #[test]
@@ -215,12 +239,7 @@ proptest! {
         let m = CostModel::new(&inst, inst.default_objective());
         let c = Costs::open(&m);
         prop_assert!(linked::applies(&c));
-        // a scrambled start, so that there is much to improve
-        let mut seq = greedy::geometric(&m, &mut |_| {});
-        for (i, r) in shuffle.iter().enumerate().take(n) {
-            seq.swap(i, (*r % n as u64) as usize);
-        }
-        let mut s = Solution::new(&c, &seq);
+        let mut s = Solution::new(&c, &scrambled(&m, &shuffle));
         let start = s.cost;
         let nb = Neighbours::new(&m, k);
         let params = cellseq::params::Params::new("t", &[], &BTreeMap::new()).unwrap();
@@ -231,13 +250,7 @@ proptest! {
         linked::or_opt(&c, &nb, &mut s, &mut ctx);
         prop_assert!(close(s.cost, s.evaluate(&c)), "tracked {} vs evaluated {}", s.cost, s.evaluate(&c));
         prop_assert!(s.cost <= start + 1e-9 * start.abs().max(1.0));
-        let mut seen = vec![false; n];
-        for (p, &cell) in s.order.iter().enumerate() {
-            prop_assert!(!seen[cell as usize]);
-            seen[cell as usize] = true;
-            prop_assert_eq!(s.pos[cell as usize] as usize, p);
-            prop_assert!((s.mode[cell as usize] as usize) < m.modes(cell as usize));
-        }
+        well_formed(&m, &s)?;
         // passes from a local optimum of the don't-look-bit search stay exact
         linked::or_opt(&c, &nb, &mut s, &mut ctx);
         prop_assert!(close(s.cost, s.evaluate(&c)));
@@ -304,13 +317,11 @@ proptest! {
         let m = CostModel::new(&inst, inst.default_objective());
         let c = Costs::open(&m);
         prop_assert!(large::applies(&c));
-        let mut seq = greedy::geometric(&m, &mut |_| {});
-        if density == 0.0 {
-            // a scrambled start, so that there is much to improve
-            for (i, r) in shuffle.iter().enumerate().take(n) {
-                seq.swap(i, (*r % n as u64) as usize);
-            }
-        }
+        let seq = if density == 0.0 {
+            scrambled(&m, &shuffle)
+        } else {
+            greedy::geometric(&m, &mut |_| {})
+        };
         let mut s = Solution::new(&c, &seq);
         let start = s.cost;
         let nb = Neighbours::new(&m, k);
@@ -330,13 +341,7 @@ proptest! {
         l.write(&mut s);
         prop_assert!(close(s.cost, s.evaluate(&c)), "kicks: tracked {} vs evaluated {}", s.cost, s.evaluate(&c));
         prop_assert!(s.cost <= after + 1e-9 * after.abs().max(1.0));
-        let mut seen = vec![false; n];
-        for (p, &cell) in s.order.iter().enumerate() {
-            prop_assert!(!seen[cell as usize]);
-            seen[cell as usize] = true;
-            prop_assert_eq!(s.pos[cell as usize] as usize, p);
-            prop_assert!((s.mode[cell as usize] as usize) < m.modes(cell as usize));
-        }
+        well_formed(&m, &s)?;
         prop_assert!(s.feasible(&m));
         let r = cellseq::check(&inst, &s.sequence(), inst.default_objective()).unwrap();
         prop_assert!(close(r.cost, s.cost + m.constant()));
@@ -365,12 +370,7 @@ proptest! {
             prop_assert!(ruin.kick(&c, &nb, &mut s, &mut rng, &mut seeds).is_some());
             prop_assert!(s.feasible(&m), "recreate broke precedence");
             prop_assert!(!seeds.is_empty());
-            let mut sorted = s.order.clone();
-            sorted.sort_unstable();
-            prop_assert_eq!(sorted, (0..n as u32).collect::<Vec<_>>());
-            for (p, &x) in s.order.iter().enumerate() {
-                prop_assert_eq!(s.pos[x as usize] as usize, p);
-            }
+            well_formed(&m, &s)?;
             prop_assert!(close(s.cost, s.evaluate(&c)));
         }
     }
