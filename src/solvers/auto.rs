@@ -226,17 +226,28 @@ impl Auto {
     /// The phases for model `m`: `symmetric_plan` when `plan` is the default and `m` is a
     /// matrix instance whose costs read the same backwards, else `plan`.
     pub fn plan_for(&self, m: &CostModel) -> &str {
-        if self.plan == PLAN && !m.is_geometric() && lk::symmetric(&Costs::open(m)) {
+        if self.symmetric_case(m) {
             &self.symmetric_plan
         } else {
             &self.plan
         }
     }
+
+    /// True when `symmetric_plan` replaces `plan` for model `m`.
+    fn symmetric_case(&self, m: &CostModel) -> bool {
+        self.plan == PLAN && !m.is_geometric() && lk::symmetric(&Costs::open(m))
+    }
 }
 
 impl Solver for Auto {
     fn solve(&self, ctx: &mut Context) -> Result<Outcome> {
-        let plan = parse_plan(self.plan_for(ctx.model))?;
+        // both plans are checked, so a malformed one is refused on every instance
+        let (plan, symmetric_plan) = (parse_plan(&self.plan)?, parse_plan(&self.symmetric_plan)?);
+        let plan = if self.symmetric_case(ctx.model) {
+            symmetric_plan
+        } else {
+            plan
+        };
         let mut budget = ctx.budget;
         if budget.time_limit.is_none() && budget.max_evals.is_none() {
             budget.time_limit = Some(Duration::from_secs_f64(self.seconds));
