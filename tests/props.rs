@@ -173,14 +173,16 @@ proptest! {
     #![proptest_config(ProptestConfig::with_cases(120))]
 
     #[test]
-    fn greedy_feasible_and_exact_not_worse(s in spec(10), air in any::<bool>()) {
+    fn greedy_and_insertion_feasible_and_exact_not_worse(s in spec(10), air in any::<bool>()) {
         let inst = build(&s);
         cellseq::validate::validate(&inst, "prop").unwrap();
         let obj = if inst.is_matrix() { Objective::Matrix } else if air { Objective::Air } else { Objective::Time };
         let g = run("greedy", &inst, obj);
         let a = run("as-given", &inst, obj);
+        let i = run("insertion", &inst, obj);
         let e = run("exact", &inst, obj);
         prop_assert!(e <= g + 1e-6, "exact {e} > greedy {g}");
+        prop_assert!(e <= i + 1e-6, "exact {e} > insertion {i}");
         prop_assert!(e <= a + 1e-6, "exact {e} > as-given {a}");
     }
 

@@ -13,6 +13,7 @@ pub mod edge;
 pub mod exact;
 pub mod greedy;
 pub mod ils;
+pub mod insertion;
 pub mod local_search;
 pub mod process;
 pub mod rules;
@@ -220,6 +221,7 @@ pub fn registry() -> Vec<&'static SolverInfo> {
         &as_given::INFO,
         &greedy::INFO,
         &edge::INFO,
+        &insertion::INFO,
         &ils::INFO,
         &exact::INFO,
         &beam::INFO,

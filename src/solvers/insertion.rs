@@ -1,0 +1,474 @@
+//! `insertion`: cheapest feasible insertion in a topological order.
+//!
+//! Cells are taken in an order that respects precedence, those with more descendants first
+//! (ties at random), and each goes, in its best mode, into the cheapest place of the path
+//! built so far that lies after all its predecessors. Its successors are not in the path yet,
+//! so no other place can break precedence. "After a predecessor" is one comparison of order
+//! labels: the path keeps a label per cell that grows along it (an order-maintenance list:
+//! a new cell takes the middle of its gap, and a run of cells is spread out again when a
+//! gap is used up).
+//!
+//! Geometric instances look for places next to the inserted cells nearest to the new one:
+//! after a cell whose exit is near an entry of the new one, before a cell whose entry is near
+//! an exit of it (two grids, one of exits and one of entries, made finer as they fill, searched
+//! ring by ring until `k` feasible places are seen), plus the places right after the last
+//! predecessor and at the end of the path, which are always feasible: O(k) per cell. Matrix
+//! instances try every place (O(n²)).
+//!
+//! Where precedence is sparse and unrelated to where the cells are (the `uniform` generator's
+//! `preds`), the nearest-neighbour walk leaves behind cells that are not ready yet and has to
+//! come back for each of them; insertion puts such a cell where the path passes by later.
+//! Measured on `uniform` with one random predecessor per cell (lift 0, air length): 0.61–0.67
+//! × the nearest-neighbour walk at 2000–5000 cells and, as the strokes (20 mm) grow long
+//! against their spacing, 0.95 × at 10^5 and 2.1 × at 10^6 (a cell's mode is fixed once it
+//! is in); with points instead of strokes 0.75 × at 10^5. `local-search` starting from it
+//! reaches 0.70 × the walk at 10^5 cells in 10 s, against 0.895 × from the walk itself.
+
+use super::{Context, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo, outcome_of};
+use crate::cost::CostModel;
+use crate::engine::{Costs, Slot};
+use crate::error::Result;
+use crate::geom::Point3;
+use crate::model::{Sequence, Visit};
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+/// Registry entry.
+pub static INFO: SolverInfo = SolverInfo {
+    name: "insertion",
+    summary: "cheapest precedence-feasible insertion of the cells in a random topological order (grid of inserted cells on geometric instances)",
+    params: &[ParamSpec {
+        name: "k",
+        default: "8",
+        kind: ParamKind::Int,
+        help: "feasible places next to nearby inserted cells to try per cell (geometric instances)",
+    }],
+    make: |p: &Params| {
+        Box::new(Insertion {
+            k: p.int("k").max(1) as usize,
+        })
+    },
+};
+
+/// The insertion solver.
+pub struct Insertion {
+    /// Feasible places next to nearby inserted cells tried per cell.
+    pub k: usize,
+}
+
+impl Solver for Insertion {
+    fn solve(&self, ctx: &mut Context) -> Result<Outcome> {
+        let seed = ctx.seed;
+        let seq = sequence(ctx.model, self.k, seed, &mut |e| ctx.count(e));
+        Ok(outcome_of(ctx.model, seq))
+    }
+}
+
+const NIL: u32 = u32::MAX;
+/// Label distance between consecutive cells appended at the end of the path.
+const STEP: u64 = 1 << 24;
+
+/// The path under construction: a doubly linked list from a head (the start, index n) with
+/// order labels that increase along it.
+struct Path {
+    next: Vec<u32>,
+    prev: Vec<u32>,
+    label: Vec<u64>,
+    mode: Vec<u32>,
+    head: u32,
+    last: u32,
+}
+
+impl Path {
+    fn new(n: usize) -> Self {
+        Path {
+            next: vec![NIL; n + 1],
+            prev: vec![NIL; n + 1],
+            label: vec![0; n + 1],
+            mode: vec![0; n + 1],
+            head: n as u32,
+            last: n as u32,
+        }
+    }
+
+    fn slot(&self, a: u32) -> Slot {
+        (a != self.head && a != NIL).then(|| (a as usize, self.mode[a as usize] as usize))
+    }
+
+    /// Puts c right after a (a may be the head).
+    fn insert_after(&mut self, a: u32, c: u32, mode: u32) {
+        let b = self.next[a as usize];
+        self.next[a as usize] = c;
+        self.prev[c as usize] = a;
+        self.next[c as usize] = b;
+        if b == NIL {
+            self.last = c;
+        } else {
+            self.prev[b as usize] = c;
+        }
+        self.mode[c as usize] = mode;
+        let lo = self.label[a as usize];
+        let hi = if b == NIL {
+            u64::MAX
+        } else {
+            self.label[b as usize]
+        };
+        let gap = hi - lo;
+        if gap >= 2 {
+            let step = if b == NIL {
+                (gap / 2).min(STEP)
+            } else {
+                gap / 2
+            };
+            self.label[c as usize] = lo + step;
+        } else {
+            self.spread(c);
+        }
+    }
+
+    /// Relabels the smallest run of cells around c (doubling on each side) whose label range
+    /// leaves gaps of at least max(run length, 32) between its cells.
+    fn spread(&mut self, c: u32) {
+        let (mut first, mut last, mut count) = (c, c, 1u64);
+        let mut w = 1;
+        loop {
+            for _ in 0..w {
+                let p = self.prev[first as usize];
+                if p != self.head {
+                    first = p;
+                    count += 1;
+                }
+                let q = self.next[last as usize];
+                if q != NIL {
+                    last = q;
+                    count += 1;
+                }
+            }
+            let lo = self.label[self.prev[first as usize] as usize];
+            let q = self.next[last as usize];
+            let hi = if q == NIL {
+                u64::MAX
+            } else {
+                self.label[q as usize]
+            };
+            let gap = (hi - lo) / (count + 1);
+            let whole = self.prev[first as usize] == self.head && q == NIL;
+            if gap >= count.max(32) || whole {
+                let mut x = first;
+                for i in 1..=count {
+                    self.label[x as usize] = lo + gap * i;
+                    x = self.next[x as usize];
+                }
+                return;
+            }
+            w *= 2;
+        }
+    }
+
+    fn sequence(&self) -> Sequence {
+        let mut seq = Vec::with_capacity(self.next.len() - 1);
+        let mut x = self.next[self.head as usize];
+        while x != NIL {
+            seq.push(Visit::new(x as usize, self.mode[x as usize] as usize));
+            x = self.next[x as usize];
+        }
+        seq
+    }
+}
+
+/// Points of the inserted cells bucketed on a uniform grid that is rebuilt finer whenever the
+/// number of points doubles, so that a bucket holds about two points at any time and a search
+/// for the nearest few visits O(1) buckets however many cells are in.
+struct Grid {
+    x0: f64,
+    y0: f64,
+    extent: f64,
+    inv: f64,
+    side: usize,
+    buckets: Vec<Vec<u32>>,
+    /// Every point added, in order, for the rebuilds.
+    points: Vec<(Point3, u32)>,
+}
+
+/// A search around a point stops after `SCAN × k` cells (most may lie before the last
+/// predecessor; 16 instead of 32 costs 4 % on `uniform` 10^5 cells with `preds=1`).
+const SCAN: usize = 32;
+
+/// A search around a point stops after this many buckets (clustered points leave many empty).
+const MAX_BUCKETS: usize = 4096;
+
+impl Grid {
+    /// An empty grid over the bounding box of every entry and exit of the model.
+    fn new(m: &CostModel) -> Self {
+        let (mut x0, mut y0, mut x1, mut y1) = (f64::MAX, f64::MAX, f64::MIN, f64::MIN);
+        for nd in 0..m.nodes() {
+            for p in [m.entry(nd), m.exit(nd)] {
+                x0 = x0.min(p.x);
+                y0 = y0.min(p.y);
+                x1 = x1.max(p.x);
+                y1 = y1.max(p.y);
+            }
+        }
+        let extent = (x1 - x0).max(y1 - y0).max(1e-9);
+        let mut g = Grid {
+            x0,
+            y0,
+            extent,
+            inv: 0.0,
+            side: 0,
+            buckets: Vec::new(),
+            points: Vec::with_capacity(m.n()),
+        };
+        g.rebuild(1);
+        g
+    }
+
+    fn rebuild(&mut self, side: usize) {
+        self.side = side;
+        self.inv = side as f64 / self.extent;
+        self.buckets.clear();
+        self.buckets.resize(side * side, Vec::new());
+        for i in 0..self.points.len() {
+            let (p, c) = self.points[i];
+            let b = self.bucket(p);
+            self.buckets[b].push(c);
+        }
+    }
+
+    fn coords(&self, p: Point3) -> (usize, usize) {
+        let f = |v: f64| ((v * self.inv) as usize).min(self.side - 1);
+        (f(p.x - self.x0), f(p.y - self.y0))
+    }
+
+    fn bucket(&self, p: Point3) -> usize {
+        let (i, j) = self.coords(p);
+        i * self.side + j
+    }
+
+    fn add(&mut self, p: Point3, c: u32) {
+        self.points.push((p, c));
+        if self.points.len() > 4 * self.side * self.side {
+            self.rebuild(self.side * 2);
+        } else {
+            let b = self.bucket(p);
+            self.buckets[b].push(c);
+        }
+    }
+
+    /// Calls `visit` on the cells of the buckets ring by ring around p until it returns
+    /// `false`, [`MAX_BUCKETS`] buckets are searched or the grid is exhausted.
+    fn rings(&self, p: Point3, mut visit: impl FnMut(u32) -> bool) {
+        let (ci, cj) = self.coords(p);
+        let (ci, cj, side) = (ci as isize, cj as isize, self.side as isize);
+        let mut searched = 0;
+        for r in 0..side {
+            for i in (ci - r).max(0)..=(ci + r).min(side - 1) {
+                let edge = i == ci - r || i == ci + r;
+                let step = if edge || r == 0 { 1 } else { 2 * r };
+                let mut j = cj - r;
+                while j <= cj + r {
+                    if j >= 0 && j < side {
+                        searched += 1;
+                        for &q in &self.buckets[(i * side + j) as usize] {
+                            if !visit(q) {
+                                return;
+                            }
+                        }
+                    }
+                    j += step;
+                }
+            }
+            if searched >= MAX_BUCKETS {
+                return;
+            }
+        }
+    }
+}
+
+/// A topological order that takes cells with more descendants first: Kahn's algorithm with
+/// a priority of 1 + the successors' priorities (the number of descendants on a forest, more
+/// where descendants are shared), ties broken at random. Cells that many others wait for are
+/// placed while the path is still short, and the cells with few or no successors come last,
+/// when the path passes near everything. On a random recursive tree of precedence it is about
+/// 0.6 × the nearest-neighbour walk's length where a random topological order is about 1.2 ×.
+fn topological(m: &CostModel, rng: &mut ChaCha8Rng) -> Vec<u32> {
+    let n = m.n();
+    let mut missing: Vec<u32> = m.dag.preds.iter().map(|p| p.len() as u32).collect();
+    // reverse topological order first, for the priorities
+    let mut kahn: Vec<u32> = (0..n as u32)
+        .filter(|&c| missing[c as usize] == 0)
+        .collect();
+    let mut i = 0;
+    while i < kahn.len() {
+        let c = kahn[i] as usize;
+        for &s in &m.dag.succs[c] {
+            missing[s as usize] -= 1;
+            if missing[s as usize] == 0 {
+                kahn.push(s);
+            }
+        }
+        i += 1;
+    }
+    let mut weight = vec![1.0f64; n];
+    for &c in kahn.iter().rev() {
+        let c = c as usize;
+        weight[c] += m.dag.succs[c]
+            .iter()
+            .map(|&s| weight[s as usize])
+            .sum::<f64>();
+    }
+    // positive floats order as their bits
+    let key = |c: u32, r: u64| (weight[c as usize].to_bits(), r, std::cmp::Reverse(c));
+    let mut missing: Vec<u32> = m.dag.preds.iter().map(|p| p.len() as u32).collect();
+    let mut ready: std::collections::BinaryHeap<_> = (0..n as u32)
+        .filter(|&c| missing[c as usize] == 0)
+        .map(|c| key(c, rng.random()))
+        .collect();
+    let mut order = Vec::with_capacity(n);
+    while let Some((_, _, std::cmp::Reverse(c))) = ready.pop() {
+        order.push(c);
+        for &s in &m.dag.succs[c as usize] {
+            missing[s as usize] -= 1;
+            if missing[s as usize] == 0 {
+                ready.push(key(s, rng.random()));
+            }
+        }
+    }
+    order
+}
+
+/// The best (delta, mode) of putting c right after a.
+fn place(costs: &Costs, path: &Path, a: u32, c: usize) -> (f64, u32) {
+    let sa = path.slot(a);
+    let sb = path.slot(path.next[a as usize]);
+    let old = costs.link(sa, sb);
+    let mut best = (f64::INFINITY, 0);
+    for mc in 0..costs.m.modes(c) {
+        let s = Some((c, mc));
+        let d = costs.link(sa, s) + costs.link(s, sb) - old;
+        if d < best.0 {
+            best = (d, mc as u32);
+        }
+    }
+    best
+}
+
+/// The insertion sequence (see the module documentation); `k` feasible places next to nearby
+/// cells per cell on geometric instances, the topological order drawn from `seed`.
+pub fn sequence(m: &CostModel, k: usize, seed: u64, count: &mut dyn FnMut(u64)) -> Sequence {
+    let n = m.n();
+    let costs = Costs::open(m);
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let order = topological(m, &mut rng);
+    let mut path = Path::new(n);
+    let mut grids = m.is_geometric().then(|| (Grid::new(m), Grid::new(m)));
+    let mut inserted: Vec<u32> = Vec::with_capacity(n);
+    for &c in &order {
+        let cu = c as usize;
+        let after = m.dag.preds[cu]
+            .iter()
+            .copied()
+            .max_by_key(|&p| path.label[p as usize])
+            .unwrap_or(path.head);
+        let floor = path.label[after as usize];
+        // (delta, place after, mode); ties go to the candidate tried first
+        let mut best = (f64::INFINITY, path.head, 0u32);
+        let mut evals = 0u64;
+        let mut consider = |a: u32, best: &mut (f64, u32, u32)| {
+            let (d, md) = place(&costs, &path, a, cu);
+            evals += 1;
+            if d < best.0 {
+                *best = (d, a, md);
+            }
+        };
+        consider(after, &mut best);
+        if path.last != after {
+            consider(path.last, &mut best);
+        }
+        match &grids {
+            Some((exits, entries)) => {
+                // after q where q's exit is near an entry of c; before q where q's entry is
+                // near an exit of c
+                for md in 0..m.modes(cu) {
+                    let nd = m.node(cu, md);
+                    for (grid, at, before) in
+                        [(exits, m.entry(nd), false), (entries, m.exit(nd), true)]
+                    {
+                        let (mut found, mut scanned) = (0usize, 0usize);
+                        grid.rings(at, |q| {
+                            scanned += 1;
+                            let a = if before { path.prev[q as usize] } else { q };
+                            if path.label[a as usize] >= floor && a != after {
+                                consider(a, &mut best);
+                                found += 1;
+                            }
+                            found < k && scanned < SCAN * k
+                        });
+                    }
+                }
+            }
+            None => {
+                for &q in &inserted {
+                    if path.label[q as usize] >= floor {
+                        consider(q, &mut best);
+                    }
+                }
+            }
+        }
+        count(evals);
+        let (_, a, md) = best;
+        path.insert_after(a, c, md);
+        match &mut grids {
+            Some((exits, entries)) => {
+                let nd = m.node(cu, md as usize);
+                exits.add(m.exit(nd), c);
+                entries.add(m.entry(nd), c);
+            }
+            None => inserted.push(c),
+        }
+    }
+    path.sequence()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Labels strictly increase along the list, and the list holds `count` cells.
+    fn ordered(p: &Path, count: usize) {
+        let (mut x, mut seen) = (p.next[p.head as usize], 0);
+        let mut last = p.label[p.head as usize];
+        while x != NIL {
+            assert!(
+                p.label[x as usize] > last,
+                "labels must increase along the path"
+            );
+            last = p.label[x as usize];
+            x = p.next[x as usize];
+            seen += 1;
+        }
+        assert_eq!(seen, count);
+    }
+
+    #[test]
+    fn labels_stay_ordered_when_gaps_run_out() {
+        let n = 5000;
+        // always at the front, always right after the first cell, always at the end, and at
+        // random places: the first two use a gap up every ~60 insertions
+        for pattern in 0..4 {
+            let mut p = Path::new(n);
+            let mut rng = ChaCha8Rng::seed_from_u64(pattern);
+            p.insert_after(p.head, 0, 0);
+            for c in 1..n as u32 {
+                let a = match pattern {
+                    0 => p.head,
+                    1 => 0,
+                    2 => p.last,
+                    _ => rng.random_range(0..c),
+                };
+                p.insert_after(a, c, 0);
+            }
+            ordered(&p, n);
+        }
+    }
+}
