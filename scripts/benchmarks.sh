@@ -60,7 +60,7 @@ if [ "$run" = 1 ]; then
     "$bin" run "experiments/$p.toml" --threads 1
   done
   # 10^6 cells: greedy (no budget); greedy + one improvement pass (the linked-list Or-opt pass,
-  # local-search vnd=false, no budget: does it finish within 60 s?); greedy + the search capped at
+  # local-search vnd=false, no budget: does it finish within 60 s? without and with precedence); greedy + the search capped at
   # the 60 s (the two-level search where it applies, else the VND; plus greedy at 10^5
   # for the memory growth), one process each so that the peak resident memory is that run's.
   if [ ! -s results/scale-1e6.csv ]; then
@@ -73,6 +73,8 @@ if [ "$run" = 1 ]; then
     done
     "$ex" 1000000 local-search kicks=0 vnd=false gen.preds=0 gen.lift=0 csv=results/scale-1e6.csv
     "$ex" 1000000 local-search kicks=0 vnd=false gen.preds=0 gen.lift=7 csv=results/scale-1e6.csv
+    "$ex" 1000000 local-search kicks=0 vnd=false gen.preds=1 gen.lift=0 csv=results/scale-1e6.csv
+    "$ex" 1000000 local-search kicks=0 vnd=false gen.preds=1 gen.lift=7 csv=results/scale-1e6.csv
     "$ex" 1000000 greedy-edge gen.preds=0 gen.lift=0 csv=results/scale-1e6.csv
   fi
   echo "load average after the runs: $(cut -d' ' -f1-3 /proc/loadavg)" >> results/machine.txt

@@ -1,28 +1,26 @@
-//! Or-opt on a doubly linked list, for large instances without precedence.
+//! Or-opt on a doubly linked list, for large instances.
 //!
 //! In the array form of [`Solution`] an Or-opt move shifts every cell between the old and the
 //! new place of the segment, O(distance). From a greedy start on 10^6 cells most useful moves
 //! go to a spatial neighbour that sits far away in the order, so a pass costs O(n²) in the
-//! worst case and does not finish in a minute. Without precedence nothing needs positions:
-//! with `next`/`prev` links every Or-opt move (a segment of 1–3 cells moved between a
-//! candidate neighbour and its successor, kept or cut the other way) and every in-place mode
-//! change is O(1). [`or_opt`] runs that pass to a local optimum (don't-look bits, best move per
-//! looked-at cell) and writes the result back into the array form.
+//! worst case and does not finish in a minute. On a linked list every Or-opt move (a segment
+//! of 1–3 cells moved between a candidate neighbour and its successor, kept or cut the other
+//! way) and every in-place mode change is O(1). Precedence is checked with the list's order
+//! labels ([`OrderList`]): a segment may go between v and w when each of its cells' outside
+//! predecessors is at or before v and each outside successor at or after w (and, reversed,
+//! when no precedence pair lies inside it), O(degree) per candidate. [`or_opt`] runs that pass
+//! to a local optimum (don't-look bits, best move per looked-at cell) and writes the result
+//! back into the array form.
 
+use super::order::OrderList;
 use super::{Costs, Neighbours, Solution};
+use crate::cost::CostModel;
 use crate::solvers::Context;
 use std::collections::VecDeque;
 
-/// True when [`or_opt`] may run: the instance has no precedence.
-pub fn applies(c: &Costs) -> bool {
-    c.m.dag.is_empty()
-}
-
-/// The path as a cyclic doubly linked list through a sentinel (index n: before the first
-/// cell and after the last).
+/// The path as a cyclic linked list with order labels, and the cells' modes.
 struct List {
-    next: Vec<u32>,
-    prev: Vec<u32>,
+    ord: OrderList,
     mode: Vec<u32>,
 }
 
@@ -61,7 +59,11 @@ fn insertion_points<'a>(
     nb.inn[head as usize]
         .iter()
         .copied()
-        .chain(nb.out[tail as usize].iter().map(|&w| l.prev[w as usize]))
+        .chain(
+            nb.out[tail as usize]
+                .iter()
+                .map(|&w| l.ord.prev[w as usize]),
+        )
         .chain([l.mode.len() as u32])
 }
 
@@ -81,7 +83,7 @@ struct Found {
 
 /// Or-opt (segments of 1–3 cells, kept or reversed, next to candidate neighbours) and
 /// single-cell mode changes on a linked list, to a local optimum or until the budget ends.
-/// Call only when [`applies`] holds. Returns true on any improvement; `s` is rewritten, its
+/// Returns true on any improvement; `s` is rewritten, its
 /// cost updated by the move deltas.
 pub fn or_opt(c: &Costs, nb: &Neighbours, s: &mut Solution, ctx: &mut Context) -> bool {
     let m = c.m;
@@ -91,18 +93,10 @@ pub fn or_opt(c: &Costs, nb: &Neighbours, s: &mut Solution, ctx: &mut Context) -
     }
     let d = n as u32;
     let mut l = List {
-        next: vec![0; n + 1],
-        prev: vec![0; n + 1],
+        ord: OrderList::from_order(n, &s.order),
         mode: s.mode.clone(),
     };
-    let mut last = d;
-    for &x in &s.order {
-        l.next[last as usize] = x;
-        l.prev[x as usize] = last;
-        last = x;
-    }
-    l.next[last as usize] = d;
-    l.prev[d as usize] = last;
+    let prec = !m.dag.is_empty();
 
     let mut on = vec![true; n];
     let mut queue: VecDeque<u32> = s.order.iter().copied().collect();
@@ -124,7 +118,7 @@ pub fn or_opt(c: &Costs, nb: &Neighbours, s: &mut Solution, ctx: &mut Context) -
             rev: false,
         };
         // in-place mode change
-        let (p, q) = (l.prev[x as usize], l.next[x as usize]);
+        let (p, q) = (l.ord.prev[x as usize], l.ord.next[x as usize]);
         let here = l.cur(c, p, x) + l.cur(c, x, q);
         for mx in 0..m.modes(x as usize) as u32 {
             if mx == l.mode[x as usize] {
@@ -155,7 +149,7 @@ pub fn or_opt(c: &Costs, nb: &Neighbours, s: &mut Solution, ctx: &mut Context) -
             }
             len += 1;
             let (f, lst) = (seg[0], seg[len - 1]);
-            let (p, q) = (l.prev[f as usize], l.next[lst as usize]);
+            let (p, q) = (l.ord.prev[f as usize], l.ord.next[lst as usize]);
             let gain = l.cur(c, p, f) + l.cur(c, lst, q) - l.cur(c, p, q);
             let inside = |z: u32| seg[..len].contains(&z);
             let (mf, ml) = (l.mode[f as usize], l.mode[lst as usize]);
@@ -163,8 +157,11 @@ pub fn or_opt(c: &Costs, nb: &Neighbours, s: &mut Solution, ctx: &mut Context) -
             // candidate insertion edges (v, w = next v), forward: v → f … lst → w;
             // reversed: v → lst' … f' → w
             for v in insertion_points(nb, &l, f, lst) {
-                let w = l.next[v as usize];
+                let w = l.ord.next[v as usize];
                 if inside(v) || inside(w) || v == p {
+                    continue;
+                }
+                if prec && !fits(m, &l.ord, &seg[..len], v, w) {
                     continue;
                 }
                 evals += 1;
@@ -184,12 +181,17 @@ pub fn or_opt(c: &Costs, nb: &Neighbours, s: &mut Solution, ctx: &mut Context) -
             }
             if can_rev && (len > 1 || rf != mf) {
                 for v in insertion_points(nb, &l, lst, f) {
-                    let w = l.next[v as usize];
+                    let w = l.ord.next[v as usize];
                     // v == p (then w == f) reverses the segment in place
                     if inside(v) || (v != p && inside(w)) {
                         continue;
                     }
                     let (vv, ww) = if v == p { (p, q) } else { (v, w) };
+                    if prec
+                        && (!reversible(m, &seg[..len]) || !fits(m, &l.ord, &seg[..len], vv, ww))
+                    {
+                        continue;
+                    }
                     let removed = if v == p {
                         l.cur(c, p, f) + l.cur(c, lst, q)
                     } else {
@@ -215,7 +217,7 @@ pub fn or_opt(c: &Costs, nb: &Neighbours, s: &mut Solution, ctx: &mut Context) -
                     }
                 }
             }
-            y = l.next[y as usize];
+            y = l.ord.next[y as usize];
         }
         ctx.count(evals);
         if !super::search::improves(best.delta, s.cost) {
@@ -226,10 +228,10 @@ pub fn or_opt(c: &Costs, nb: &Neighbours, s: &mut Solution, ctx: &mut Context) -
         let mut touched = [d; 7];
         if best.v == u32::MAX {
             l.mode[x as usize] = best.w;
-            touched[..3].copy_from_slice(&[l.prev[x as usize], x, l.next[x as usize]]);
+            touched[..3].copy_from_slice(&[l.ord.prev[x as usize], x, l.ord.next[x as usize]]);
         } else {
             let (f, lst) = (best.f, best.l);
-            let (p, q) = (l.prev[f as usize], l.next[lst as usize]);
+            let (p, q) = (l.ord.prev[f as usize], l.ord.next[lst as usize]);
             // the segment's cells, first to last
             let mut cells = [d; 3];
             let mut k = 0;
@@ -240,7 +242,7 @@ pub fn or_opt(c: &Costs, nb: &Neighbours, s: &mut Solution, ctx: &mut Context) -
                 if z == lst {
                     break;
                 }
-                z = l.next[z as usize];
+                z = l.ord.next[z as usize];
             }
             // insertion edge (v, w) once the segment is unlinked
             let (v, w) = if best.v == p {
@@ -248,8 +250,9 @@ pub fn or_opt(c: &Costs, nb: &Neighbours, s: &mut Solution, ctx: &mut Context) -
             } else {
                 (best.v, best.w)
             };
-            l.next[p as usize] = q;
-            l.prev[q as usize] = p;
+            for &z in &cells[..k] {
+                l.ord.unlink(z);
+            }
             let mut order = cells;
             if best.rev {
                 order[..k].reverse();
@@ -260,12 +263,9 @@ pub fn or_opt(c: &Costs, nb: &Neighbours, s: &mut Solution, ctx: &mut Context) -
                     let md = l.mode[z as usize] as usize;
                     l.mode[z as usize] = m.turned_or_same(z as usize, md) as u32;
                 }
-                l.next[a as usize] = z;
-                l.prev[z as usize] = a;
+                l.ord.insert_after(a, z);
                 a = z;
             }
-            l.next[a as usize] = w;
-            l.prev[w as usize] = a;
             touched[..k].copy_from_slice(&cells[..k]);
             touched[3..7].copy_from_slice(&[p, q, v, w]);
         }
@@ -277,14 +277,30 @@ pub fn or_opt(c: &Costs, nb: &Neighbours, s: &mut Solution, ctx: &mut Context) -
         }
     }
     // back to the array form
-    let mut z = l.next[d as usize];
-    let mut p = 0usize;
-    while z != d {
+    for (p, z) in l.ord.cells().enumerate() {
         s.order[p] = z;
         s.pos[z as usize] = p as u32;
-        p += 1;
-        z = l.next[z as usize];
     }
     s.mode = l.mode;
     improved
+}
+
+/// True when the segment `seg` (cells in path order) may go between v and w: every
+/// predecessor outside it is at or before v, every successor outside it at or after w.
+fn fits(m: &CostModel, ord: &OrderList, seg: &[u32], v: u32, w: u32) -> bool {
+    let (lo, hi) = (ord.after(v), ord.before(w));
+    seg.iter().all(|&z| {
+        m.dag.preds[z as usize]
+            .iter()
+            .all(|&p| seg.contains(&p) || ord.after(p) <= lo)
+            && m.dag.succs[z as usize]
+                .iter()
+                .all(|&q| seg.contains(&q) || ord.after(q) >= hi)
+    })
+}
+
+/// True when no precedence pair lies inside the segment, so it may be cut backwards.
+fn reversible(m: &CostModel, seg: &[u32]) -> bool {
+    seg.iter()
+        .all(|&z| m.dag.succs[z as usize].iter().all(|q| !seg.contains(q)))
 }

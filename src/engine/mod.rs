@@ -14,6 +14,7 @@ pub mod lk;
 pub mod modes;
 pub mod moves;
 pub mod neighbours;
+pub mod order;
 pub mod ruin;
 pub mod search;
 pub mod solution;

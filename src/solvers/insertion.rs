@@ -26,6 +26,7 @@
 
 use super::{Context, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo, outcome_of};
 use crate::cost::CostModel;
+use crate::engine::order::OrderList;
 use crate::engine::{Costs, Slot};
 use crate::error::Result;
 use crate::geom::Point3;
@@ -64,115 +65,22 @@ impl Solver for Insertion {
     }
 }
 
-const NIL: u32 = u32::MAX;
-/// Label distance between consecutive cells appended at the end of the path.
-const STEP: u64 = 1 << 24;
-
-/// The path under construction: a doubly linked list from a head (the start, index n) with
-/// order labels that increase along it.
+/// The path under construction, with order labels ([`OrderList`]) and the cells' modes.
 struct Path {
-    next: Vec<u32>,
-    prev: Vec<u32>,
-    label: Vec<u64>,
+    list: OrderList,
     mode: Vec<u32>,
-    head: u32,
-    last: u32,
 }
 
 impl Path {
-    fn new(n: usize) -> Self {
-        Path {
-            next: vec![NIL; n + 1],
-            prev: vec![NIL; n + 1],
-            label: vec![0; n + 1],
-            mode: vec![0; n + 1],
-            head: n as u32,
-            last: n as u32,
-        }
-    }
-
     fn slot(&self, a: u32) -> Slot {
-        (a != self.head && a != NIL).then(|| (a as usize, self.mode[a as usize] as usize))
-    }
-
-    /// Puts c right after a (a may be the head).
-    fn insert_after(&mut self, a: u32, c: u32, mode: u32) {
-        let b = self.next[a as usize];
-        self.next[a as usize] = c;
-        self.prev[c as usize] = a;
-        self.next[c as usize] = b;
-        if b == NIL {
-            self.last = c;
-        } else {
-            self.prev[b as usize] = c;
-        }
-        self.mode[c as usize] = mode;
-        let lo = self.label[a as usize];
-        let hi = if b == NIL {
-            u64::MAX
-        } else {
-            self.label[b as usize]
-        };
-        let gap = hi - lo;
-        if gap >= 2 {
-            let step = if b == NIL {
-                (gap / 2).min(STEP)
-            } else {
-                gap / 2
-            };
-            self.label[c as usize] = lo + step;
-        } else {
-            self.spread(c);
-        }
-    }
-
-    /// Relabels the smallest run of cells around c (doubling on each side) whose label range
-    /// leaves gaps of at least max(run length, 32) between its cells.
-    fn spread(&mut self, c: u32) {
-        let (mut first, mut last, mut count) = (c, c, 1u64);
-        let mut w = 1;
-        loop {
-            for _ in 0..w {
-                let p = self.prev[first as usize];
-                if p != self.head {
-                    first = p;
-                    count += 1;
-                }
-                let q = self.next[last as usize];
-                if q != NIL {
-                    last = q;
-                    count += 1;
-                }
-            }
-            let lo = self.label[self.prev[first as usize] as usize];
-            let q = self.next[last as usize];
-            let hi = if q == NIL {
-                u64::MAX
-            } else {
-                self.label[q as usize]
-            };
-            let gap = (hi - lo) / (count + 1);
-            let whole = self.prev[first as usize] == self.head && q == NIL;
-            if gap >= count.max(32) || whole {
-                let mut x = first;
-                for i in 1..=count {
-                    self.label[x as usize] = lo + gap * i;
-                    x = self.next[x as usize];
-                }
-                return;
-            }
-            w *= 2;
-        }
+        (a != self.list.sentinel()).then(|| (a as usize, self.mode[a as usize] as usize))
     }
 
     fn sequence(&self) -> Sequence {
-        let mut seq = Vec::with_capacity(self.next.len() - 1);
-        let mut x = self.next[self.head as usize];
-        while x != NIL {
-            seq.push(Visit::new(x as usize, self.mode[x as usize] as usize));
-            x = self.next[x as usize];
-        }
-        seq
+        self.list
+            .cells()
+            .map(|x| Visit::new(x as usize, self.mode[x as usize] as usize))
+            .collect()
     }
 }
 
@@ -340,7 +248,7 @@ fn topological(m: &CostModel, rng: &mut ChaCha8Rng) -> Vec<u32> {
 /// The best (delta, mode) of putting c right after a.
 fn place(costs: &Costs, path: &Path, a: u32, c: usize) -> (f64, u32) {
     let sa = path.slot(a);
-    let sb = path.slot(path.next[a as usize]);
+    let sb = path.slot(path.list.next[a as usize]);
     let old = costs.link(sa, sb);
     let mut best = (f64::INFINITY, 0);
     for mc in 0..costs.m.modes(c) {
@@ -360,7 +268,11 @@ pub fn sequence(m: &CostModel, k: usize, seed: u64, count: &mut dyn FnMut(u64)) 
     let costs = Costs::open(m);
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let order = topological(m, &mut rng);
-    let mut path = Path::new(n);
+    let mut path = Path {
+        list: OrderList::new(n),
+        mode: vec![0; n],
+    };
+    let head = path.list.sentinel();
     let mut grids = m.is_geometric().then(|| (Grid::new(m), Grid::new(m)));
     let mut inserted: Vec<u32> = Vec::with_capacity(n);
     for &c in &order {
@@ -368,11 +280,11 @@ pub fn sequence(m: &CostModel, k: usize, seed: u64, count: &mut dyn FnMut(u64)) 
         let after = m.dag.preds[cu]
             .iter()
             .copied()
-            .max_by_key(|&p| path.label[p as usize])
-            .unwrap_or(path.head);
-        let floor = path.label[after as usize];
+            .max_by_key(|&p| path.list.after(p))
+            .unwrap_or(head);
+        let floor = path.list.after(after);
         // (delta, place after, mode); ties go to the candidate tried first
-        let mut best = (f64::INFINITY, path.head, 0u32);
+        let mut best = (f64::INFINITY, head, 0u32);
         let mut evals = 0u64;
         let mut consider = |a: u32, best: &mut (f64, u32, u32)| {
             let (d, md) = place(&costs, &path, a, cu);
@@ -382,8 +294,9 @@ pub fn sequence(m: &CostModel, k: usize, seed: u64, count: &mut dyn FnMut(u64)) 
             }
         };
         consider(after, &mut best);
-        if path.last != after {
-            consider(path.last, &mut best);
+        let last = path.list.last();
+        if last != after {
+            consider(last, &mut best);
         }
         match &grids {
             Some((exits, entries)) => {
@@ -397,8 +310,12 @@ pub fn sequence(m: &CostModel, k: usize, seed: u64, count: &mut dyn FnMut(u64)) 
                         let (mut found, mut scanned) = (0usize, 0usize);
                         grid.rings(at, |q| {
                             scanned += 1;
-                            let a = if before { path.prev[q as usize] } else { q };
-                            if path.label[a as usize] >= floor && a != after {
+                            let a = if before {
+                                path.list.prev[q as usize]
+                            } else {
+                                q
+                            };
+                            if path.list.after(a) >= floor && a != after {
                                 consider(a, &mut best);
                                 found += 1;
                             }
@@ -409,7 +326,7 @@ pub fn sequence(m: &CostModel, k: usize, seed: u64, count: &mut dyn FnMut(u64)) 
             }
             None => {
                 for &q in &inserted {
-                    if path.label[q as usize] >= floor {
+                    if path.list.after(q) >= floor {
                         consider(q, &mut best);
                     }
                 }
@@ -417,7 +334,8 @@ pub fn sequence(m: &CostModel, k: usize, seed: u64, count: &mut dyn FnMut(u64)) 
         }
         count(evals);
         let (_, a, md) = best;
-        path.insert_after(a, c, md);
+        path.list.insert_after(a, c);
+        path.mode[cu] = md;
         match &mut grids {
             Some((exits, entries)) => {
                 let nd = m.node(cu, md as usize);
@@ -428,47 +346,4 @@ pub fn sequence(m: &CostModel, k: usize, seed: u64, count: &mut dyn FnMut(u64)) 
         }
     }
     path.sequence()
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// Labels strictly increase along the list, and the list holds `count` cells.
-    fn ordered(p: &Path, count: usize) {
-        let (mut x, mut seen) = (p.next[p.head as usize], 0);
-        let mut last = p.label[p.head as usize];
-        while x != NIL {
-            assert!(
-                p.label[x as usize] > last,
-                "labels must increase along the path"
-            );
-            last = p.label[x as usize];
-            x = p.next[x as usize];
-            seen += 1;
-        }
-        assert_eq!(seen, count);
-    }
-
-    #[test]
-    fn labels_stay_ordered_when_gaps_run_out() {
-        let n = 5000;
-        // always at the front, always right after the first cell, always at the end, and at
-        // random places: the first two use a gap up every ~60 insertions
-        for pattern in 0..4 {
-            let mut p = Path::new(n);
-            let mut rng = ChaCha8Rng::seed_from_u64(pattern);
-            p.insert_after(p.head, 0, 0);
-            for c in 1..n as u32 {
-                let a = match pattern {
-                    0 => p.head,
-                    1 => 0,
-                    2 => p.last,
-                    _ => rng.random_range(0..c),
-                };
-                p.insert_after(a, c, 0);
-            }
-            ordered(&p, n);
-        }
-    }
 }
