@@ -152,6 +152,15 @@ pub fn or_opt(c: &Costs, nb: &Neighbours, s: &mut Solution, ctx: &mut Context) -
             let (p, q) = (l.ord.prev[f as usize], l.ord.next[lst as usize]);
             let gain = l.cur(c, p, f) + l.cur(c, lst, q) - l.cur(c, p, q);
             let inside = |z: u32| seg[..len].contains(&z);
+            // labels the new place must lie between: after every outside predecessor, before
+            // every outside successor (read once per segment, O(1) per candidate)
+            let (lo, hi) = if prec {
+                bounds(m, &l.ord, &seg[..len])
+            } else {
+                (0, u64::MAX)
+            };
+            let fits = |v: u32, w: u32| l.ord.after(v) >= lo && l.ord.before(w) <= hi;
+            let rev_ok = !prec || reversible(m, &seg[..len]);
             let (mf, ml) = (l.mode[f as usize], l.mode[lst as usize]);
             let (rf, rl) = (seg_modes[0], seg_modes[len - 1]);
             // candidate insertion edges (v, w = next v), forward: v → f … lst → w;
@@ -161,7 +170,7 @@ pub fn or_opt(c: &Costs, nb: &Neighbours, s: &mut Solution, ctx: &mut Context) -
                 if inside(v) || inside(w) || v == p {
                     continue;
                 }
-                if prec && !fits(m, &l.ord, &seg[..len], v, w) {
+                if !fits(v, w) {
                     continue;
                 }
                 evals += 1;
@@ -187,9 +196,7 @@ pub fn or_opt(c: &Costs, nb: &Neighbours, s: &mut Solution, ctx: &mut Context) -
                         continue;
                     }
                     let (vv, ww) = if v == p { (p, q) } else { (v, w) };
-                    if prec
-                        && (!reversible(m, &seg[..len]) || !fits(m, &l.ord, &seg[..len], vv, ww))
-                    {
+                    if !rev_ok || !fits(vv, ww) {
                         continue;
                     }
                     let removed = if v == p {
@@ -285,18 +292,24 @@ pub fn or_opt(c: &Costs, nb: &Neighbours, s: &mut Solution, ctx: &mut Context) -
     improved
 }
 
-/// True when the segment `seg` (cells in path order) may go between v and w: every
-/// predecessor outside it is at or before v, every successor outside it at or after w.
-fn fits(m: &CostModel, ord: &OrderList, seg: &[u32], v: u32, w: u32) -> bool {
-    let (lo, hi) = (ord.after(v), ord.before(w));
-    seg.iter().all(|&z| {
-        m.dag.preds[z as usize]
-            .iter()
-            .all(|&p| seg.contains(&p) || ord.after(p) <= lo)
-            && m.dag.succs[z as usize]
-                .iter()
-                .all(|&q| seg.contains(&q) || ord.after(q) >= hi)
-    })
+/// The highest label among the outside predecessors of the segment `seg` (0 if none) and the
+/// lowest among its outside successors (u64::MAX if none): the segment may go between v and w
+/// when v's label is at least the first and w's at most the second.
+fn bounds(m: &CostModel, ord: &OrderList, seg: &[u32]) -> (u64, u64) {
+    let (mut lo, mut hi) = (0, u64::MAX);
+    for &z in seg {
+        for &p in &m.dag.preds[z as usize] {
+            if !seg.contains(&p) {
+                lo = lo.max(ord.after(p));
+            }
+        }
+        for &q in &m.dag.succs[z as usize] {
+            if !seg.contains(&q) {
+                hi = hi.min(ord.after(q));
+            }
+        }
+    }
+    (lo, hi)
 }
 
 /// True when no precedence pair lies inside the segment, so it may be cut backwards.
