@@ -1,4 +1,5 @@
-//! Core benches: full evaluation of a 100k-cell sequence and greedy on 10k / 100k cells.
+//! Core benches: full evaluation of a 100k-cell sequence, greedy on 10k / 100k cells, and
+//! greedy against insertion on 100k cells with one random predecessor each.
 //!
 //! `cargo bench --bench core`; compare commits with `-- --save-baseline NAME` / `--baseline NAME`.
 
@@ -54,5 +55,34 @@ fn greedy(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, evaluation, greedy);
+/// The two constructions `local-search` starts from on sparse precedence (`uniform`, 10^5
+/// cells, `preds=1`, lift 0, air length).
+fn sparse_precedence(c: &mut Criterion) {
+    let p: BTreeMap<String, String> = [("n", "100000"), ("preds", "1"), ("lift", "0")]
+        .into_iter()
+        .map(|(k, v)| (k.to_string(), v.to_string()))
+        .collect();
+    let inst = cellseq::generate::generate("uniform", &p, 1).expect("uniform instance");
+    let mut g = c.benchmark_group("sparse_precedence_100k");
+    g.sample_size(10);
+    for solver in ["greedy", "insertion"] {
+        g.bench_function(solver, |b| {
+            b.iter(|| {
+                solvers::run(
+                    solver,
+                    &inst,
+                    Objective::Air,
+                    &BTreeMap::new(),
+                    1,
+                    Budget::default(),
+                    &mut NoObserver,
+                )
+                .unwrap()
+            })
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(benches, evaluation, greedy, sparse_precedence);
 criterion_main!(benches);
