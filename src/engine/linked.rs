@@ -83,8 +83,7 @@ struct Found {
 
 /// Or-opt (segments of 1–3 cells, kept or reversed, next to candidate neighbours) and
 /// single-cell mode changes on a linked list, to a local optimum or until the budget ends.
-/// Returns true on any improvement; `s` is rewritten, its
-/// cost updated by the move deltas.
+/// Returns true on any improvement; `s` is rewritten, its cost updated by the move deltas.
 pub fn or_opt(c: &Costs, nb: &Neighbours, s: &mut Solution, ctx: &mut Context) -> bool {
     let m = c.m;
     let n = s.n();

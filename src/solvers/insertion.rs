@@ -31,8 +31,10 @@ use crate::engine::{Costs, Slot};
 use crate::error::Result;
 use crate::geom::Point3;
 use crate::model::{Sequence, Visit};
+use crate::precedence::{ranked_topological_order, topological_order};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
+use std::cmp::Reverse;
 
 /// Registry entry.
 pub static INFO: SolverInfo = SolverInfo {
@@ -201,22 +203,8 @@ impl Grid {
 /// 0.6 × the nearest-neighbour walk's length where a random topological order is about 1.2 ×.
 fn topological(m: &CostModel, rng: &mut ChaCha8Rng) -> Vec<u32> {
     let n = m.n();
-    let mut missing: Vec<u32> = m.dag.preds.iter().map(|p| p.len() as u32).collect();
-    // reverse topological order first, for the priorities
-    let mut kahn: Vec<u32> = (0..n as u32)
-        .filter(|&c| missing[c as usize] == 0)
-        .collect();
-    let mut i = 0;
-    while i < kahn.len() {
-        let c = kahn[i] as usize;
-        for &s in &m.dag.succs[c] {
-            missing[s as usize] -= 1;
-            if missing[s as usize] == 0 {
-                kahn.push(s);
-            }
-        }
-        i += 1;
-    }
+    // a validated model is acyclic; the fallbacks only keep this total
+    let kahn = topological_order(&m.dag).unwrap_or_else(|_| (0..n as u32).collect());
     let mut weight = vec![1.0f64; n];
     for &c in kahn.iter().rev() {
         let c = c as usize;
@@ -225,24 +213,20 @@ fn topological(m: &CostModel, rng: &mut ChaCha8Rng) -> Vec<u32> {
             .map(|&s| weight[s as usize])
             .sum::<f64>();
     }
-    // positive floats order as their bits
-    let key = |c: u32, r: u64| (weight[c as usize].to_bits(), r, std::cmp::Reverse(c));
-    let mut missing: Vec<u32> = m.dag.preds.iter().map(|p| p.len() as u32).collect();
-    let mut ready: std::collections::BinaryHeap<_> = (0..n as u32)
-        .filter(|&c| missing[c as usize] == 0)
-        .map(|c| key(c, rng.random()))
-        .collect();
-    let mut order = Vec::with_capacity(n);
-    while let Some((_, _, std::cmp::Reverse(c))) = ready.pop() {
-        order.push(c);
-        for &s in &m.dag.succs[c as usize] {
-            missing[s as usize] -= 1;
-            if missing[s as usize] == 0 {
-                ready.push(key(s, rng.random()));
-            }
-        }
+    // rank = place in the order by weight (descending; positive floats order as their
+    // bits), then a random draw, then index; among ready cells the lowest rank goes first
+    let draw: Vec<u64> = (0..n).map(|_| rng.random()).collect();
+    let mut by_key: Vec<usize> = (0..n).collect();
+    by_key.sort_unstable_by_key(|&c| (Reverse(weight[c].to_bits()), draw[c], c));
+    let mut rank = vec![0usize; n];
+    for (r, &c) in by_key.iter().enumerate() {
+        rank[c] = r;
     }
-    order
+    ranked_topological_order(&m.dag, &rank)
+        .unwrap_or_else(|_| (0..n).collect())
+        .into_iter()
+        .map(|c| c as u32)
+        .collect()
 }
 
 /// The best (delta, mode) of putting c right after a.

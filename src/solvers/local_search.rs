@@ -84,9 +84,9 @@ pub static INFO: SolverInfo = SolverInfo {
 };
 
 /// From this many cells on, instances get a first Or-opt pass on a linked list
-/// ([`linked::or_opt`]; precedence checked with order labels) before the VND. At 10^5 cells it does not pay (the VND's 2-opt
-/// gains more per second: 0.825 against 0.837 × greedy's air after 10 s); at 10^6 it is the
-/// only pass that finishes within a minute.
+/// ([`linked::or_opt`]; precedence checked with order labels) before the VND. At 10^5 cells
+/// it does not pay (the VND's 2-opt gains more per second: 0.825 against 0.837 × greedy's air
+/// after 10 s); at 10^6 it is the only pass that finishes within a minute.
 pub const LINKED_CELLS: usize = 200_000;
 
 /// The VND solver.
