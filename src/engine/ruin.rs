@@ -34,6 +34,8 @@ pub struct Ruin {
     pub blink: f64,
     removed: Vec<bool>,
     cells: Vec<u32>,
+    /// Index in `cells` of each removed cell.
+    index: Vec<u32>,
     seq: Vec<u32>,
     at: Vec<u32>,
     missing: Vec<u32>,
@@ -53,6 +55,7 @@ impl Ruin {
             blink,
             removed: Vec::new(),
             cells: Vec::new(),
+            index: Vec::new(),
             seq: Vec::new(),
             at: Vec::new(),
             missing: Vec::new(),
@@ -102,6 +105,7 @@ impl Ruin {
         let n = s.n();
         self.removed.clear();
         self.removed.resize(n, false);
+        self.index.resize(n, 0);
         self.cells.clear();
         let lmax = self.max_string.min(n / 4).max(1);
         // SISR: strings = U(1, 4·avg / (1 + lmax)) so that about avg cells go
@@ -126,6 +130,7 @@ impl Ruin {
                 let z = s.order[q];
                 if !self.removed[z as usize] {
                     self.removed[z as usize] = true;
+                    self.index[z as usize] = self.cells.len() as u32;
                     self.cells.push(z);
                 }
             }
@@ -262,11 +267,7 @@ impl Ruin {
             placed += 1;
             for &q in &m.dag.succs[xs] {
                 if self.removed[q as usize] {
-                    let kq = self
-                        .cells
-                        .iter()
-                        .position(|&z| z == q)
-                        .expect("removed cell");
+                    let kq = self.index[q as usize] as usize;
                     self.missing[kq] -= 1;
                     if self.missing[kq] == 0 {
                         self.ready.push(kq as u32);
