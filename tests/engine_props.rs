@@ -398,3 +398,120 @@ proptest! {
         }
     }
 }
+
+/// `seq` with `windows` of its positions (taken from `picks`) each put in another random
+/// order that keeps the precedence among the window's cells, and some modes changed: a
+/// second feasible parent that shares some of `seq`'s structure and differs elsewhere.
+fn reshuffled(
+    m: &CostModel,
+    seq: &cellseq::model::Sequence,
+    picks: &[u64],
+) -> cellseq::model::Sequence {
+    let n = seq.len();
+    let mut out = seq.clone();
+    let mut it = picks.iter().copied().cycle();
+    for _ in 0..3 {
+        let w = 2 + (it.next().unwrap() % 8) as usize;
+        if w > n {
+            break;
+        }
+        let a = (it.next().unwrap() % (n - w + 1) as u64) as usize;
+        let cells: Vec<usize> = out[a..a + w].iter().map(|v| v.cell).collect();
+        let inside = |x: usize| cells.contains(&x);
+        let mut missing: Vec<usize> = cells
+            .iter()
+            .map(|&x| {
+                m.dag.preds[x]
+                    .iter()
+                    .filter(|&&p| inside(p as usize))
+                    .count()
+            })
+            .collect();
+        let mut ready: Vec<usize> = (0..w).filter(|&k| missing[k] == 0).collect();
+        let mut order = Vec::with_capacity(w);
+        while !ready.is_empty() {
+            let k = ready.swap_remove((it.next().unwrap() % ready.len() as u64) as usize);
+            order.push(k);
+            for &q in &m.dag.succs[cells[k]] {
+                if let Some(kq) = cells.iter().position(|&x| x == q as usize) {
+                    missing[kq] -= 1;
+                    if missing[kq] == 0 {
+                        ready.push(kq);
+                    }
+                }
+            }
+        }
+        let old: Vec<cellseq::model::Visit> = out[a..a + w].to_vec();
+        for (slot, &k) in order.iter().enumerate() {
+            let mut v = old[k];
+            if it.next().unwrap() % 3 == 0 {
+                v.mode = (it.next().unwrap() % m.modes(v.cell) as u64) as usize;
+            }
+            out[a + slot] = v;
+        }
+    }
+    out
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(60))]
+    /// The partition crossover's child is a feasible permutation with an exact cached cost,
+    /// strictly cheaper than both parents, and as cheap as the best of all combinations of
+    /// the parents' segments (enumerated here from the prefix sets); when it returns nothing,
+    /// no combination beats the better parent.
+    #[test]
+    fn partition_crossover_is_the_best_feasible_combination(seed in 0u64..1000, n in 2usize..40, modes in 1usize..3,
+            tools in 1usize..3, density in 0.0f64..0.5, closed in any::<bool>(),
+            shuffle in prop::collection::vec(any::<u64>(), 1..40), picks in prop::collection::vec(any::<u64>(), 1..40)) {
+        use cellseq::engine::crossover::Crossover;
+        use std::collections::BTreeSet;
+        let m = model(seed, n, modes, tools, density, false);
+        let c = Costs { m: &m, closed };
+        let sa = shuffled_feasible(&m, &shuffle);
+        let sb = reshuffled(&m, &sa, &picks);
+        let (a, b) = (Solution::new(&c, &sa), Solution::new(&c, &sb));
+        prop_assert!(a.feasible(&m) && b.feasible(&m));
+        // segments: maximal runs between positions where both prefixes hold the same cells
+        let mut cuts = Vec::new();
+        let (mut pa, mut pb) = (BTreeSet::new(), BTreeSet::new());
+        for k in 0..n {
+            pa.insert(sa[k].cell);
+            pb.insert(sb[k].cell);
+            if pa == pb {
+                cuts.push(k);
+            }
+        }
+        let mut best = f64::INFINITY;
+        if cuts.len() <= 12 {
+            for mask in 0u32..(1 << cuts.len()) {
+                let mut seq = Vec::with_capacity(n);
+                let mut from = 0;
+                for (si, &k) in cuts.iter().enumerate() {
+                    let src = if mask >> si & 1 == 1 { &sb } else { &sa };
+                    seq.extend_from_slice(&src[from..=k]);
+                    from = k + 1;
+                }
+                let s = Solution::new(&c, &seq);
+                prop_assert!(s.feasible(&m));
+                best = best.min(s.cost);
+            }
+        }
+        let better = a.cost.min(b.cost);
+        match Crossover::default().cross(&c, &a, &b) {
+            Some(child) => {
+                well_formed(&m, &child)?;
+                prop_assert!(child.feasible(&m));
+                prop_assert!(close(child.cost, child.evaluate(&c)));
+                prop_assert!(child.cost < better);
+                if best.is_finite() {
+                    prop_assert!(close(child.cost, best), "child {} but best combination {}", child.cost, best);
+                }
+            }
+            None => {
+                if best.is_finite() {
+                    prop_assert!(best >= better - 1e-7 * better.abs().max(1.0), "missed {} < {}", best, better);
+                }
+            }
+        }
+    }
+}

@@ -24,6 +24,7 @@
 use super::aco::{COLONY, Pheromone};
 use super::start::{greedy_solution, outcome};
 use super::{Context, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo};
+use crate::engine::crossover::Crossover;
 use crate::engine::lk::Lk;
 use crate::engine::modes::mode_dp;
 use crate::engine::search::Search;
@@ -81,6 +82,12 @@ pub static INFO: SolverInfo = SolverInfo {
             help: "candidate neighbours per cell (Or-opt)",
         },
         ParamSpec {
+            name: "cross",
+            default: "true",
+            kind: ParamKind::Bool,
+            help: "partition crossover of every improved ant with the best (engine::crossover): segments that hold the same cells in both are taken from the cheaper one",
+        },
+        ParamSpec {
             name: "lk",
             default: "false",
             kind: ParamKind::Choice(&["auto", "true", "false"]),
@@ -105,6 +112,7 @@ pub fn from_params(p: &Params) -> Eacs {
         two_opt: p.bool("two-opt"),
         two_way: p.bool("two-way"),
         lk: p.switch("lk"),
+        cross: p.bool("cross"),
     }
 }
 
@@ -134,6 +142,8 @@ pub struct Eacs {
     pub two_way: bool,
     /// Lin-Kernighan chains in the ants' local search (`None`: when costs are symmetric).
     pub lk: Option<bool>,
+    /// Partition crossover of every improved ant with the best.
+    pub cross: bool,
 }
 
 /// Scratch space of one construction.
@@ -362,6 +372,8 @@ impl Eacs {
         let mut seeds = Vec::new();
         let mut since_best = 0u64;
         let mut since_reset = 0u64;
+        let mut px = Crossover::default();
+        let mut crosses = 0u64;
         while !ctx.exhausted() && (bounded || since_best < self.stall) {
             let mut improved = false;
             for _ in 0..self.ants {
@@ -406,6 +418,16 @@ impl Eacs {
                         );
                     }
                 }
+                // an ant that does not beat the best may still hold better segments: the
+                // partition crossover takes each segment from the cheaper of the two
+                if self.cross
+                    && s.cost >= best.cost - 1e-9 * best.cost.abs().max(1.0)
+                    && let Some(child) = px.cross(&c, &s, &best)
+                {
+                    ctx.count(n as u64);
+                    crosses += 1;
+                    s = child;
+                }
                 if s.cost < best.cost - 1e-9 * best.cost.abs().max(1.0) {
                     search.vnd(&mut s, ctx);
                     if let Some(lk) = lk.as_mut() {
@@ -437,6 +459,9 @@ impl Eacs {
                 prev = Some(x);
             }
             ctx.count(n as u64);
+        }
+        if std::env::var_os("CELLSEQ_TRACE").is_some() {
+            eprintln!("eacs: {crosses} crossovers gave a new best");
         }
         Ok(outcome(m, &best))
     }

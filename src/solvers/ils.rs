@@ -15,6 +15,7 @@
 
 use super::start::{greedy_solution, outcome};
 use super::{Context, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo};
+use crate::engine::crossover::Crossover;
 use crate::engine::lk::Lk;
 use crate::engine::moves::sop3_delta;
 use crate::engine::ruin::Ruin;
@@ -103,10 +104,34 @@ pub static INFO: SolverInfo = SolverInfo {
             help: "first steps tried from each cell by a Lin-Kernighan chain",
         },
         ParamSpec {
+            name: "lk-penalty",
+            default: "2",
+            kind: ParamKind::Float,
+            help: "Lin-Kernighan chains may pass through paths that break precedence pairs (at most lk-max-viol at a time), each charged this many times the start's mean link cost; only paths that keep every pair are kept (0: chains never break a pair)",
+        },
+        ParamSpec {
+            name: "lk-max-viol",
+            default: "2",
+            kind: ParamKind::Int,
+            help: "most precedence pairs a Lin-Kernighan chain may break on its way (with lk-penalty > 0)",
+        },
+        ParamSpec {
             name: "sop3",
             default: "true",
             kind: ParamKind::Bool,
             help: "the repair runs SOP-3-exchange (off: Or-opt, and LK when on, only)",
+        },
+        ParamSpec {
+            name: "sop3-gain",
+            default: "false",
+            kind: ParamKind::Bool,
+            help: "SOP-3-exchange scans a block pair only when its first new link is cheaper than the one it replaces (Lin-Kernighan gain criterion)",
+        },
+        ParamSpec {
+            name: "cross",
+            default: "true",
+            kind: ParamKind::Bool,
+            help: "partition crossover of every repaired kick with the best (engine::crossover): segments that hold the same cells in both are taken from the cheaper one",
         },
         ParamSpec {
             name: "stall",
@@ -139,6 +164,10 @@ pub fn from_params(p: &Params) -> Ils {
         lk_depth: p.int("lk-depth").max(1) as usize,
         lk_breadth: p.int("lk-breadth").max(1) as usize,
         sop3: p.bool("sop3"),
+        lk_penalty: p.float("lk-penalty").max(0.0),
+        lk_max_viol: p.int("lk-max-viol") as u32,
+        cross: p.bool("cross"),
+        sop3_gain: p.bool("sop3-gain"),
     }
 }
 
@@ -172,6 +201,14 @@ pub struct Ils {
     pub lk_breadth: usize,
     /// SOP-3-exchange in the repair.
     pub sop3: bool,
+    /// Penalty per broken precedence pair inside a Lin-Kernighan chain (0: none).
+    pub lk_penalty: f64,
+    /// Most pairs a Lin-Kernighan chain may break on its way.
+    pub lk_max_viol: u32,
+    /// Partition crossover of every repaired kick with the best.
+    pub cross: bool,
+    /// Gain criterion in SOP-3-exchange.
+    pub sop3_gain: bool,
 }
 
 /// The kick of [`Ils`].
@@ -340,9 +377,12 @@ impl Ils {
         };
         let mut search = Search::new(c, self.k);
         search.vnd(&mut cur, ctx);
+        search.sop3_gain = self.sop3_gain;
         let mut lk = Lk::when(self.lk, &c, self.lk_depth, self.lk_breadth);
         if let Some(lk) = lk.as_mut() {
             lk.alternate_with_vnd(&mut search, &mut cur, ctx);
+            lk.penalty = self.lk_penalty * cur.cost.abs() / (n as f64 + 1.0);
+            lk.max_viol = self.lk_max_viol;
         }
         let mut best = cur.clone();
         ctx.report(best.cost + m.constant());
@@ -363,6 +403,9 @@ impl Ils {
         let mut since_best = 0u64;
         let mut since_restart = 0u64;
         let mut trial = cur.clone();
+        let mut px = Crossover::default();
+        let mut crosses = 0u64;
+        let mut kicks_done = 0u64;
         while !ctx.exhausted() {
             if !bounded && since_best >= self.stall {
                 break;
@@ -390,6 +433,7 @@ impl Ils {
                 };
             }
             ctx.count(seeds.len() as u64 + 1);
+            kicks_done += 1;
             if !kicked {
                 since_best += 1;
                 continue;
@@ -416,7 +460,19 @@ impl Ils {
             }
             since_best += 1;
             since_restart += 1;
-            if trial.cost < best.cost - 1e-9 * best.cost.abs().max(1.0) {
+            // a repaired kick that does not beat the best may still hold better segments:
+            // the partition crossover takes each segment from the cheaper of the two
+            let mut improved = trial.cost < best.cost - 1e-9 * best.cost.abs().max(1.0);
+            if !improved
+                && self.cross
+                && let Some(child) = px.cross(&c, &trial, &best)
+            {
+                ctx.count(n as u64);
+                crosses += 1;
+                trial = child;
+                improved = true;
+            }
+            if improved {
                 // polish a new best with the full descent before keeping it
                 search.vnd(&mut trial, ctx);
                 if let Some(lk) = lk.as_mut() {
@@ -434,6 +490,9 @@ impl Ils {
                 cur.clone_from(&best);
                 since_restart = 0;
             }
+        }
+        if std::env::var_os("CELLSEQ_TRACE").is_some() {
+            eprintln!("ils: {kicks_done} kicks, {crosses} crossovers gave a new best");
         }
         Ok(outcome(m, &best))
     }
