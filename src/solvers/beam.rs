@@ -199,6 +199,9 @@ struct Prefix<const W: usize> {
     rem_out: f64,
     /// Σ qpath multipliers over unvisited cells
     lam_open: f64,
+    /// Σ μ_S over the sets the rest must still leave ([`Tables::active_mu`], kept
+    /// incrementally: a child has its parent's less [`Tables::closing_mu`] of the parent)
+    act: f64,
     f: f64,
 }
 
@@ -216,6 +219,7 @@ impl<const W: usize> Prefix<W> {
             rem_in: t.total_in - t.cell_in[c],
             rem_out: t.total_out - t.cell_out[c],
             lam_open,
+            act: t.active_mu(&bits, c),
             f: 0.0,
         }
     }
@@ -285,6 +289,8 @@ struct Tables {
     mu_arc: Vec<f64>,
     /// subtour-elimination sets as cell bitsets (words of 64) with their multipliers
     sec_sets: Vec<(Vec<u64>, f64)>,
+    /// per cell: the indices of the subtour-elimination sets that hold it
+    sets_of: Vec<Vec<u32>>,
 }
 
 impl Tables {
@@ -308,8 +314,9 @@ impl Tables {
     #[inline]
     fn closing_mu(&self, bits: &[u64], l: usize) -> f64 {
         let mut sum = 0.0;
-        for (set, mu) in &self.sec_sets {
-            if set[l / 64] >> (l % 64) & 1 == 1 && set.iter().zip(bits).all(|(s, b)| s & !b == 0) {
+        for &k in &self.sets_of[l] {
+            let (set, mu) = &self.sec_sets[k as usize];
+            if set.iter().zip(bits).all(|(s, b)| s & !b == 0) {
                 sum += mu;
             }
         }
@@ -488,6 +495,13 @@ fn tables(
         cell_in,
         cell_out,
         mu_arc,
+        sets_of: (0..n)
+            .map(|c| {
+                (0..sec_sets.len() as u32)
+                    .filter(|&k| sec_sets[k as usize].0[c / 64] >> (c % 64) & 1 == 1)
+                    .collect()
+            })
+            .collect(),
         sec_sets,
         r_home,
         in_list,
@@ -738,7 +752,8 @@ impl Beam {
         let n = m.n();
         // `cells`: the prefix's number of cells
         // `act`: Σ μ_S over the sets the rest must still leave (`Tables::active_mu`)
-        let bound = |p: &Prefix<W>, cells: usize, act: f64| {
+        let bound = |p: &Prefix<W>, cells: usize| {
+            let act = p.act;
             let h_in = p.rem_in + t.node_in[p.node as usize];
             let h_out = p.rem_out + t.node_out[p.node as usize];
             let h = match qp {
@@ -770,8 +785,7 @@ impl Beam {
         // level 1: every cell that may come first, in every mode
         let mut cands: Vec<Prefix<W>> = first_prefixes(m, t, lam_total, lam);
         for p in cands.iter_mut() {
-            let act = t.active_mu(&p.bits, m.cell_mode(p.node as usize).0);
-            p.f = bound(p, 1, act);
+            p.f = bound(p, 1);
         }
         cands.retain(|p| p.f <= cut);
         ctx.count(cands.len() as u64);
@@ -793,26 +807,19 @@ impl Beam {
             if prev.is_empty() {
                 break;
             }
-            let mut cands: Vec<Prefix<W>> = Vec::with_capacity(prev.len() * 4);
-            index.clear();
+            let mut cands: Vec<Prefix<W>> = Vec::with_capacity(prev.len() * 2);
             let mut evals = 0u64;
+            // children grouped by their new cell, so the dominance map holds one cell's
+            // children at a time: small enough to stay in cache (on p43.2 a whole level's map
+            // had millions of entries and its cache misses took ~40 % of the time)
+            let mut acts: Vec<f64> = Vec::with_capacity(prev.len());
+            let mut by_cell: Vec<Vec<u32>> = vec![Vec::new(); n];
+            let mut listed = 0usize;
             for (pi, p) in prev.iter().enumerate() {
-                // a wide level takes seconds: honour the time limit inside it too (the
-                // evaluation count is only updated per level, so evaluation budgets stay
-                // deterministic)
-                if pi % 1024 == 1023 {
-                    if may_abort && ctx.exhausted() {
-                        return Pass::aborted();
-                    }
-                    if overflow(stored, prev.len() + cands.len(), index.len()) {
-                        ctx.count(evals);
-                        return Pass::overflow();
-                    }
-                }
-                let (a, ma) = m.cell_mode(p.node as usize);
+                let a = m.cell_mode(p.node as usize).0;
                 // every child leaves the same sets: the parent's, less those that `a` closes
-                let act = t.active_mu(&p.bits, a) - t.closing_mu(&p.bits, a);
-                for v in 0..n {
+                acts.push(p.act - t.closing_mu(&p.bits, a));
+                for (v, list) in by_cell.iter_mut().enumerate() {
                     if p.bits[v / 64] >> (v % 64) & 1 == 1 {
                         continue;
                     }
@@ -820,9 +827,34 @@ impl Beam {
                         .iter()
                         .zip(p.bits.iter())
                         .all(|(need, have)| need & !have == 0);
-                    if !ready {
-                        continue;
+                    if ready {
+                        list.push(pi as u32);
+                        listed += 1;
                     }
+                }
+            }
+            // the parent lists and their Σ μ count as stored prefixes (8 bytes each)
+            let lists = (listed / 2 + acts.len()) as u64;
+            let mut done = 0usize;
+            for (v, list) in by_cell.iter().enumerate() {
+                index.clear();
+                for &pi in list {
+                    // a wide level takes seconds: honour the time limit inside it too (the
+                    // evaluation count is only updated per level, so evaluation budgets stay
+                    // deterministic)
+                    done += 1;
+                    if done % 1024 == 1023 {
+                        if may_abort && ctx.exhausted() {
+                            return Pass::aborted();
+                        }
+                        if overflow(stored + lists, prev.len() + cands.len(), index.len()) {
+                            ctx.count(evals);
+                            return Pass::overflow();
+                        }
+                    }
+                    let p = &prev[pi as usize];
+                    let (a, ma) = m.cell_mode(p.node as usize);
+                    let act = acts[pi as usize];
                     let mut bits = p.bits;
                     bits[v / 64] |= 1 << (v % 64);
                     for mv in 0..m.modes(v) {
@@ -830,14 +862,15 @@ impl Beam {
                         let mut c = Prefix {
                             bits,
                             node: m.node(v, mv) as u32,
-                            parent: pi as u32,
+                            parent: pi,
                             g: p.g + m.arc(a, ma, v, mv),
                             rem_in: p.rem_in - t.cell_in[v],
                             rem_out: p.rem_out - t.cell_out[v],
                             lam_open: p.lam_open - lam(v),
+                            act,
                             f: 0.0,
                         };
-                        c.f = bound(&c, k + 1, act);
+                        c.f = bound(&c, k + 1);
                         if c.f > cut {
                             continue;
                         }
@@ -856,6 +889,7 @@ impl Beam {
                     }
                 }
             }
+            drop(by_cell);
             ctx.count(evals);
             // refinement pays only where it prunes: each level refines a first sample of
             // candidates and goes on only when it pruned at least a quarter of them (on
