@@ -45,6 +45,18 @@ fn beam_alone(inst: &Instance, obj: Objective) -> solvers::RunResult {
     solvers::run("beam", inst, obj, &p, 1, Budget::default(), &mut NoObserver).expect("beam solves")
 }
 
+/// The beam alone (as [`beam_alone`]) going to its unbounded pass right after width 1:
+/// the exhaustive pass (adaptive refinement, compact levels) must find and prove the optimum.
+/// With `memory_mb` = 0 that pass stops at its memory cap at once.
+fn beam_exhaustive(inst: &Instance, obj: Objective, memory_mb: &str) -> solvers::RunResult {
+    let mut p = BTreeMap::new();
+    p.insert("warm_evals".to_string(), "0".to_string());
+    p.insert("root_bound".to_string(), "false".to_string());
+    p.insert("exhaustive_from".to_string(), "1".to_string());
+    p.insert("memory_mb".to_string(), memory_mb.to_string());
+    solvers::run("beam", inst, obj, &p, 1, Budget::default(), &mut NoObserver).expect("beam solves")
+}
+
 fn all_bounds(inst: &Instance, obj: Objective) -> bound::Bounds {
     let m = CostModel::new(inst, obj);
     bound::compute(&m, &BoundOptions::default())
@@ -75,7 +87,18 @@ fn check_instance(inst: &Instance, obj: Objective) {
         "{}: beam lower bound {lb} exceeds the optimum {opt}",
         inst.name
     );
-    for r in [beam(inst, obj), beam_alone(inst, obj)] {
+    // an unbounded pass cut at once by its memory cap proves nothing it should not
+    let capped = beam_exhaustive(inst, obj, "0");
+    assert!(capped.report.cost >= opt - 1e-6 * opt.abs().max(1.0));
+    assert!(
+        !capped.outcome.proven_optimal
+            || (capped.report.cost - opt).abs() <= 1e-6 * opt.abs().max(1.0)
+    );
+    for r in [
+        beam(inst, obj),
+        beam_alone(inst, obj),
+        beam_exhaustive(inst, obj, "2048"),
+    ] {
         assert!(
             r.outcome.proven_optimal,
             "{}: beam did not prove optimality",
@@ -440,6 +463,105 @@ fn twin_sop_text(k: usize, costs: &[u32], prec: &[bool], triple: bool, skew: boo
     s
 }
 
+/// A random TSPLIB SOP text on `k` cells (precedence only from lower to higher indices, by
+/// `prec`) where each cell of `copies` gets the arc costs of cell 1 wherever both arcs are
+/// allowed, but keeps its own precedence: copies apart from the precedence, which the beam
+/// may order when one of them is less constrained at the front and more at the back.
+/// `extra`: further (i, j) entries set to −1 (j precedes i).
+fn near_twin_sop_text(
+    k: usize,
+    costs: &[u32],
+    prec: &[bool],
+    copies: &[usize],
+    extra: &[(usize, usize)],
+) -> String {
+    let n = k + 2;
+    let mut idx = 0;
+    let mut m: Vec<Vec<i64>> = (0..n)
+        .map(|i| {
+            (0..n)
+                .map(|j| {
+                    idx += 1;
+                    let forced = j == 0 || i == n - 1 || (j < i && prec[idx % prec.len()]);
+                    if i == j {
+                        0
+                    } else if forced {
+                        -1
+                    } else {
+                        costs[idx % costs.len()] as i64
+                    }
+                })
+                .collect()
+        })
+        .collect();
+    for &(i, j) in extra {
+        m[i][j] = -1;
+    }
+    for &c in copies {
+        #[allow(clippy::needless_range_loop)]
+        for j in 0..n {
+            if j != c && j != 1 {
+                if m[c][j] != -1 && m[1][j] != -1 {
+                    m[c][j] = m[1][j];
+                }
+                if m[j][c] != -1 && m[j][1] != -1 {
+                    m[j][c] = m[j][1];
+                }
+            }
+        }
+    }
+    for &a in copies.iter().chain(&[1]) {
+        for &b in copies.iter().chain(&[1]) {
+            if a != b && m[a][b] != -1 && m[b][a] != -1 {
+                m[a][b] = 7;
+                m[b][a] = 7;
+            }
+        }
+    }
+    let mut s = format!(
+        "NAME: near-twins\nTYPE: SOP\nDIMENSION: {n}\nEDGE_WEIGHT_TYPE: EXPLICIT\n\
+         EDGE_WEIGHT_FORMAT: FULL_MATRIX\nEDGE_WEIGHT_SECTION\n{n}\n"
+    );
+    for row in &m {
+        let r: Vec<String> = row.iter().map(|v| v.to_string()).collect();
+        s += &r.join(" ");
+        s += "\n";
+    }
+    s += "EOF\n";
+    s
+}
+
+#[test]
+fn near_twins_are_ordered_by_constraint() {
+    let costs: Vec<u32> = (0..50).map(|i| (i * 37 % 41) as u32).collect();
+    // cell 6 copies cell 1 and also needs cell 3 first: 1 may lead it
+    let text = near_twin_sop_text(6, &costs, &[false], &[6], &[(6, 3)]);
+    let inst = formats::parse_instance("near.sop", &text, Format::Sop).unwrap();
+    let m = CostModel::new(&inst, Objective::Matrix);
+    let cl = bound::closure::Closure::new(&m.dag).unwrap();
+    assert!(
+        cl.ancestors(6) > cl.ancestors(1),
+        "the copy is more constrained"
+    );
+    let pairs = solvers::beam::interchangeable_order(&m);
+    assert!(pairs.contains(&(1, 6)), "{pairs:?}");
+    assert!(!pairs.contains(&(6, 1)), "{pairs:?}");
+    // cell 1 also needs cell 2 first: neither may lead the other
+    let text = near_twin_sop_text(6, &costs, &[false], &[6], &[(6, 3), (1, 2)]);
+    let inst = formats::parse_instance("near.sop", &text, Format::Sop).unwrap();
+    let m = CostModel::new(&inst, Objective::Matrix);
+    let pairs = solvers::beam::interchangeable_order(&m);
+    assert!(
+        !pairs.iter().any(|&p| p == (1, 6) || p == (6, 1)),
+        "{pairs:?}"
+    );
+    // the same costs and no copy: no pair
+    let text = near_twin_sop_text(6, &costs, &[false], &[], &[(6, 3)]);
+    let inst = formats::parse_instance("near.sop", &text, Format::Sop).unwrap();
+    let m = CostModel::new(&inst, Objective::Matrix);
+    assert!(!solvers::beam::interchangeable_order(&m).contains(&(1, 6)));
+}
+
 #[test]
 fn interchangeable_cells_are_found() {
     let costs: Vec<u32> = (0..50).map(|i| (i * 37 % 41) as u32).collect();
@@ -447,7 +569,8 @@ fn interchangeable_cells_are_found() {
     let inst = formats::parse_instance("twins.sop", &text, Format::Sop).unwrap();
     let m = CostModel::new(&inst, Objective::Matrix);
     let pairs = solvers::beam::interchangeable_order(&m);
-    assert_eq!(pairs.len(), 2, "{pairs:?}");
+    // every pair of the three copies, the smaller index first
+    assert_eq!(pairs, vec![(1, 2), (1, 3), (2, 3)]);
     let text = twin_sop_text(6, &costs, &[false], false, true);
     let inst = formats::parse_instance("twins.sop", &text, Format::Sop).unwrap();
     let m = CostModel::new(&inst, Objective::Matrix);
@@ -506,6 +629,21 @@ proptest! {
     ) {
         let text = twin_sop_text(k, &costs, &prec, triple, skew);
         let inst = formats::parse_instance("twins.sop", &text, Format::Sop).unwrap();
+        check_instance(&inst, Objective::Matrix);
+    }
+
+    #[test]
+    fn beam_exact_with_near_twin_cells(
+        k in 4usize..=9,
+        costs in prop::collection::vec(0u32..50, 50),
+        prec in prop::collection::vec(prop::bool::weighted(0.3), 40),
+        two in any::<bool>(),
+    ) {
+        // copies at the high indices: more predecessors than cell 1, so the precedence
+        // differs while one copy may still lead the other
+        let copies: Vec<usize> = if two { vec![k - 1, k] } else { vec![k] };
+        let text = near_twin_sop_text(k, &costs, &prec, &copies, &[]);
+        let inst = formats::parse_instance("near.sop", &text, Format::Sop).unwrap();
         check_instance(&inst, Objective::Matrix);
     }
 

@@ -104,6 +104,13 @@ pub static INFO: SolverInfo = SolverInfo {
             help: "factor by which the beam width grows from width 1024 on (doubling before)",
         },
         ParamSpec {
+            name: "exhaustive_from",
+            default: "16384",
+            kind: ParamKind::Int,
+            help: "after the pass of this width, one pass without a width limit (stopped at \
+                   memory_mb) before wider truncated passes; 0 = never",
+        },
+        ParamSpec {
             name: "warm_evals",
             default: "2000000",
             kind: ParamKind::Int,
@@ -123,6 +130,7 @@ pub static INFO: SolverInfo = SolverInfo {
             sec: p.bool("sec"),
             growth: p.int("growth").max(2) as usize,
             twins: p.bool("twins"),
+            exhaustive_from: p.int("exhaustive_from") as usize,
         })
     },
 };
@@ -151,6 +159,8 @@ pub struct Beam {
     pub sec: bool,
     /// Width growth factor from width 1024 on.
     pub growth: usize,
+    /// Width after which one unbounded pass is tried (0: never).
+    pub exhaustive_from: usize,
 }
 
 /// Width from which the beam grows by the `growth` factor instead of doubling.
@@ -189,6 +199,9 @@ struct Prefix<const W: usize> {
     rem_out: f64,
     /// Σ qpath multipliers over unvisited cells
     lam_open: f64,
+    /// Σ μ_S over the sets the rest must still leave ([`Tables::active_mu`], kept
+    /// incrementally: a child has its parent's less [`Tables::closing_mu`] of the parent)
+    act: f64,
     f: f64,
 }
 
@@ -206,6 +219,7 @@ impl<const W: usize> Prefix<W> {
             rem_in: t.total_in - t.cell_in[c],
             rem_out: t.total_out - t.cell_out[c],
             lam_open,
+            act: t.active_mu(&bits, c),
             f: 0.0,
         }
     }
@@ -275,6 +289,8 @@ struct Tables {
     mu_arc: Vec<f64>,
     /// subtour-elimination sets as cell bitsets (words of 64) with their multipliers
     sec_sets: Vec<(Vec<u64>, f64)>,
+    /// per cell: the indices of the subtour-elimination sets that hold it
+    sets_of: Vec<Vec<u32>>,
 }
 
 impl Tables {
@@ -285,6 +301,22 @@ impl Tables {
         let mut sum = 0.0;
         for (set, mu) in &self.sec_sets {
             if set[l / 64] >> (l % 64) & 1 == 1 || set.iter().zip(bits).any(|(s, b)| s & !b != 0) {
+                sum += mu;
+            }
+        }
+        sum
+    }
+
+    /// Σ μ_S over the sets that hold `l` and lie inside `bits`: a prefix (`bits`, last `l`)
+    /// must still leave them, each of its children no longer (they are visited and the child's
+    /// last cell lies outside them); every other set keeps its status. So every child of the
+    /// prefix has `active_mu` = the prefix's minus this.
+    #[inline]
+    fn closing_mu(&self, bits: &[u64], l: usize) -> f64 {
+        let mut sum = 0.0;
+        for &k in &self.sets_of[l] {
+            let (set, mu) = &self.sec_sets[k as usize];
+            if set.iter().zip(bits).all(|(s, b)| s & !b == 0) {
                 sum += mu;
             }
         }
@@ -463,6 +495,13 @@ fn tables(
         cell_in,
         cell_out,
         mu_arc,
+        sets_of: (0..n)
+            .map(|c| {
+                (0..sec_sets.len() as u32)
+                    .filter(|&k| sec_sets[k as usize].0[c / 64] >> (c % 64) & 1 == 1)
+                    .collect()
+            })
+            .collect(),
         sec_sets,
         r_home,
         in_list,
@@ -561,12 +600,26 @@ impl Beam {
         }
         let mut proven = false;
         let prefix_bytes = (std::mem::size_of::<Prefix<W>>() + 24) as u64;
+        let grow = |w: usize| {
+            // doubling, then faster: a pass that is not truncated stores only what survives
+            // the bound, so a wider-than-needed final pass costs little, while every narrower
+            // pass is repeated work
+            if w < GROWTH_FROM {
+                w * 2
+            } else {
+                w.saturating_mul(self.growth)
+            }
+        };
         let mut width = 1usize;
+        // the bounded width to go on from after the unbounded pass
+        let mut resume = None;
         loop {
             let ub = best.as_ref().map(|b| b.0).unwrap_or(f64::INFINITY);
-            let (found, truncated, aborted) =
-                self.iteration::<W>(ctx, &t, qp.as_ref(), width, cut(ub), best.is_some());
-            if let Some((c, seq)) = found
+            let unbounded = width == usize::MAX;
+            let cap = unbounded.then(|| self.memory_mb.saturating_mul(1 << 20));
+            let pass =
+                self.iteration::<W>(ctx, &t, qp.as_ref(), width, cut(ub), best.is_some(), cap);
+            if let Some((c, seq)) = pass.found
                 && best
                     .as_ref()
                     .is_none_or(|b| c < b.0 - 1e-9 * c.abs().max(1.0))
@@ -576,12 +629,20 @@ impl Beam {
             }
             if std::env::var_os("CELLSEQ_BEAM_TRACE").is_some() {
                 eprintln!(
-                    "beam width {width}: best {:?} truncated {truncated} aborted {aborted} {:.2}s",
+                    "beam width {}: best {:?} truncated {} aborted {} overflow {} {:.2}s",
+                    if unbounded {
+                        "unbounded".to_string()
+                    } else {
+                        width.to_string()
+                    },
                     best.as_ref().map(|b| b.0),
+                    pass.truncated,
+                    pass.aborted,
+                    pass.overflow,
                     ctx.elapsed()
                 );
             }
-            if !aborted && !truncated && best.is_some() {
+            if !pass.aborted && !pass.truncated && best.is_some() {
                 proven = true;
                 break;
             }
@@ -609,17 +670,30 @@ impl Beam {
                 proven = true;
                 break;
             }
-            if aborted || ctx.exhausted() || width >= self.max_width {
+            if pass.aborted || ctx.exhausted() {
                 break;
             }
-            // doubling, then faster: a pass that is not truncated stores only what survives
-            // the bound, so a wider-than-needed final pass costs little, while every narrower
-            // pass is repeated work
-            width = if width < GROWTH_FROM {
-                width * 2
-            } else {
-                width.saturating_mul(self.growth)
+            let from = match resume {
+                Some(w) if unbounded => w,
+                _ => width,
             };
+            if from >= self.max_width {
+                break;
+            }
+            let next = grow(from);
+            // once the bounded passes pass `exhaustive_from`, one unbounded pass (cut by the
+            // memory cap): it proves the incumbent optimal as soon as every prefix within
+            // the bound fits, without the wider truncated passes in between
+            if resume.is_none()
+                && !unbounded
+                && self.exhaustive_from > 0
+                && next > self.exhaustive_from
+            {
+                resume = Some(width);
+                width = usize::MAX;
+                continue;
+            }
+            width = next;
             let need = prefix_bytes * width as u64 * (n as u64 + 1) * 2;
             if need > self.memory_mb.saturating_mul(1 << 20) {
                 break;
@@ -660,8 +734,10 @@ impl Beam {
         Ok(Some((cost, out.sequence)))
     }
 
-    /// One beam pass of the given width. Returns the best complete sequence found (cost, seq),
-    /// whether any child was discarded because of the width, and whether the budget stopped it.
+    /// One beam pass of the given width (`usize::MAX`: unbounded, an exhaustive search when
+    /// it ends). The pass stops early when the budget is spent (`may_abort`) or when its
+    /// stored prefixes would pass `mem_cap` bytes.
+    #[allow(clippy::too_many_arguments)]
     fn iteration<const W: usize>(
         &self,
         ctx: &mut Context,
@@ -670,14 +746,16 @@ impl Beam {
         width: usize,
         cut: f64,
         may_abort: bool,
-    ) -> (Option<(f64, Sequence)>, bool, bool) {
+        mem_cap: Option<u64>,
+    ) -> Pass {
         let m = ctx.model;
         let n = m.n();
         // `cells`: the prefix's number of cells
+        // `act`: Σ μ_S over the sets the rest must still leave (`Tables::active_mu`)
         let bound = |p: &Prefix<W>, cells: usize| {
+            let act = p.act;
             let h_in = p.rem_in + t.node_in[p.node as usize];
             let h_out = p.rem_out + t.node_out[p.node as usize];
-            let act = t.active_mu(&p.bits, m.cell_mode(p.node as usize).0);
             let h = match qp {
                 // rounding slack: λ sums are kept incrementally
                 Some(q) => {
@@ -693,8 +771,17 @@ impl Beam {
         let lam = |c: usize| qp.map_or(0.0, |q| q.lambda(c));
         let lam_total = qp.map_or(0.0, |q| q.lambda_total());
         let mut scratch = vec![(0.0, 0.0); n + t.clusters.len()];
-        let mut levels: Vec<Vec<Prefix<W>>> = Vec::with_capacity(n);
+        // completed levels, compact: (parent index, node) per prefix
+        let mut trail: Vec<Vec<(u32, u32)>> = Vec::with_capacity(n);
+        let mut stored = 0u64;
+        let prefix_bytes = std::mem::size_of::<Prefix<W>>() as u64;
+        let entry_bytes = std::mem::size_of::<(([u64; W], u32), u32)>() as u64 + 8;
         let mut truncated = false;
+        let overflow = |stored: u64, live: usize, map: usize| {
+            mem_cap.is_some_and(|cap| {
+                stored * 8 + live as u64 * prefix_bytes + map as u64 * entry_bytes > cap
+            })
+        };
         // level 1: every cell that may come first, in every mode
         let mut cands: Vec<Prefix<W>> = first_prefixes(m, t, lam_total, lam);
         for p in cands.iter_mut() {
@@ -712,25 +799,27 @@ impl Beam {
             eprintln!("beam: first-level bound {lb}");
         }
         truncated |= keep_best(&mut cands, width, self.by_cost);
-        levels.push(cands);
+        let mut prev = cands;
+        trail.push(prev.iter().map(|p| (p.parent, p.node)).collect());
+        stored += prev.len() as u64;
         let mut index: FxHashMap<([u64; W], u32), u32> = FxHashMap::default();
         for k in 1..n {
-            let prev = levels.last().expect("a level");
             if prev.is_empty() {
                 break;
             }
-            let mut cands: Vec<Prefix<W>> = Vec::with_capacity(prev.len() * 4);
-            index.clear();
+            let mut cands: Vec<Prefix<W>> = Vec::with_capacity(prev.len() * 2);
             let mut evals = 0u64;
+            // children grouped by their new cell, so the dominance map holds one cell's
+            // children at a time: small enough to stay in cache (on p43.2 a whole level's map
+            // had millions of entries and its cache misses took ~40 % of the time)
+            let mut acts: Vec<f64> = Vec::with_capacity(prev.len());
+            let mut by_cell: Vec<Vec<u32>> = vec![Vec::new(); n];
+            let mut listed = 0usize;
             for (pi, p) in prev.iter().enumerate() {
-                // a wide level takes seconds: honour the time limit inside it too (the
-                // evaluation count is only updated per level, so evaluation budgets stay
-                // deterministic)
-                if may_abort && pi % 1024 == 1023 && ctx.exhausted() {
-                    return (None, true, true);
-                }
-                let (a, ma) = m.cell_mode(p.node as usize);
-                for v in 0..n {
+                let a = m.cell_mode(p.node as usize).0;
+                // every child leaves the same sets: the parent's, less those that `a` closes
+                acts.push(p.act - t.closing_mu(&p.bits, a));
+                for (v, list) in by_cell.iter_mut().enumerate() {
                     if p.bits[v / 64] >> (v % 64) & 1 == 1 {
                         continue;
                     }
@@ -738,9 +827,34 @@ impl Beam {
                         .iter()
                         .zip(p.bits.iter())
                         .all(|(need, have)| need & !have == 0);
-                    if !ready {
-                        continue;
+                    if ready {
+                        list.push(pi as u32);
+                        listed += 1;
                     }
+                }
+            }
+            // the parent lists and their Σ μ count as stored prefixes (8 bytes each)
+            let lists = (listed / 2 + acts.len()) as u64;
+            let mut done = 0usize;
+            for (v, list) in by_cell.iter().enumerate() {
+                index.clear();
+                for &pi in list {
+                    // a wide level takes seconds: honour the time limit inside it too (the
+                    // evaluation count is only updated per level, so evaluation budgets stay
+                    // deterministic)
+                    done += 1;
+                    if done % 1024 == 1023 {
+                        if may_abort && ctx.exhausted() {
+                            return Pass::aborted();
+                        }
+                        if overflow(stored + lists, prev.len() + cands.len(), index.len()) {
+                            ctx.count(evals);
+                            return Pass::overflow();
+                        }
+                    }
+                    let p = &prev[pi as usize];
+                    let (a, ma) = m.cell_mode(p.node as usize);
+                    let act = acts[pi as usize];
                     let mut bits = p.bits;
                     bits[v / 64] |= 1 << (v % 64);
                     for mv in 0..m.modes(v) {
@@ -748,11 +862,12 @@ impl Beam {
                         let mut c = Prefix {
                             bits,
                             node: m.node(v, mv) as u32,
-                            parent: pi as u32,
+                            parent: pi,
                             g: p.g + m.arc(a, ma, v, mv),
                             rem_in: p.rem_in - t.cell_in[v],
                             rem_out: p.rem_out - t.cell_out[v],
                             lam_open: p.lam_open - lam(v),
+                            act,
                             f: 0.0,
                         };
                         c.f = bound(&c, k + 1);
@@ -774,43 +889,61 @@ impl Beam {
                     }
                 }
             }
+            drop(by_cell);
             ctx.count(evals);
+            // refinement pays only where it prunes: each level refines a first sample of
+            // candidates and goes on only when it pruned at least a quarter of them (on
+            // p43.2 it prunes ~4 % of the candidates and took 76 % of the time)
+            let mut sample = Sample::default();
             if self.refine && cands.len() > width && !self.by_cost {
                 // refine lazily in order of the incremental bound until more than `width`
                 // survive: the rest is discarded (and the level counts as truncated)
                 cands.sort_unstable_by(rank);
                 let mut kept = Vec::with_capacity(width + 1);
-                let mut done = 0u64;
                 for mut c in cands.drain(..) {
-                    done += 1;
-                    if may_abort && done.is_multiple_of(4096) && ctx.exhausted() {
-                        return (None, true, true);
-                    }
-                    c.f = c.f.max(refined(m, t, &c, &mut scratch));
-                    if c.f <= cut {
-                        kept.push(c);
-                        if kept.len() > width {
-                            break;
+                    if sample.on() {
+                        if may_abort && sample.done % 4096 == 4095 && ctx.exhausted() {
+                            return Pass::aborted();
+                        }
+                        c.f = c.f.max(refined(m, t, &c, &mut scratch));
+                        if !sample.record(c.f <= cut) {
+                            continue;
                         }
                     }
+                    kept.push(c);
+                    if kept.len() > width {
+                        break;
+                    }
                 }
-                ctx.count(done);
+                ctx.count(sample.done);
                 cands = kept;
             } else if self.refine {
-                for c in cands.iter_mut() {
+                cands.retain_mut(|c| {
+                    if !sample.on() {
+                        return true;
+                    }
                     c.f = c.f.max(refined(m, t, c, &mut scratch));
-                }
-                ctx.count(cands.len() as u64);
-                cands.retain(|c| c.f <= cut);
+                    sample.record(c.f <= cut)
+                });
+                ctx.count(sample.done);
             }
             truncated |= keep_best(&mut cands, width, self.by_cost);
-            levels.push(cands);
+            trail.push(cands.iter().map(|p| (p.parent, p.node)).collect());
+            stored += cands.len() as u64;
+            prev = cands;
             if may_abort && ctx.exhausted() {
-                return (None, truncated, true);
+                return Pass {
+                    truncated,
+                    ..Pass::aborted()
+                };
+            }
+            if overflow(stored, prev.len(), 0) {
+                return Pass::overflow();
             }
         }
         if std::env::var_os("CELLSEQ_BEAM_TRACE").is_some() {
-            let sizes: Vec<usize> = levels.iter().map(|l| l.len()).collect();
+            let sizes: Vec<usize> = trail.iter().map(|l| l.len()).collect();
+            eprintln!("beam: level sizes {sizes:?}");
             eprintln!(
                 "beam: width {width} stored {} largest level {}",
                 sizes.iter().sum::<usize>(),
@@ -818,12 +951,17 @@ impl Beam {
             );
         }
         // complete sequences
-        let last = levels.last().expect("a level");
-        if levels.len() < n {
-            return (None, truncated, false);
+        let done = Pass {
+            found: None,
+            truncated,
+            aborted: false,
+            overflow: false,
+        };
+        if trail.len() < n {
+            return done;
         }
         let mut best: Option<(f64, usize)> = None;
-        for (i, p) in last.iter().enumerate() {
+        for (i, p) in prev.iter().enumerate() {
             let (c, md) = m.cell_mode(p.node as usize);
             let total = p.g + m.finish(c, md);
             if total <= cut && best.is_none_or(|b| total < b.0) {
@@ -831,30 +969,94 @@ impl Beam {
             }
         }
         let Some((_, mut i)) = best else {
-            return (None, truncated, false);
+            return done;
         };
         let mut seq = Vec::with_capacity(n);
-        for lvl in levels.iter().rev() {
-            let p = &lvl[i];
-            let (c, md) = m.cell_mode(p.node as usize);
+        for lvl in trail.iter().rev() {
+            let (parent, node) = lvl[i];
+            let (c, md) = m.cell_mode(node as usize);
             seq.push(Visit::new(c, md));
-            i = p.parent as usize;
+            i = parent as usize;
         }
         seq.reverse();
         let cost = m.evaluate(&seq);
-        (Some((cost, seq)), truncated, false)
+        Pass {
+            found: Some((cost, seq)),
+            ..done
+        }
+    }
+}
+
+/// Candidates refined at the start of a level before deciding whether refinement goes on.
+const REFINE_SAMPLE: u64 = 1024;
+
+/// Counts of the refined candidates of one level: refinement stops for the rest of the
+/// level when fewer than a quarter of the first [`REFINE_SAMPLE`] were pruned.
+#[derive(Default)]
+struct Sample {
+    done: u64,
+    pruned: u64,
+    off: bool,
+}
+
+impl Sample {
+    fn on(&self) -> bool {
+        !self.off
+    }
+
+    /// Records one refined candidate (`kept`: it survived) and returns `kept`.
+    fn record(&mut self, kept: bool) -> bool {
+        self.done += 1;
+        self.pruned += u64::from(!kept);
+        if self.done == REFINE_SAMPLE && self.pruned * 4 < self.done {
+            self.off = true;
+        }
+        kept
+    }
+}
+
+/// Result of one beam pass.
+struct Pass {
+    /// the best complete sequence found (cost, sequence)
+    found: Option<(f64, Sequence)>,
+    /// some candidate was discarded because of the width
+    truncated: bool,
+    /// the budget stopped the pass
+    aborted: bool,
+    /// an unbounded pass stopped at its memory cap
+    overflow: bool,
+}
+
+impl Pass {
+    fn aborted() -> Pass {
+        Pass {
+            found: None,
+            truncated: true,
+            aborted: true,
+            overflow: false,
+        }
+    }
+
+    fn overflow() -> Pass {
+        Pass {
+            found: None,
+            truncated: true,
+            aborted: false,
+            overflow: true,
+        }
     }
 }
 
 /// Largest instance searched for interchangeable cells (O(n² · n · modes²)).
 const TWIN_MAX_CELLS: usize = 300;
 
-/// Whether cells `a` and `b` are interchangeable: same modes, same start and finish costs,
-/// same arc costs to and from every other cell (mode by mode), `arc(a, i, b, j) = arc(b, i, a,
-/// j)`, and the same ancestors and descendants apart from each other (and neither precedes
-/// the other). Swapping such cells (with their modes) in any sequence keeps it feasible and
-/// keeps its cost.
-fn twins(m: &CostModel, cl: &Closure, a: usize, b: usize) -> bool {
+/// Whether cells `a` and `b` are *cost twins*: neither precedes the other, same modes, same
+/// start and finish costs, `arc(a, i, b, j) = arc(b, i, a, j)`, and the same arc costs to and
+/// from every other cell (mode by mode) wherever the precedence closure allows both arcs.
+/// Exchanging `a` and `b` (with their modes) in a feasible sequence whose exchanged version is
+/// feasible too keeps its cost: every arc of a feasible sequence is allowed by the closure, so
+/// every arc that changes is one compared here.
+fn cost_twins(m: &CostModel, cl: &Closure, a: usize, b: usize) -> bool {
     let k = m.modes(a);
     if k != m.modes(b) || cl.before(a, b) || cl.before(b, a) {
         return false;
@@ -873,12 +1075,12 @@ fn twins(m: &CostModel, cl: &Closure, a: usize, b: usize) -> bool {
         if c == a || c == b {
             continue;
         }
-        if cl.before(c, a) != cl.before(c, b) || cl.before(a, c) != cl.before(b, c) {
-            return false;
-        }
+        let out = cl.arc_allowed(a, c) && cl.arc_allowed(b, c);
+        let inn = cl.arc_allowed(c, a) && cl.arc_allowed(c, b);
         for i in 0..k {
             for j in 0..m.modes(c) {
-                if m.arc(a, i, c, j) != m.arc(b, i, c, j) || m.arc(c, j, a, i) != m.arc(c, j, b, i)
+                if (out && m.arc(a, i, c, j) != m.arc(b, i, c, j))
+                    || (inn && m.arc(c, j, a, i) != m.arc(c, j, b, i))
                 {
                     return false;
                 }
@@ -888,11 +1090,26 @@ fn twins(m: &CostModel, cl: &Closure, a: usize, b: usize) -> bool {
     true
 }
 
-/// Symmetry breaking: groups of pairwise interchangeable cells (same modes, start, finish,
-/// arc costs to and from every other cell, symmetric arcs between them, same precedence),
-/// each ordered by index. Returns (a, b) pairs: a must come right before b in the group's
-/// order (any optimum can be relabelled so that it holds). Empty when the precedence has a
-/// cycle.
+/// Whether `a` may lead `b`: every ancestor of `a` is an ancestor of `b`, and every
+/// descendant of `b` is a descendant of `a` (neither precedes the other). Then in a feasible
+/// sequence with `b` before `a`, exchanging them keeps it feasible: `a` moves earlier but
+/// still after all of its ancestors, `b` moves later but still before all of its descendants.
+fn may_lead(cl: &Closure, a: usize, b: usize) -> bool {
+    (0..cl.n()).all(|c| {
+        c == a
+            || c == b
+            || ((!cl.before(c, a) || cl.before(c, b)) && (!cl.before(b, c) || cl.before(a, c)))
+    })
+}
+
+/// Symmetry breaking: pairs `(a, b)` of cost twins ([`cost_twins`]: copies of each other apart
+/// from the precedence) where `a` may lead `b` ([`may_lead`]; when each may lead the other,
+/// the smaller index leads). Any optimum can be turned into one where `a` comes before `b`
+/// for every pair: exchange an inverted pair while there is one; each exchange keeps
+/// feasibility and cost and lowers the number of inversions against a linear extension of
+/// the strict order "leads, then index", so the exchanges end. Cells with the same precedence
+/// (e.g. 1–3 of p43.1) are ordered by index; p43.2's cells 5 and 6 too (6 has one more
+/// predecessor). Empty when the precedence has a cycle.
 pub fn interchangeable_order(m: &CostModel) -> Vec<(usize, usize)> {
     Closure::new(&m.dag)
         .map(|cl| twin_order(m, &cl))
@@ -900,20 +1117,21 @@ pub fn interchangeable_order(m: &CostModel) -> Vec<(usize, usize)> {
 }
 
 fn twin_order(m: &CostModel, cl: &Closure) -> Vec<(usize, usize)> {
-    let mut groups: Vec<Vec<usize>> = Vec::new();
-    for b in 0..m.n() {
-        match groups
-            .iter_mut()
-            .find(|g| g.iter().all(|&a| twins(m, cl, a, b)))
-        {
-            Some(g) => g.push(b),
-            None => groups.push(vec![b]),
+    let n = m.n();
+    let mut out = Vec::new();
+    for a in 0..n {
+        for b in a + 1..n {
+            if !cost_twins(m, cl, a, b) {
+                continue;
+            }
+            if may_lead(cl, a, b) {
+                out.push((a, b));
+            } else if may_lead(cl, b, a) {
+                out.push((b, a));
+            }
         }
     }
-    groups
-        .iter()
-        .flat_map(|g| g.windows(2).map(|w| (w[0], w[1])))
-        .collect()
+    out
 }
 
 /// Disjoint clusters of cells for the bound: subtours of the assignment relaxation, found
