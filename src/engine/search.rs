@@ -65,9 +65,6 @@ pub struct Search<'a> {
     pub nb: Neighbours,
     /// Longest block considered by SOP-3-exchange (each side).
     pub max_block: usize,
-    /// SOP-3-exchange scans a block pair only when its first new link is cheaper than the
-    /// link it replaces (the Lin–Kernighan gain criterion from the looked-at end).
-    pub sop3_gain: bool,
     labels: Labels,
     rev: Reversal,
 }
@@ -86,7 +83,6 @@ impl<'a> Search<'a> {
             } else {
                 8
             },
-            sop3_gain: false,
             labels: Labels::default(),
             rev: Reversal::default(),
         }
@@ -257,15 +253,7 @@ impl<'a> Search<'a> {
                 break;
             }
             let mut evals = 0u64;
-            let found = forward(
-                &c,
-                s,
-                &mut self.labels,
-                x,
-                self.max_block,
-                self.sop3_gain,
-                &mut evals,
-            );
+            let found = forward(&c, s, &mut self.labels, x, self.max_block, &mut evals);
             ctx.count(evals);
             if let Some((d, h, i, j)) = found {
                 for cell in s.swap_blocks_touched(h, i as usize, j as usize, d) {

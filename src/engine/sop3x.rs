@@ -65,7 +65,6 @@ pub(crate) fn forward(
     w: &mut Labels,
     x: u32,
     max_block: usize,
-    gain: bool,
     evals: &mut u64,
 ) -> Option<(f64, isize, isize, isize)> {
     let m = c.m;
@@ -85,13 +84,9 @@ pub(crate) fn forward(
             for &q in &m.dag.succs[s.order[i as usize] as usize] {
                 w.stamp[q as usize] = label;
             }
-            let new_h = s.link(c, h, i + 1);
-            // gain criterion: the new link out of h must be cheaper than the one it replaces
-            if gain && new_h >= old_h {
-                continue;
-            }
             let jmax = (i + max_block as isize).min(n - 1);
             let mut best = (0.0, 0isize);
+            let new_h = s.link(c, h, i + 1);
             let old_i = s.link(c, i, i + 1);
             let last_l = s.at(i);
             for j in (i + 1)..=jmax {
@@ -132,7 +127,6 @@ fn backward(
     w: &mut Labels,
     x: u32,
     max_block: usize,
-    gain: bool,
     evals: &mut u64,
 ) -> Option<(f64, isize, isize, isize)> {
     let m = c.m;
@@ -154,14 +148,9 @@ fn backward(
             for &q in &m.dag.preds[s.order[(i + 1) as usize] as usize] {
                 w.stamp[q as usize] = label;
             }
-            let new_i = s.link(c, i, j + 1);
-            // gain criterion: the new link into j+1 must be cheaper than the one it replaces
-            if gain && new_i >= old_j {
-                i -= 1;
-                continue;
-            }
             let hmin = (i - max_block as isize).max(-1);
             let mut best = (0.0, 0isize);
+            let new_i = s.link(c, i, j + 1);
             let old_i = s.link(c, i, i + 1);
             let first_r = s.at(i + 1);
             // L = [h+1..=i] grows leftwards
@@ -227,9 +216,8 @@ pub fn sop3_two_way(
             break;
         }
         let mut evals = 0u64;
-        let (mb, g) = (search.max_block, search.sop3_gain);
-        let found = forward(&c, s, &mut w.labels, x, mb, g, &mut evals)
-            .or_else(|| backward(&c, s, &mut w.labels, x, mb, g, &mut evals));
+        let found = forward(&c, s, &mut w.labels, x, search.max_block, &mut evals)
+            .or_else(|| backward(&c, s, &mut w.labels, x, search.max_block, &mut evals));
         ctx.count(evals);
         if let Some((d, h, i, j)) = found {
             for cell in s.swap_blocks_touched(h, i as usize, j as usize, d) {

@@ -122,12 +122,6 @@ pub static INFO: SolverInfo = SolverInfo {
             help: "the repair runs SOP-3-exchange (off: Or-opt, and LK when on, only)",
         },
         ParamSpec {
-            name: "sop3-gain",
-            default: "false",
-            kind: ParamKind::Bool,
-            help: "SOP-3-exchange scans a block pair only when its first new link is cheaper than the one it replaces (Lin-Kernighan gain criterion)",
-        },
-        ParamSpec {
             name: "cross",
             default: "true",
             kind: ParamKind::Bool,
@@ -167,7 +161,6 @@ pub fn from_params(p: &Params) -> Ils {
         lk_penalty: p.float("lk-penalty").max(0.0),
         lk_max_viol: p.int("lk-max-viol") as u32,
         cross: p.bool("cross"),
-        sop3_gain: p.bool("sop3-gain"),
     }
 }
 
@@ -207,8 +200,6 @@ pub struct Ils {
     pub lk_max_viol: u32,
     /// Partition crossover of every repaired kick with the best.
     pub cross: bool,
-    /// Gain criterion in SOP-3-exchange.
-    pub sop3_gain: bool,
 }
 
 /// The kick of [`Ils`].
@@ -377,7 +368,6 @@ impl Ils {
         };
         let mut search = Search::new(c, self.k);
         search.vnd(&mut cur, ctx);
-        search.sop3_gain = self.sop3_gain;
         let mut lk = Lk::when(self.lk, &c, self.lk_depth, self.lk_breadth);
         if let Some(lk) = lk.as_mut() {
             lk.alternate_with_vnd(&mut search, &mut cur, ctx);
