@@ -179,9 +179,9 @@ def main():
     for k, v in machine.items():
         L.append(f"- {k}: {v}")
     L.append(
-        "- Caveat: the machine was shared; other processes (other sessions' builds and tests) "
-        "were running during the measurements, so wall-clock budgets bought less search than on "
-        "an idle machine and times are noisy."
+        "- Caveat: budgets are wall clock, so what a run finds depends on the machine's load "
+        "(see the load lines above); times at 10^6 cells are memory-bound and vary from run "
+        "to run."
     )
     L.append("")
 
