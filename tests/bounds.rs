@@ -30,31 +30,36 @@ fn exact(inst: &Instance, obj: Objective) -> f64 {
     r.report.cost
 }
 
-fn beam(inst: &Instance, obj: Objective) -> solvers::RunResult {
-    let mut p = BTreeMap::new();
-    p.insert("warm_evals".to_string(), "20000".to_string());
+/// The beam with these parameters (the rest at their defaults).
+fn beam_with(inst: &Instance, obj: Objective, params: &[(&str, &str)]) -> solvers::RunResult {
+    let p: BTreeMap<String, String> = params
+        .iter()
+        .map(|(k, v)| (k.to_string(), v.to_string()))
+        .collect();
     solvers::run("beam", inst, obj, &p, 1, Budget::default(), &mut NoObserver).expect("beam solves")
+}
+
+fn beam(inst: &Instance, obj: Objective) -> solvers::RunResult {
+    beam_with(inst, obj, &[("warm_evals", "20000")])
 }
 
 /// The beam with no warm start and no root bound: the tree search alone must find and prove
 /// the optimum, so an invalid node bound (over-pruning) shows up as a wrong cost.
 fn beam_alone(inst: &Instance, obj: Objective) -> solvers::RunResult {
-    let mut p = BTreeMap::new();
-    p.insert("warm_evals".to_string(), "0".to_string());
-    p.insert("root_bound".to_string(), "false".to_string());
-    solvers::run("beam", inst, obj, &p, 1, Budget::default(), &mut NoObserver).expect("beam solves")
+    beam_with(inst, obj, &[("warm_evals", "0"), ("root_bound", "false")])
 }
 
 /// The beam alone (as [`beam_alone`]) going to its unbounded pass right after width 1:
 /// the exhaustive pass (adaptive refinement, compact levels) must find and prove the optimum.
 /// With `memory_mb` = 0 that pass stops at its memory cap at once.
 fn beam_exhaustive(inst: &Instance, obj: Objective, memory_mb: &str) -> solvers::RunResult {
-    let mut p = BTreeMap::new();
-    p.insert("warm_evals".to_string(), "0".to_string());
-    p.insert("root_bound".to_string(), "false".to_string());
-    p.insert("exhaustive_from".to_string(), "1".to_string());
-    p.insert("memory_mb".to_string(), memory_mb.to_string());
-    solvers::run("beam", inst, obj, &p, 1, Budget::default(), &mut NoObserver).expect("beam solves")
+    let params = [
+        ("warm_evals", "0"),
+        ("root_bound", "false"),
+        ("exhaustive_from", "1"),
+        ("memory_mb", memory_mb),
+    ];
+    beam_with(inst, obj, &params)
 }
 
 fn all_bounds(inst: &Instance, obj: Objective) -> bound::Bounds {
@@ -76,11 +81,7 @@ fn check_instance(inst: &Instance, obj: Objective) {
     }
     // a one-prefix beam rarely proves anything: its reported lower bound (the first-level
     // node bound) must still be below the optimum
-    let mut p = BTreeMap::new();
-    p.insert("warm_evals".to_string(), "0".to_string());
-    p.insert("max_width".to_string(), "1".to_string());
-    let narrow = solvers::run("beam", inst, obj, &p, 1, Budget::default(), &mut NoObserver)
-        .expect("beam solves");
+    let narrow = beam_with(inst, obj, &[("warm_evals", "0"), ("max_width", "1")]);
     let lb = narrow.outcome.lower_bound.expect("beam reports a bound");
     assert!(
         lb <= opt + 1e-6 * opt.abs().max(1.0),
@@ -409,18 +410,17 @@ fn pcglns_text(groups: usize, sizes: &[usize], costs: &[u32], prec: &[bool]) -> 
     s
 }
 
-/// A random TSPLIB SOP text on `k` cells where cell 2 is a copy of cell 1 (and cell 3 too
-/// when `triple`), so the beam's symmetry breaking applies; `skew` makes the arcs between
-/// the copies asymmetric (then they are not interchangeable).
-fn twin_sop_text(k: usize, costs: &[u32], prec: &[bool], triple: bool, skew: bool) -> String {
-    let n = k + 2;
+/// A random TSPLIB SOP matrix on `n` nodes (first and last fixed): arc costs cycled from
+/// `costs`, and j before i (entry −1) for j < i wherever `prec` says so, so the order stays
+/// acyclic.
+fn random_sop_matrix(n: usize, costs: &[u32], prec: &[bool]) -> Vec<Vec<i64>> {
     let mut idx = 0;
-    let mut m: Vec<Vec<i64>> = (0..n)
+    (0..n)
         .map(|i| {
             (0..n)
                 .map(|j| {
                     idx += 1;
-                    let forced = j == 0 || i == n - 1 || (j < i && i > 1 && prec[idx % prec.len()]);
+                    let forced = j == 0 || i == n - 1 || (j < i && prec[idx % prec.len()]);
                     if i == j {
                         0
                     } else if forced {
@@ -431,7 +431,31 @@ fn twin_sop_text(k: usize, costs: &[u32], prec: &[bool], triple: bool, skew: boo
                 })
                 .collect()
         })
-        .collect();
+        .collect()
+}
+
+/// The TSPLIB SOP text of a full matrix.
+fn sop_matrix_text(name: &str, m: &[Vec<i64>]) -> String {
+    let n = m.len();
+    let mut s = format!(
+        "NAME: {name}\nTYPE: SOP\nDIMENSION: {n}\nEDGE_WEIGHT_TYPE: EXPLICIT\n\
+         EDGE_WEIGHT_FORMAT: FULL_MATRIX\nEDGE_WEIGHT_SECTION\n{n}\n"
+    );
+    for row in m {
+        let r: Vec<String> = row.iter().map(|v| v.to_string()).collect();
+        s += &r.join(" ");
+        s += "\n";
+    }
+    s += "EOF\n";
+    s
+}
+
+/// A random TSPLIB SOP text on `k` cells where cell 2 is a copy of cell 1 (and cell 3 too
+/// when `triple`), so the beam's symmetry breaking applies; `skew` makes the arcs between
+/// the copies asymmetric (then they are not interchangeable).
+fn twin_sop_text(k: usize, costs: &[u32], prec: &[bool], triple: bool, skew: bool) -> String {
+    let n = k + 2;
+    let mut m = random_sop_matrix(n, costs, prec);
     let copies: &[usize] = if triple { &[2, 3] } else { &[2] };
     for &c in copies {
         m[c] = m[1].clone();
@@ -450,17 +474,7 @@ fn twin_sop_text(k: usize, costs: &[u32], prec: &[bool], triple: bool, skew: boo
     if skew {
         m[1][2] = 9;
     }
-    let mut s = format!(
-        "NAME: twins\nTYPE: SOP\nDIMENSION: {n}\nEDGE_WEIGHT_TYPE: EXPLICIT\n\
-         EDGE_WEIGHT_FORMAT: FULL_MATRIX\nEDGE_WEIGHT_SECTION\n{n}\n"
-    );
-    for row in &m {
-        let r: Vec<String> = row.iter().map(|v| v.to_string()).collect();
-        s += &r.join(" ");
-        s += "\n";
-    }
-    s += "EOF\n";
-    s
+    sop_matrix_text("twins", &m)
 }
 
 /// A random TSPLIB SOP text on `k` cells (precedence only from lower to higher indices, by
@@ -476,24 +490,7 @@ fn near_twin_sop_text(
     extra: &[(usize, usize)],
 ) -> String {
     let n = k + 2;
-    let mut idx = 0;
-    let mut m: Vec<Vec<i64>> = (0..n)
-        .map(|i| {
-            (0..n)
-                .map(|j| {
-                    idx += 1;
-                    let forced = j == 0 || i == n - 1 || (j < i && prec[idx % prec.len()]);
-                    if i == j {
-                        0
-                    } else if forced {
-                        -1
-                    } else {
-                        costs[idx % costs.len()] as i64
-                    }
-                })
-                .collect()
-        })
-        .collect();
+    let mut m = random_sop_matrix(n, costs, prec);
     for &(i, j) in extra {
         m[i][j] = -1;
     }
@@ -518,17 +515,7 @@ fn near_twin_sop_text(
             }
         }
     }
-    let mut s = format!(
-        "NAME: near-twins\nTYPE: SOP\nDIMENSION: {n}\nEDGE_WEIGHT_TYPE: EXPLICIT\n\
-         EDGE_WEIGHT_FORMAT: FULL_MATRIX\nEDGE_WEIGHT_SECTION\n{n}\n"
-    );
-    for row in &m {
-        let r: Vec<String> = row.iter().map(|v| v.to_string()).collect();
-        s += &r.join(" ");
-        s += "\n";
-    }
-    s += "EOF\n";
-    s
+    sop_matrix_text("near-twins", &m)
 }
 
 #[test]
