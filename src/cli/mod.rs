@@ -65,6 +65,36 @@ enum Command {
     Report(harness::ReportArgs),
 }
 
+/// Parses a count given as an integer (`200000000`, `200_000_000`) or in exponent notation
+/// (`2e8`, `1.5e6`) when that names a whole number that fits in a `u64`.
+pub(crate) fn parse_count(s: &str) -> Result<u64, String> {
+    let t = s.trim().replace('_', "");
+    if let Ok(v) = t.parse::<u64>() {
+        return Ok(v);
+    }
+    let (mant, exp) = t
+        .split_once(['e', 'E'])
+        .ok_or_else(|| format!("`{s}` is not a whole number (examples: 200000000, 2e8)"))?;
+    let exp: u32 = exp
+        .parse()
+        .map_err(|_| format!("`{s}`: the exponent must be a small non-negative integer"))?;
+    let (int, frac) = mant.split_once('.').unwrap_or((mant, ""));
+    let digits = format!("{int}{frac}");
+    if digits.is_empty() || !digits.bytes().all(|b| b.is_ascii_digit()) {
+        return Err(format!(
+            "`{s}` is not a whole number (examples: 200000000, 2e8)"
+        ));
+    }
+    let shift = exp
+        .checked_sub(frac.len() as u32)
+        .ok_or_else(|| format!("`{s}` is not a whole number"))?;
+    let base: u64 = digits.parse().map_err(|_| format!("`{s}` is too large"))?;
+    10u64
+        .checked_pow(shift)
+        .and_then(|p| base.checked_mul(p))
+        .ok_or_else(|| format!("`{s}` is too large"))
+}
+
 /// Runs the parsed command.
 pub fn dispatch(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
@@ -95,4 +125,21 @@ pub(crate) fn stdout_failed(e: std::io::Error) -> ! {
     }
     eprintln!("error: writing to standard output: {e}");
     std::process::exit(2);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::parse_count;
+
+    #[test]
+    fn counts_in_integer_and_exponent_notation() {
+        assert_eq!(parse_count("200000000"), Ok(200_000_000));
+        assert_eq!(parse_count("200_000_000"), Ok(200_000_000));
+        assert_eq!(parse_count("2e8"), Ok(200_000_000));
+        assert_eq!(parse_count("1.5E6"), Ok(1_500_000));
+        assert_eq!(parse_count("0"), Ok(0));
+        for bad in ["", "e8", "1.25e1", "2e", "-3", "1e30", "x", "2e-1"] {
+            assert!(parse_count(bad).is_err(), "{bad} accepted");
+        }
+    }
 }

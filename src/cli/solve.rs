@@ -38,8 +38,8 @@ pub struct SolveArgs {
     /// Wall-clock limit in seconds.
     #[arg(long, value_name = "SECONDS")]
     pub time_limit: Option<f64>,
-    /// Evaluation budget (deterministic runs).
-    #[arg(long, value_name = "N")]
+    /// Evaluation budget (deterministic runs): an integer, `200_000_000` or `2e8`.
+    #[arg(long, value_name = "N", value_parser = super::parse_count)]
     pub max_evals: Option<u64>,
     /// Objective: time (default), air, or matrix.
     #[arg(long)]
