@@ -54,7 +54,7 @@ fn plans_parse_and_bad_plans_are_rejected() {
 fn auto_rejects_a_bad_plan_parameter() {
     // ESC12's costs are asymmetric, so the symmetric plan is not the one that would run
     let inst = sop("ESC12");
-    for key in ["plan", "symmetric-plan"] {
+    for key in ["plan", "symmetric-plan", "symmetric-beam-plan"] {
         let mut given = BTreeMap::new();
         given.insert(key.to_string(), "ils:2".to_string());
         let e = run(
@@ -155,7 +155,7 @@ fn ils_lin_kernighan_chains_help_on_a_symmetric_instance_and_stay_deterministic(
 #[test]
 fn auto_gives_ils_more_time_on_symmetric_matrix_costs_only() {
     use cellseq::cost::CostModel;
-    use cellseq::solvers::auto::{Auto, PLAN, SYMMETRIC_PLAN};
+    use cellseq::solvers::auto::{Auto, PLAN, SYMMETRIC_BEAM_PLAN, SYMMETRIC_PLAN};
     let auto = |plan: &str| Auto {
         seconds: 1.0,
         beam_share: 0.1,
@@ -163,17 +163,28 @@ fn auto_gives_ils_more_time_on_symmetric_matrix_costs_only() {
         plan: plan.to_string(),
         symmetric_plan: SYMMETRIC_PLAN.to_string(),
         beam_min_seconds: 2.0,
+        symmetric_beam_share: 0.3,
+        symmetric_beam_plan: SYMMETRIC_BEAM_PLAN.to_string(),
     };
     let model = |name: &str| {
         let inst = sop(name);
         CostModel::new(&inst, inst.default_objective())
     };
     // prob.42's matrix reads the same backwards; ESC25's does not
-    assert_eq!(auto(PLAN).plan_for(&model("prob.42")), SYMMETRIC_PLAN);
-    assert_eq!(auto(PLAN).plan_for(&model("ESC25")), PLAN);
-    // a plan the user chose is kept
+    let (p42, esc) = (model("prob.42"), model("ESC25"));
+    assert_eq!(auto(PLAN).plan_for(&p42, false), SYMMETRIC_PLAN);
+    assert_eq!(auto(PLAN).plan_for(&p42, true), SYMMETRIC_BEAM_PLAN);
+    assert_eq!(auto(PLAN).beam_share_for(&p42), 0.3);
+    for after_beam in [false, true] {
+        assert_eq!(auto(PLAN).plan_for(&esc, after_beam), PLAN);
+    }
+    assert_eq!(auto(PLAN).beam_share_for(&esc), 0.1);
+    // a plan the user chose is kept, and so is the beam share
     let own = "local-search:0.5,ils*:1";
-    assert_eq!(auto(own).plan_for(&model("prob.42")), own);
+    for after_beam in [false, true] {
+        assert_eq!(auto(own).plan_for(&p42, after_beam), own);
+    }
+    assert_eq!(auto(own).beam_share_for(&p42), 0.1);
     // geometric instances keep the default plan
     let kv: BTreeMap<String, String> = [("n", "30"), ("modes", "2"), ("reversible", "true")]
         .into_iter()
@@ -181,6 +192,7 @@ fn auto_gives_ils_more_time_on_symmetric_matrix_costs_only() {
         .collect();
     let inst = cellseq::generate::generate("uniform", &kv, 3).unwrap();
     let m = CostModel::new(&inst, inst.default_objective());
-    assert_eq!(auto(PLAN).plan_for(&m), PLAN);
+    assert_eq!(auto(PLAN).plan_for(&m, true), PLAN);
     assert!(parse_plan(SYMMETRIC_PLAN).is_ok());
+    assert!(parse_plan(SYMMETRIC_BEAM_PLAN).is_ok());
 }

@@ -11,7 +11,10 @@
 //!    then `ils` for the rest; a `*` starts a phase from the best sequence so far instead of
 //!    from greedy. On matrix instances whose costs read the same backwards the
 //!    default is `symmetric-plan` (`local-search:0.2,eacs*:0.3,ils*:1`), which gives `ils`
-//!    and its Lin–Kernighan chains more of the time.
+//!    and its Lin–Kernighan chains more of the time; there, when the beam phase ran, it gets
+//!    `symmetric-beam-share` (30 %) and is followed by `symmetric-beam-plan` (`ils*:1`):
+//!    `ils` started from the beam's sequence (on prob.100 at 10 s the median of 16 seeds
+//!    went from 1210.5 to 1172; notes/sopq5.md).
 //!
 //! The best sequence wins. Budgets are split by fraction, evaluations as well as time, so a
 //! run with an evaluation budget stays deterministic. Without any budget `auto` gives itself
@@ -62,6 +65,18 @@ pub static INFO: SolverInfo = SolverInfo {
             help: "the phases used instead of the default plan on matrix instances whose costs read the same backwards (TSPLIB's prob.100, prob.42), where ils runs Lin-Kernighan chains; ignored when plan is given",
         },
         ParamSpec {
+            name: "symmetric-beam-share",
+            default: "0.3",
+            kind: ParamKind::Float,
+            help: "share of the budget given to the beam phase on matrix instances whose costs read the same backwards (with the default plan)",
+        },
+        ParamSpec {
+            name: "symmetric-beam-plan",
+            default: SYMMETRIC_BEAM_PLAN,
+            kind: ParamKind::Text,
+            help: "the phases after a beam phase that ran (budget >= beam-min-seconds, at most beam-max-cells cells) on matrix instances whose costs read the same backwards; ignored when plan is given",
+        },
+        ParamSpec {
             name: "plan",
             default: PLAN,
             kind: ParamKind::Text,
@@ -75,6 +90,8 @@ pub static INFO: SolverInfo = SolverInfo {
             beam_max_cells: p.int("beam-max-cells") as usize,
             plan: p.word("plan").to_string(),
             symmetric_plan: p.word("symmetric-plan").to_string(),
+            symmetric_beam_share: p.float("symmetric-beam-share").clamp(0.0, 1.0),
+            symmetric_beam_plan: p.word("symmetric-beam-plan").to_string(),
             beam_min_seconds: p.float("beam-min-seconds").max(0.0),
         })
     },
@@ -94,6 +111,10 @@ pub struct Auto {
     pub symmetric_plan: String,
     /// Shortest wall-clock budget that gets a beam phase.
     pub beam_min_seconds: f64,
+    /// Share of the budget for the beam phase on symmetric matrix costs.
+    pub symmetric_beam_share: f64,
+    /// Phases after a beam phase that ran, on symmetric matrix costs.
+    pub symmetric_beam_plan: String,
 }
 
 /// Default phases after the beam.
@@ -104,6 +125,13 @@ pub const PLAN: &str = "local-search:0.3,eacs:0.5,ils*:1";
 /// went from 1238 to 1211 and of 10 seeds at 1 s from 1380.5 to 1282; prob.42 from 245.5
 /// to 243 at 1 s (notes/sopq3.md).
 pub const SYMMETRIC_PLAN: &str = "local-search:0.2,eacs*:0.3,ils*:1";
+
+/// Default phases on matrix instances with symmetric costs after a beam phase that ran:
+/// `ils` from the beam's sequence. The beam builds its paths with bounds over the whole
+/// remainder and lands in a better basin for `ils` than greedy, `local-search` or `eacs`
+/// starts: on prob.100 at 10 s, median of 16 seeds 1172 against the symmetric plan's 1210.5
+/// (and 1205 from local-search, 1217 from eacs; notes/sopq5.md).
+pub const SYMMETRIC_BEAM_PLAN: &str = "ils*:1";
 
 /// One phase of a plan: solver name, share of what is left, start from the best so far.
 #[derive(Debug, Clone, PartialEq)]
@@ -221,20 +249,39 @@ impl Auto {
         };
         ctx.count(sub.evaluations());
         ctx.report(out.cost);
+        if super::trace_enabled() {
+            eprintln!(
+                "auto: {name}{} cost {} after {} evaluations, {:.2} s",
+                if start.is_some() { "*" } else { "" },
+                out.cost,
+                ctx.evaluations(),
+                ctx.elapsed()
+            );
+        }
         Ok(out)
     }
 
-    /// The phases for model `m`: `symmetric_plan` when `plan` is the default and `m` is a
-    /// matrix instance whose costs read the same backwards, else `plan`.
-    pub fn plan_for(&self, m: &CostModel) -> &str {
-        if self.symmetric_case(m) {
-            &self.symmetric_plan
-        } else {
-            &self.plan
+    /// The phases for model `m`: on a matrix instance whose costs read the same backwards
+    /// (and with the default `plan`), `symmetric_beam_plan` after a beam phase that ran
+    /// (`after_beam`) and `symmetric_plan` otherwise; else `plan`.
+    pub fn plan_for(&self, m: &CostModel, after_beam: bool) -> &str {
+        match (self.symmetric_case(m), after_beam) {
+            (true, true) => &self.symmetric_beam_plan,
+            (true, false) => &self.symmetric_plan,
+            _ => &self.plan,
         }
     }
 
-    /// True when `symmetric_plan` replaces `plan` for model `m`.
+    /// The beam phase's share of the budget for model `m`.
+    pub fn beam_share_for(&self, m: &CostModel) -> f64 {
+        if self.symmetric_case(m) {
+            self.symmetric_beam_share
+        } else {
+            self.beam_share
+        }
+    }
+
+    /// True when the symmetric settings replace the default ones for model `m`.
     fn symmetric_case(&self, m: &CostModel) -> bool {
         self.plan == PLAN && !m.is_geometric() && lk::symmetric(&Costs::open(m))
     }
@@ -242,13 +289,10 @@ impl Auto {
 
 impl Solver for Auto {
     fn solve(&self, ctx: &mut Context) -> Result<Outcome> {
-        // both plans are checked, so a malformed one is refused on every instance
-        let (plan, symmetric_plan) = (parse_plan(&self.plan)?, parse_plan(&self.symmetric_plan)?);
-        let plan = if self.symmetric_case(ctx.model) {
-            symmetric_plan
-        } else {
-            plan
-        };
+        // every plan is checked, so a malformed one is refused on every instance
+        for p in [&self.plan, &self.symmetric_plan, &self.symmetric_beam_plan] {
+            parse_plan(p)?;
+        }
         let mut budget = ctx.budget;
         if budget.time_limit.is_none() && budget.max_evals.is_none() {
             budget.time_limit = Some(Duration::from_secs_f64(self.seconds));
@@ -262,15 +306,19 @@ impl Solver for Auto {
         let short = budget
             .time_limit
             .is_some_and(|t| t.as_secs_f64() < self.beam_min_seconds);
-        if ctx.model.n() <= self.beam_max_cells && self.beam_share > 0.0 && !short {
-            let b = share(budget, 0, 0.0, self.beam_share);
+        let beam_share = self.beam_share_for(ctx.model);
+        let mut after_beam = false;
+        if ctx.model.n() <= self.beam_max_cells && beam_share > 0.0 && !short {
+            let b = share(budget, 0, 0.0, beam_share);
             if let Ok(o) = self.phase(ctx, "beam", &BTreeMap::new(), b, None) {
                 if o.proven_optimal {
                     return Ok(o);
                 }
                 keep(&mut best, o);
+                after_beam = true;
             }
         }
+        let plan = parse_plan(self.plan_for(ctx.model, after_beam))?;
         for ph in &plan {
             let b = share(budget, ctx.evaluations(), ctx.elapsed(), ph.share);
             let start = if ph.chained { best.as_ref() } else { None };

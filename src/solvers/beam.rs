@@ -465,7 +465,7 @@ fn tables(
     } else {
         Vec::new()
     };
-    if std::env::var_os("CELLSEQ_BEAM_TRACE").is_some() {
+    if super::trace_enabled() {
         eprintln!(
             "beam: assignment {:?}, clusters {:?}",
             asg.as_ref().map(|a| a.value),
@@ -588,7 +588,7 @@ impl Beam {
             } else {
                 q.root
             };
-            if std::env::var_os("CELLSEQ_BEAM_TRACE").is_some() {
+            if super::trace_enabled() {
                 eprintln!(
                     "beam: qpath root {} after {} iterations, {:.2}s",
                     q.root,
@@ -627,7 +627,7 @@ impl Beam {
                 ctx.report(c);
                 best = Some((c, seq));
             }
-            if std::env::var_os("CELLSEQ_BEAM_TRACE").is_some() {
+            if super::trace_enabled() {
                 eprintln!(
                     "beam width {}: best {:?} truncated {} aborted {} overflow {} {:.2}s",
                     if unbounded {
@@ -794,7 +794,7 @@ impl Beam {
                 c.f = c.f.max(refined(m, t, c, &mut scratch));
             }
         }
-        if width == 1 && std::env::var_os("CELLSEQ_BEAM_TRACE").is_some() {
+        if width == 1 && super::trace_enabled() {
             let lb = cands.iter().map(|c| c.f).fold(f64::INFINITY, f64::min);
             eprintln!("beam: first-level bound {lb}");
         }
@@ -941,7 +941,7 @@ impl Beam {
                 return Pass::overflow();
             }
         }
-        if std::env::var_os("CELLSEQ_BEAM_TRACE").is_some() {
+        if super::trace_enabled() {
             let sizes: Vec<usize> = trail.iter().map(|l| l.len()).collect();
             eprintln!("beam: level sizes {sizes:?}");
             eprintln!(

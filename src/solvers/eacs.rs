@@ -460,7 +460,7 @@ impl Eacs {
             }
             ctx.count(n as u64);
         }
-        if std::env::var_os("CELLSEQ_TRACE").is_some() {
+        if super::trace_enabled() {
             eprintln!("eacs: {crosses} crossovers gave a new best");
         }
         Ok(outcome(m, &best))

@@ -481,7 +481,7 @@ impl Ils {
                 since_restart = 0;
             }
         }
-        if std::env::var_os("CELLSEQ_TRACE").is_some() {
+        if super::trace_enabled() {
             eprintln!("ils: {kicks_done} kicks, {crosses} crossovers gave a new best");
         }
         Ok(outcome(m, &best))

@@ -214,6 +214,12 @@ pub struct SolverInfo {
     pub make: fn(&Params) -> Box<dyn Solver>,
 }
 
+/// True when the environment asks the solvers for their diagnostic trace on standard error:
+/// `CELLSEQ_TRACE` (any value; `CELLSEQ_BEAM_TRACE`, the beam's older name, is read as well).
+pub fn trace_enabled() -> bool {
+    std::env::var_os("CELLSEQ_TRACE").is_some() || std::env::var_os("CELLSEQ_BEAM_TRACE").is_some()
+}
+
 /// Every registered solver, in display order.
 pub fn registry() -> Vec<&'static SolverInfo> {
     vec![
