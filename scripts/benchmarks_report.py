@@ -93,6 +93,9 @@ def summarize(rows):
                 )
                 if ok
                 else None,
+                "lifts": statistics.median([fnum(r["lifts"]) for r in ok if fnum(r.get("lifts")) is not None])
+                if ok and any(fnum(r.get("lifts")) is not None for r in ok)
+                else None,
                 "gen_params": rs[0]["gen_params"],
                 "seeds": sorted({r["seed"] for r in rs}),
             }
@@ -360,10 +363,30 @@ def main():
             if r["solver"] == "greedy" and r["n"] == "100000":
                 targets.append((f"greedy < 1 s at 10^5 ({short(r['gen_params'])})", f"{r['time']:.2f} s", r["time"] < 1.0))
             if r["solver"] == "local-search" and r["n"] == "100000" and ratio is not None:
+                measured = f"{ratio:.3f} in {r['time']:.2f} s"
+                lift = float(dict(x.split("=", 1) for x in r["gen_params"].split(";") if "=" in x).get("lift", "0"))
+                grec = next((q for q in recs if q["instance"] == r["instance"] and q["solver"] == "greedy"), None)
+                if lift > 0 and r["lifts"] is not None and grec and grec["lifts"] is not None:
+                    # every lift pays 2 * lift of retract and plunge; with link distance 0 only
+                    # coincident points link, so these lifts are the same for every order
+                    vert, gvert = r["lifts"] * 2 * lift, grec["lifts"] * 2 * lift
+                    planar = (r["air"] - vert) / (g - gvert) if g > gvert else None
+                    floor = min(vert, gvert) / g
+                    need = (0.80 * g - gvert) / (g - gvert) if g > gvert else None
+                    reach = (
+                        "so no order reaches 0.80"
+                        if floor > 0.80
+                        else f"so 0.80 needs planar travel at {need:.3f} × greedy's"
+                    )
+                    measured += (
+                        f" (the {int(r['lifts'])} lifts' retract and plunge, {2 * lift:g} mm each, are "
+                        f"{floor:.3f} × greedy's air, {reach}; the planar travel is "
+                        f"{planar:.3f} × greedy's)"
+                    )
                 targets.append(
                     (
                         f"improvement solver (`local-search`) ≤ 0.80 × greedy air at 10^5 in ≤ 10 s ({short(r['gen_params'])})",
-                        f"{ratio:.3f} in {r['time']:.2f} s",
+                        measured,
                         ratio <= 0.80 and r["time"] <= 10.5,
                     )
                 )
