@@ -7,7 +7,8 @@
 #   --session  (default) what the committed results/benchmarks.md was made from: --quick plus
 #              sop-auto-10s.toml (auto, 10 s, 1 seed, ~7 min) and sop-solvers-1s.toml (auto,
 #              local-search, aco, ils, eacs; 1 s; 3 seeds; ~10 min): ~30 min.
-#   --median   --session plus sop-auto-5x10s.toml (auto, 10 s, median of 5 seeds, ~35 min):
+#   --median   --session plus sop-auto-5x10s.toml (auto, 10 s, median of 5 seeds, ~35 min) and
+#              sop-auto-5x1s.toml (auto, 1 s, median of 5 seeds, ~4 min):
 #              the protocol for the default solver: ~65 min.
 #   --full     the protocol: sop.toml (auto, local-search, aco, ils, eacs; 10 s;
 #              5 seeds; ~2.8 h), pcgtsp.toml (auto; 10 s; 5 seeds; ~30 min), scale.toml, probes.
@@ -34,7 +35,7 @@ done
 case "$mode" in
   quick) plans=(sop-quick pcgtsp-quick scale) ;;
   session) plans=(sop-auto-10s sop-quick sop-solvers-1s pcgtsp-quick scale) ;;
-  median) plans=(sop-auto-5x10s sop-auto-10s sop-quick sop-solvers-1s pcgtsp-quick scale) ;;
+  median) plans=(sop-auto-5x10s sop-auto-10s sop-auto-5x1s sop-quick sop-solvers-1s pcgtsp-quick scale) ;;
   full) plans=(sop sop-quick pcgtsp scale) ;;
 esac
 py=${PYTHON:-python3}

@@ -4,7 +4,7 @@
 usage: scripts/benchmarks_report.py [--results DIR] [--out FILE] [--note TEXT]
 
 Reads, when present:
-  DIR/<plan>/results.csv   for the SOP plans (sop, sop-auto-5x10s, sop-auto-10s, sop-quick, sop-solvers-1s), the PCGTSP plans
+  DIR/<plan>/results.csv   for the SOP plans (sop, sop-auto-5x10s, sop-auto-10s, sop-auto-5x1s, sop-quick, sop-solvers-1s), the PCGTSP plans
                            (pcgtsp, pcgtsp-quick) and the scale plan (scale), as written by
                            `cellseq run`;
   DIR/scale-1e6.csv        rows appended by `cargo run --release --example scale -- ... csv=`;
@@ -22,7 +22,7 @@ import sys
 from collections import OrderedDict, defaultdict
 
 EPS = 1e-9
-SOP_PLANS = ["sop", "sop-auto-5x10s", "sop-auto-10s", "sop-quick", "sop-solvers-1s"]
+SOP_PLANS = ["sop", "sop-auto-5x10s", "sop-auto-10s", "sop-auto-5x1s", "sop-quick", "sop-solvers-1s"]
 PCG_PLANS = ["pcgtsp", "pcgtsp-quick"]
 
 
