@@ -420,13 +420,13 @@ impl Eacs {
                 }
                 // an ant that does not beat the best may still hold better segments: the
                 // partition crossover takes each segment from the cheaper of the two
-                if self.cross
-                    && s.cost >= best.cost - 1e-9 * best.cost.abs().max(1.0)
-                    && let Some(child) = px.cross(&c, &s, &best)
-                {
+                if self.cross && s.cost >= best.cost - 1e-9 * best.cost.abs().max(1.0) {
+                    // every attempt is charged its O(n), whether it gives a child or not
                     ctx.count(n as u64);
-                    crosses += 1;
-                    s = child;
+                    if let Some(child) = px.cross(&c, &s, &best) {
+                        crosses += 1;
+                        s = child;
+                    }
                 }
                 if s.cost < best.cost - 1e-9 * best.cost.abs().max(1.0) {
                     search.vnd(&mut s, ctx);

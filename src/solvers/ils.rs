@@ -453,14 +453,14 @@ impl Ils {
             // a repaired kick that does not beat the best may still hold better segments:
             // the partition crossover takes each segment from the cheaper of the two
             let mut improved = trial.cost < best.cost - 1e-9 * best.cost.abs().max(1.0);
-            if !improved
-                && self.cross
-                && let Some(child) = px.cross(&c, &trial, &best)
-            {
+            if !improved && self.cross {
+                // every attempt is charged its O(n), whether it gives a child or not
                 ctx.count(n as u64);
-                crosses += 1;
-                trial = child;
-                improved = true;
+                if let Some(child) = px.cross(&c, &trial, &best) {
+                    crosses += 1;
+                    trial = child;
+                    improved = true;
+                }
             }
             if improved {
                 // polish a new best with the full descent before keeping it
