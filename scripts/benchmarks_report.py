@@ -332,15 +332,18 @@ def main():
                 )
             )
 
+    def gen_kv(gp):
+        return dict(x.split("=", 1) for x in gp.split(";") if "=" in x)
+
     def short(gp):
-        kv = dict(x.split("=", 1) for x in gp.split(";") if "=" in x)
+        kv = gen_kv(gp)
         return ", ".join(f"{k}={kv[k]}" for k in ("preds", "reversible", "lift") if k in kv)
 
     p = os.path.join(args.results, "scale", "results.csv")
     if os.path.exists(p):
         rows = load(p)
         recs = summarize(rows)
-        greedy_air = {r["instance"]: r["air"] for r in recs if r["solver"] == "greedy"}
+        greedy = {r["instance"]: r for r in recs if r["solver"] == "greedy"}
         L.append("## Scale (`uniform`, reversible open cells, objective air length, plan `scale`)")
         L.append("")
         L.append(
@@ -352,7 +355,8 @@ def main():
         L.append("| instance | n | generator parameters | solver | budget | air length (mm) | ratio to greedy | wall time (s) |")
         L.append("|---|---|---|---|---|---|---|---|")
         for r in recs:
-            g = greedy_air.get(r["instance"])
+            grec = greedy.get(r["instance"])
+            g = grec["air"] if grec else None
             ratio = r["air"] / g if (g and r["air"] is not None) else None
             L.append(
                 f"| {r['instance']} | {r['n']} | {short(r['gen_params'])} | {r['solver']} | {r['budget']} | "
@@ -364,8 +368,7 @@ def main():
                 targets.append((f"greedy < 1 s at 10^5 ({short(r['gen_params'])})", f"{r['time']:.2f} s", r["time"] < 1.0))
             if r["solver"] == "local-search" and r["n"] == "100000" and ratio is not None:
                 measured = f"{ratio:.3f} in {r['time']:.2f} s"
-                lift = float(dict(x.split("=", 1) for x in r["gen_params"].split(";") if "=" in x).get("lift", "0"))
-                grec = next((q for q in recs if q["instance"] == r["instance"] and q["solver"] == "greedy"), None)
+                lift = float(gen_kv(r["gen_params"]).get("lift", "0"))
                 if lift > 0 and r["lifts"] is not None and grec and grec["lifts"] is not None:
                     # every lift pays 2 * lift of retract and plunge; with link distance 0 only
                     # coincident points link, so these lifts are the same for every order

@@ -211,6 +211,17 @@ pub fn parse_plan(plan: &str) -> Result<Vec<Phase>> {
     Ok(out)
 }
 
+/// Which of [`Auto`]'s three plans runs (0 `plan`, 1 `symmetric_plan`, 2
+/// `symmetric_beam_plan`): the symmetric ones only when the symmetric settings apply, the
+/// beam one only after a beam phase that ran.
+fn plan_index(symmetric: bool, after_beam: bool) -> usize {
+    match (symmetric, after_beam) {
+        (true, true) => 2,
+        (true, false) => 1,
+        _ => 0,
+    }
+}
+
 /// A share of `b` (what is left of it after `used_evals` and `used_s`).
 fn share(b: Budget, used_evals: u64, used_s: f64, frac: f64) -> Budget {
     Budget {
@@ -265,16 +276,22 @@ impl Auto {
     /// (and with the default `plan`), `symmetric_beam_plan` after a beam phase that ran
     /// (`after_beam`) and `symmetric_plan` otherwise; else `plan`.
     pub fn plan_for(&self, m: &CostModel, after_beam: bool) -> &str {
-        match (self.symmetric_case(m), after_beam) {
-            (true, true) => &self.symmetric_beam_plan,
-            (true, false) => &self.symmetric_plan,
-            _ => &self.plan,
-        }
+        self.plans()[plan_index(self.symmetric_case(m), after_beam)]
     }
 
     /// The beam phase's share of the budget for model `m`.
     pub fn beam_share_for(&self, m: &CostModel) -> f64 {
-        if self.symmetric_case(m) {
+        self.beam_share_when(self.symmetric_case(m))
+    }
+
+    /// `plan`, `symmetric_plan` and `symmetric_beam_plan`, in the order of [`plan_index`].
+    fn plans(&self) -> [&str; 3] {
+        [&self.plan, &self.symmetric_plan, &self.symmetric_beam_plan]
+    }
+
+    /// The beam share when the symmetric settings apply (`symmetric`) or not.
+    fn beam_share_when(&self, symmetric: bool) -> f64 {
+        if symmetric {
             self.symmetric_beam_share
         } else {
             self.beam_share
@@ -289,10 +306,13 @@ impl Auto {
 
 impl Solver for Auto {
     fn solve(&self, ctx: &mut Context) -> Result<Outcome> {
-        // every plan is checked, so a malformed one is refused on every instance
-        for p in [&self.plan, &self.symmetric_plan, &self.symmetric_beam_plan] {
-            parse_plan(p)?;
-        }
+        // every plan is parsed, so a malformed one is refused on every instance
+        let mut plans = self
+            .plans()
+            .iter()
+            .map(|p| parse_plan(p))
+            .collect::<Result<Vec<_>>>()?;
+        let symmetric = self.symmetric_case(ctx.model);
         let mut budget = ctx.budget;
         if budget.time_limit.is_none() && budget.max_evals.is_none() {
             budget.time_limit = Some(Duration::from_secs_f64(self.seconds));
@@ -306,7 +326,7 @@ impl Solver for Auto {
         let short = budget
             .time_limit
             .is_some_and(|t| t.as_secs_f64() < self.beam_min_seconds);
-        let beam_share = self.beam_share_for(ctx.model);
+        let beam_share = self.beam_share_when(symmetric);
         let mut after_beam = false;
         if ctx.model.n() <= self.beam_max_cells && beam_share > 0.0 && !short {
             let b = share(budget, 0, 0.0, beam_share);
@@ -318,7 +338,7 @@ impl Solver for Auto {
                 after_beam = true;
             }
         }
-        let plan = parse_plan(self.plan_for(ctx.model, after_beam))?;
+        let plan = plans.swap_remove(plan_index(symmetric, after_beam));
         for ph in &plan {
             let b = share(budget, ctx.evaluations(), ctx.elapsed(), ph.share);
             let start = if ph.chained { best.as_ref() } else { None };

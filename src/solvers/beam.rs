@@ -343,10 +343,15 @@ fn arc_mu(mu_arc: &[f64], n: usize, i: usize, j: usize) -> f64 {
 /// Evaluations charged per generated child (and per refined candidate): a child copies a
 /// prefix, computes its bound and probes the dominance map, which takes about as long as 8
 /// arc evaluations of the local search (evaluations per second on TSPLIB SOP: beam 2.4–7.6
-/// million, ils 17–75 million: 5–16 times as many, about 9 in the median; notes/sopq5.md). So an evaluation
-/// budget buys the beam about the wall time it buys the other solvers, and `auto`'s shares
-/// of an evaluation budget match its shares of a time budget.
+/// million, ils 17–75 million: 5–16 times as many, about 9 in the median; notes/sopq5.md).
+/// So an evaluation budget buys the beam about the wall time it buys the other solvers, and
+/// `auto`'s shares of an evaluation budget match its shares of a time budget.
 pub const CHILD_EVALS: u64 = 8;
+
+/// Charges `children` generated or refined candidates to the evaluation count.
+fn charge(ctx: &mut Context, children: u64) {
+    ctx.count(children * CHILD_EVALS);
+}
 
 /// Work budget (arc evaluations) of the qpath multipliers' subgradient steps.
 const QPATH_WORK: f64 = 4e8;
@@ -796,7 +801,7 @@ impl Beam {
             p.f = bound(p, 1);
         }
         cands.retain(|p| p.f <= cut);
-        ctx.count(cands.len() as u64 * CHILD_EVALS);
+        charge(ctx, cands.len() as u64);
         if self.refine {
             for c in cands.iter_mut() {
                 c.f = c.f.max(refined(m, t, c, &mut scratch));
@@ -856,7 +861,7 @@ impl Beam {
                             return Pass::aborted();
                         }
                         if overflow(stored + lists, prev.len() + cands.len(), index.len()) {
-                            ctx.count(evals * CHILD_EVALS);
+                            charge(ctx, evals);
                             return Pass::overflow();
                         }
                     }
@@ -898,7 +903,7 @@ impl Beam {
                 }
             }
             drop(by_cell);
-            ctx.count(evals * CHILD_EVALS);
+            charge(ctx, evals);
             // refinement pays only where it prunes: each level refines a first sample of
             // candidates and goes on only when it pruned at least a quarter of them (on
             // p43.2 it prunes ~4 % of the candidates and took 76 % of the time)
@@ -923,7 +928,7 @@ impl Beam {
                         break;
                     }
                 }
-                ctx.count(sample.done * CHILD_EVALS);
+                charge(ctx, sample.done);
                 cands = kept;
             } else if self.refine {
                 cands.retain_mut(|c| {
@@ -933,7 +938,7 @@ impl Beam {
                     c.f = c.f.max(refined(m, t, c, &mut scratch));
                     sample.record(c.f <= cut)
                 });
-                ctx.count(sample.done * CHILD_EVALS);
+                charge(ctx, sample.done);
             }
             truncated |= keep_best(&mut cands, width, self.by_cost);
             trail.push(cands.iter().map(|p| (p.parent, p.node)).collect());
