@@ -377,12 +377,7 @@ impl Instance {
     }
     /// Precedence density: edges of the transitive closure over n(n−1)/2.
     pub fn precedence_density(&self) -> f64 {
-        let n = self.n();
-        if n < 2 {
-            return 0.0;
-        }
-        let closure = crate::precedence::closure_size(n, &self.precedence);
-        closure as f64 / (n as f64 * (n as f64 - 1.0) / 2.0)
+        crate::precedence::closure_density(&crate::precedence::Dag::new(self.n(), &self.precedence))
     }
     /// Distinct tool ids used by the cells, in first-use order.
     pub fn used_tools(&self) -> Vec<&str> {

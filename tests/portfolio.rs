@@ -153,9 +153,11 @@ fn ils_lin_kernighan_chains_help_on_a_symmetric_instance_and_stay_deterministic(
 }
 
 #[test]
-fn auto_gives_ils_more_time_on_symmetric_matrix_costs_only() {
+fn auto_picks_its_plan_by_symmetry_and_precedence_density() {
     use cellseq::cost::CostModel;
-    use cellseq::solvers::auto::{Auto, PLAN, SYMMETRIC_BEAM_PLAN, SYMMETRIC_PLAN};
+    use cellseq::solvers::auto::{
+        Auto, Case, PLAN, SPARSE_PLAN, SYMMETRIC_BEAM_PLAN, SYMMETRIC_PLAN,
+    };
     let auto = |plan: &str| Auto {
         seconds: 1.0,
         beam_share: 0.1,
@@ -165,20 +167,28 @@ fn auto_gives_ils_more_time_on_symmetric_matrix_costs_only() {
         beam_min_seconds: 2.0,
         symmetric_beam_share: 0.3,
         symmetric_beam_plan: SYMMETRIC_BEAM_PLAN.to_string(),
+        sparse_plan: SPARSE_PLAN.to_string(),
+        dense_density: 0.8,
     };
     let model = |name: &str| {
         let inst = sop(name);
         CostModel::new(&inst, inst.default_objective())
     };
-    // prob.42's matrix reads the same backwards; ESC25's does not
-    let (p42, esc) = (model("prob.42"), model("ESC25"));
+    // prob.42's matrix reads the same backwards; ESC25's does not, and its precedence
+    // closure is sparse (0.18); rbg109a's is dense (0.91)
+    let (p42, esc, rbg) = (model("prob.42"), model("ESC25"), model("rbg109a"));
+    assert_eq!(auto(PLAN).case(&p42), Case::Symmetric);
     assert_eq!(auto(PLAN).plan_for(&p42, false), SYMMETRIC_PLAN);
     assert_eq!(auto(PLAN).plan_for(&p42, true), SYMMETRIC_BEAM_PLAN);
     assert_eq!(auto(PLAN).beam_share_for(&p42), 0.3);
+    assert_eq!(auto(PLAN).case(&esc), Case::Sparse);
+    assert_eq!(auto(PLAN).case(&rbg), Case::Default);
     for after_beam in [false, true] {
-        assert_eq!(auto(PLAN).plan_for(&esc, after_beam), PLAN);
+        assert_eq!(auto(PLAN).plan_for(&esc, after_beam), SPARSE_PLAN);
+        assert_eq!(auto(PLAN).plan_for(&rbg, after_beam), PLAN);
     }
     assert_eq!(auto(PLAN).beam_share_for(&esc), 0.1);
+    assert_eq!(auto(PLAN).beam_share_for(&rbg), 0.1);
     // a plan the user chose is kept, and so is the beam share
     let own = "local-search:0.5,ils*:1";
     for after_beam in [false, true] {
@@ -195,4 +205,5 @@ fn auto_gives_ils_more_time_on_symmetric_matrix_costs_only() {
     assert_eq!(auto(PLAN).plan_for(&m, true), PLAN);
     assert!(parse_plan(SYMMETRIC_PLAN).is_ok());
     assert!(parse_plan(SYMMETRIC_BEAM_PLAN).is_ok());
+    assert!(parse_plan(SPARSE_PLAN).is_ok());
 }

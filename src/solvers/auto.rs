@@ -14,7 +14,9 @@
 //!    and its Lin–Kernighan chains more of the time; there, when the beam phase ran, it gets
 //!    `symmetric-beam-share` (30 %) and is followed by `symmetric-beam-plan` (`ils*:1`):
 //!    `ils` started from the beam's sequence (on prob.100 at 10 s the median of 16 seeds
-//!    went from 1210.5 to 1172; notes/sopq5.md).
+//!    went from 1210.5 to 1172; notes/sopq5.md). On other matrix instances whose
+//!    precedence closure is sparser than `dense-density` (0.8) the default is `sparse-plan`,
+//!    the default plan with a wider acceptance band for the last `ils` (see [`SPARSE_PLAN`]).
 //!
 //! The best sequence wins. Budgets are split by fraction, evaluations as well as time, so a
 //! run with an evaluation budget stays deterministic. Without any budget `auto` gives itself
@@ -26,6 +28,7 @@ use super::{
 use crate::cost::CostModel;
 use crate::engine::{Costs, Solution, lk};
 use crate::error::{Error, Result};
+use crate::precedence::closure_density;
 use std::collections::BTreeMap;
 use std::time::Duration;
 
@@ -77,6 +80,18 @@ pub static INFO: SolverInfo = SolverInfo {
             help: "the phases after a beam phase that ran (budget >= beam-min-seconds, at most beam-max-cells cells) on matrix instances whose costs read the same backwards; ignored when plan is given",
         },
         ParamSpec {
+            name: "sparse-plan",
+            default: SPARSE_PLAN,
+            kind: ParamKind::Text,
+            help: "the phases used instead of the default plan on matrix instances whose precedence closure is sparser than dense-density (and whose costs do not read the same backwards); ignored when plan is given",
+        },
+        ParamSpec {
+            name: "dense-density",
+            default: "0.8",
+            kind: ParamKind::Float,
+            help: "matrix instances with a precedence closure density (pairs ordered over n(n-1)/2) below this get sparse-plan",
+        },
+        ParamSpec {
             name: "plan",
             default: PLAN,
             kind: ParamKind::Text,
@@ -92,6 +107,8 @@ pub static INFO: SolverInfo = SolverInfo {
             symmetric_plan: p.word("symmetric-plan").to_string(),
             symmetric_beam_share: p.float("symmetric-beam-share").clamp(0.0, 1.0),
             symmetric_beam_plan: p.word("symmetric-beam-plan").to_string(),
+            sparse_plan: p.word("sparse-plan").to_string(),
+            dense_density: p.float("dense-density"),
             beam_min_seconds: p.float("beam-min-seconds").max(0.0),
         })
     },
@@ -115,6 +132,10 @@ pub struct Auto {
     pub symmetric_beam_share: f64,
     /// Phases after a beam phase that ran, on symmetric matrix costs.
     pub symmetric_beam_plan: String,
+    /// Phases used instead of the default `plan` on matrix instances with sparse precedence.
+    pub sparse_plan: String,
+    /// Precedence closure density at and above which a matrix instance counts as dense.
+    pub dense_density: f64,
 }
 
 /// Default phases after the beam.
@@ -132,6 +153,15 @@ pub const SYMMETRIC_PLAN: &str = "local-search:0.2,eacs*:0.3,ils*:1";
 /// starts: on prob.100 at 10 s, median of 16 seeds 1172 against the symmetric plan's 1210.5
 /// (and 1205 from local-search, 1217 from eacs; notes/sopq5.md).
 pub const SYMMETRIC_BEAM_PLAN: &str = "ils*:1";
+
+/// Default phases on asymmetric matrix instances whose precedence closure is sparser than
+/// `dense-density` (on TSPLIB SOP every instance but rbg109a–rbg378a, which lie at
+/// 0.89–0.95 while the others lie at 0.05–0.62): the last `ils` accepts kicked solutions up
+/// to 3 % above the best instead of 0.1 %. With few precedences the walk needs the wider
+/// band to leave the basin that `eacs` hands it (kro124p.3: median 49703 → 49499, its best
+/// known), while on the dense rbg instances the wider band wanders (rbg358a: 2545 → 2565;
+/// notes/sopq5.md, notes/sopq6.md).
+pub const SPARSE_PLAN: &str = "local-search:0.3,eacs:0.5,ils[accept=0.03]*:1";
 
 /// One phase of a plan: solver name, share of what is left, start from the best so far.
 #[derive(Debug, Clone, PartialEq)]
@@ -211,14 +241,26 @@ pub fn parse_plan(plan: &str) -> Result<Vec<Phase>> {
     Ok(out)
 }
 
-/// Which of [`Auto`]'s three plans runs (0 `plan`, 1 `symmetric_plan`, 2
-/// `symmetric_beam_plan`): the symmetric ones only when the symmetric settings apply, the
-/// beam one only after a beam phase that ran.
-fn plan_index(symmetric: bool, after_beam: bool) -> usize {
-    match (symmetric, after_beam) {
-        (true, true) => 2,
-        (true, false) => 1,
-        _ => 0,
+/// Which settings of [`Auto`] apply to an instance (only with the default `plan`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Case {
+    /// `plan` and `beam-share`.
+    Default,
+    /// Matrix costs that read the same backwards: `symmetric-plan` (or
+    /// `symmetric-beam-plan` after a beam phase) and `symmetric-beam-share`.
+    Symmetric,
+    /// Asymmetric matrix costs with sparse precedence: `sparse-plan` and `beam-share`.
+    Sparse,
+}
+
+/// Which of [`Auto`]'s plans runs (0 `plan`, 1 `symmetric_plan`, 2 `symmetric_beam_plan`,
+/// 3 `sparse_plan`): the symmetric beam one only after a beam phase that ran.
+fn plan_index(case: Case, after_beam: bool) -> usize {
+    match (case, after_beam) {
+        (Case::Default, _) => 0,
+        (Case::Symmetric, false) => 1,
+        (Case::Symmetric, true) => 2,
+        (Case::Sparse, _) => 3,
     }
 }
 
@@ -276,31 +318,47 @@ impl Auto {
     /// (and with the default `plan`), `symmetric_beam_plan` after a beam phase that ran
     /// (`after_beam`) and `symmetric_plan` otherwise; else `plan`.
     pub fn plan_for(&self, m: &CostModel, after_beam: bool) -> &str {
-        self.plans()[plan_index(self.symmetric_case(m), after_beam)]
+        self.plans()[plan_index(self.case(m), after_beam)]
     }
 
     /// The beam phase's share of the budget for model `m`.
     pub fn beam_share_for(&self, m: &CostModel) -> f64 {
-        self.beam_share_when(self.symmetric_case(m))
+        self.beam_share_when(self.case(m))
     }
 
-    /// `plan`, `symmetric_plan` and `symmetric_beam_plan`, in the order of [`plan_index`].
-    fn plans(&self) -> [&str; 3] {
-        [&self.plan, &self.symmetric_plan, &self.symmetric_beam_plan]
+    /// `plan`, `symmetric_plan`, `symmetric_beam_plan` and `sparse_plan`, in the order of
+    /// [`plan_index`].
+    fn plans(&self) -> [&str; 4] {
+        [
+            &self.plan,
+            &self.symmetric_plan,
+            &self.symmetric_beam_plan,
+            &self.sparse_plan,
+        ]
     }
 
-    /// The beam share when the symmetric settings apply (`symmetric`) or not.
-    fn beam_share_when(&self, symmetric: bool) -> f64 {
-        if symmetric {
-            self.symmetric_beam_share
-        } else {
-            self.beam_share
+    /// The beam share in `case`.
+    fn beam_share_when(&self, case: Case) -> f64 {
+        match case {
+            Case::Symmetric => self.symmetric_beam_share,
+            _ => self.beam_share,
         }
     }
 
-    /// True when the symmetric settings replace the default ones for model `m`.
-    fn symmetric_case(&self, m: &CostModel) -> bool {
-        self.plan == PLAN && !m.is_geometric() && lk::symmetric(&Costs::open(m))
+    /// Which settings apply to model `m`: the default ones when the user gave a `plan` or
+    /// for geometric instances; else the symmetric ones when the matrix reads the same
+    /// backwards, the sparse ones when the precedence closure is sparser than
+    /// `dense_density`.
+    pub fn case(&self, m: &CostModel) -> Case {
+        if self.plan != PLAN || m.is_geometric() {
+            Case::Default
+        } else if lk::symmetric(&Costs::open(m)) {
+            Case::Symmetric
+        } else if closure_density(&m.dag) < self.dense_density {
+            Case::Sparse
+        } else {
+            Case::Default
+        }
     }
 }
 
@@ -312,7 +370,7 @@ impl Solver for Auto {
             .iter()
             .map(|p| parse_plan(p))
             .collect::<Result<Vec<_>>>()?;
-        let symmetric = self.symmetric_case(ctx.model);
+        let case = self.case(ctx.model);
         let mut budget = ctx.budget;
         if budget.time_limit.is_none() && budget.max_evals.is_none() {
             budget.time_limit = Some(Duration::from_secs_f64(self.seconds));
@@ -326,7 +384,7 @@ impl Solver for Auto {
         let short = budget
             .time_limit
             .is_some_and(|t| t.as_secs_f64() < self.beam_min_seconds);
-        let beam_share = self.beam_share_when(symmetric);
+        let beam_share = self.beam_share_when(case);
         let mut after_beam = false;
         if ctx.model.n() <= self.beam_max_cells && beam_share > 0.0 && !short {
             let b = share(budget, 0, 0.0, beam_share);
@@ -338,7 +396,7 @@ impl Solver for Auto {
                 after_beam = true;
             }
         }
-        let plan = plans.swap_remove(plan_index(symmetric, after_beam));
+        let plan = plans.swap_remove(plan_index(case, after_beam));
         for ph in &plan {
             let b = share(budget, ctx.evaluations(), ctx.elapsed(), ph.share);
             let start = if ph.chained { best.as_ref() } else { None };
