@@ -168,6 +168,9 @@ pub fn closure_density(dag: &Dag) -> f64 {
 /// [`closure_size`] of a built [`Dag`].
 fn dag_closure_size(dag: &Dag) -> usize {
     let n = dag.n();
+    if dag.succs.iter().all(|s| s.is_empty()) {
+        return 0;
+    }
     if n > 20_000 {
         return dag.succs.iter().map(|s| s.len()).sum();
     }

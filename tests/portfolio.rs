@@ -54,7 +54,12 @@ fn plans_parse_and_bad_plans_are_rejected() {
 fn auto_rejects_a_bad_plan_parameter() {
     // ESC12's costs are asymmetric, so the symmetric plan is not the one that would run
     let inst = sop("ESC12");
-    for key in ["plan", "symmetric-plan", "symmetric-beam-plan"] {
+    for key in [
+        "plan",
+        "symmetric-plan",
+        "symmetric-beam-plan",
+        "sparse-plan",
+    ] {
         let mut given = BTreeMap::new();
         given.insert(key.to_string(), "ils:2".to_string());
         let e = run(

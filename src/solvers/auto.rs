@@ -253,17 +253,6 @@ pub enum Case {
     Sparse,
 }
 
-/// Which of [`Auto`]'s plans runs (0 `plan`, 1 `symmetric_plan`, 2 `symmetric_beam_plan`,
-/// 3 `sparse_plan`): the symmetric beam one only after a beam phase that ran.
-fn plan_index(case: Case, after_beam: bool) -> usize {
-    match (case, after_beam) {
-        (Case::Default, _) => 0,
-        (Case::Symmetric, false) => 1,
-        (Case::Symmetric, true) => 2,
-        (Case::Sparse, _) => 3,
-    }
-}
-
 /// A share of `b` (what is left of it after `used_evals` and `used_s`).
 fn share(b: Budget, used_evals: u64, used_s: f64, frac: f64) -> Budget {
     Budget {
@@ -314,11 +303,21 @@ impl Auto {
         Ok(out)
     }
 
-    /// The phases for model `m`: on a matrix instance whose costs read the same backwards
-    /// (and with the default `plan`), `symmetric_beam_plan` after a beam phase that ran
-    /// (`after_beam`) and `symmetric_plan` otherwise; else `plan`.
+    /// The phases for model `m` (see [`Auto::case`] and [`Auto::plan_in`]).
     pub fn plan_for(&self, m: &CostModel, after_beam: bool) -> &str {
-        self.plans()[plan_index(self.case(m), after_beam)]
+        self.plan_in(self.case(m), after_beam)
+    }
+
+    /// The phases in `case`: `symmetric_beam_plan` after a beam phase that ran
+    /// (`after_beam`) and `symmetric_plan` otherwise in the symmetric case, `sparse_plan` in
+    /// the sparse one, else `plan`.
+    fn plan_in(&self, case: Case, after_beam: bool) -> &str {
+        match (case, after_beam) {
+            (Case::Default, _) => &self.plan,
+            (Case::Symmetric, false) => &self.symmetric_plan,
+            (Case::Symmetric, true) => &self.symmetric_beam_plan,
+            (Case::Sparse, _) => &self.sparse_plan,
+        }
     }
 
     /// The beam phase's share of the budget for model `m`.
@@ -326,8 +325,7 @@ impl Auto {
         self.beam_share_when(self.case(m))
     }
 
-    /// `plan`, `symmetric_plan`, `symmetric_beam_plan` and `sparse_plan`, in the order of
-    /// [`plan_index`].
+    /// Every plan: `plan`, `symmetric_plan`, `symmetric_beam_plan` and `sparse_plan`.
     fn plans(&self) -> [&str; 4] {
         [
             &self.plan,
@@ -365,11 +363,9 @@ impl Auto {
 impl Solver for Auto {
     fn solve(&self, ctx: &mut Context) -> Result<Outcome> {
         // every plan is parsed, so a malformed one is refused on every instance
-        let mut plans = self
-            .plans()
-            .iter()
-            .map(|p| parse_plan(p))
-            .collect::<Result<Vec<_>>>()?;
+        for p in self.plans() {
+            parse_plan(p)?;
+        }
         let case = self.case(ctx.model);
         let mut budget = ctx.budget;
         if budget.time_limit.is_none() && budget.max_evals.is_none() {
@@ -396,7 +392,7 @@ impl Solver for Auto {
                 after_beam = true;
             }
         }
-        let plan = plans.swap_remove(plan_index(case, after_beam));
+        let plan = parse_plan(self.plan_in(case, after_beam))?;
         for ph in &plan {
             let b = share(budget, ctx.evaluations(), ctx.elapsed(), ph.share);
             let start = if ph.chained { best.as_ref() } else { None };
