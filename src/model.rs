@@ -359,6 +359,69 @@ impl Instance {
             Objective::Time
         }
     }
+    /// The same matrix instance travelled backwards: the cost matrix transposed, every
+    /// precedence edge turned round, and the first and last cells swapped (a closed tour keeps
+    /// its fixed first cell, and its edges out of that cell). A sequence of one maps to a
+    /// sequence of the other of the same cost by [`Instance::reverse_sequence`]. An ant
+    /// colony run on the twin builds its sequences from the other end, which draws it into
+    /// other basins. `None` for geometric instances and for a closed tour with a last cell.
+    pub fn reversed_matrix(&self) -> Option<Instance> {
+        let m = self.matrix.as_ref()?;
+        let keep_first = self.closed && self.first.is_some();
+        if keep_first && self.last.is_some() {
+            return None;
+        }
+        let k = m.size;
+        let mut costs = vec![0.0; k * k];
+        for a in 0..k {
+            for b in 0..k {
+                costs[b * k + a] = m.costs[a * k + b];
+            }
+        }
+        let precedence = self
+            .precedence
+            .iter()
+            .map(|&(a, b)| {
+                if keep_first && Some(a) == self.first {
+                    (a, b)
+                } else {
+                    (b, a)
+                }
+            })
+            .collect();
+        let (first, last) = if keep_first {
+            (self.first, None)
+        } else {
+            (self.last, self.first)
+        };
+        Some(Instance {
+            name: self.name.clone(),
+            meta: self.meta.clone(),
+            machine: self.machine.clone(),
+            tools: self.tools.clone(),
+            cells: self.cells.clone(),
+            precedence,
+            as_given: None,
+            matrix: Some(CostMatrix { size: k, costs }),
+            first,
+            last,
+            closed: self.closed,
+        })
+    }
+    /// Maps a sequence of this instance to one of [`Instance::reversed_matrix`] and back (the
+    /// map is its own inverse): the order reversed, with a closed tour's fixed first cell
+    /// left in front.
+    pub fn reverse_sequence(&self, seq: &[Visit]) -> Sequence {
+        let keep_first =
+            self.closed && self.first.is_some() && seq.first().map(|v| v.cell) == self.first;
+        let mut out = seq.to_vec();
+        if keep_first {
+            out[1..].reverse();
+        } else {
+            out.reverse();
+        }
+        out
+    }
     /// Total number of (cell, mode) pairs.
     pub fn total_modes(&self) -> usize {
         self.cells.iter().map(|c| c.modes.len()).sum()

@@ -201,3 +201,36 @@ proptest! {
         prop_assert!((e - b).abs() <= 1e-6 * b.abs().max(1.0), "exact {e} vs brute force {b}");
     }
 }
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(80))]
+
+    /// The backwards twin of a matrix instance (`Instance::reversed_matrix`) has the same
+    /// optimum, and `reverse_sequence` carries the exact solution over at the same cost,
+    /// feasible by the checker, and back again unchanged.
+    #[test]
+    fn reversed_twin_keeps_costs_and_optimum(mut s in spec(6)) {
+        if s.matrix.is_none() {
+            return Ok(());
+        }
+        let few = s.pts.len() <= 4;
+        for p in s.pts.iter_mut() {
+            p.5 = p.5 && few;
+        }
+        let inst = build(&s);
+        let twin = inst.reversed_matrix().expect("matrix instances have a twin");
+        cellseq::validate::validate(&twin, "twin").unwrap();
+        let obj = Objective::Matrix;
+        let seq = solvers::run("exact", &inst, obj, &BTreeMap::new(), 3, Budget::default(), &mut NoObserver)
+            .unwrap()
+            .outcome
+            .sequence;
+        let back = inst.reverse_sequence(&seq);
+        let there = check(&twin, &back, obj).expect("reversed sequence feasible on the twin");
+        let here = check(&inst, &seq, obj).unwrap();
+        prop_assert!((there.cost - here.cost).abs() <= 1e-9, "{} vs {}", there.cost, here.cost);
+        prop_assert_eq!(twin.reverse_sequence(&back), seq);
+        let b = brute_force(&twin, obj);
+        prop_assert!((b - here.cost).abs() <= 1e-6, "twin optimum {b} vs {}", here.cost);
+    }
+}

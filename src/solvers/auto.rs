@@ -15,8 +15,16 @@
 //!    `symmetric-beam-share` (30 %) and is followed by `symmetric-beam-plan` (`ils*:1`):
 //!    `ils` started from the beam's sequence (on prob.100 at 10 s the median of 16 seeds
 //!    went from 1210.5 to 1172; notes/sopq5.md). On other matrix instances whose
-//!    precedence closure is sparser than `dense-density` (0.8) the default is `sparse-plan`,
-//!    the default plan with a wider acceptance band for the last `ils` (see [`SPARSE_PLAN`]).
+//!    precedence closure is sparser than `dense-density` (0.8) the default is `sparse-plan`:
+//!    a shorter `local-search`, the colony run backwards, and a wider acceptance band for
+//!    the last `ils` (see [`SPARSE_PLAN`]).
+//!
+//! Plan syntax: `solver[key=value;...]:share`, with `*` after the name to start from the
+//! best sequence so far, `+` to start from the sequence of the phase just before, and `~`
+//! before the name to run the phase on the instance travelled backwards
+//! ([`crate::model::Instance::reversed_matrix`]; matrix instances only, elsewhere the phase
+//! runs forwards). A solver named twice in a plan gets a new seed each time
+//! ([`phase_seed`]), so `eacs:0.4,~eacs:0.5` runs two independent colonies.
 //!
 //! The best sequence wins. Budgets are split by fraction, evaluations as well as time, so a
 //! run with an evaluation budget stays deterministic. Without any budget `auto` gives itself
@@ -28,6 +36,7 @@ use super::{
 use crate::cost::CostModel;
 use crate::engine::{Costs, Solution, lk};
 use crate::error::{Error, Result};
+use crate::model::Instance;
 use crate::precedence::closure_density;
 use std::collections::BTreeMap;
 use std::time::Duration;
@@ -95,7 +104,7 @@ pub static INFO: SolverInfo = SolverInfo {
             name: "plan",
             default: PLAN,
             kind: ParamKind::Text,
-            help: "phases after the beam: solver[key=value;...]:share,... (share of what is left; optional parameters in brackets; a '*' after the name starts ils/eacs from the best so far)",
+            help: "phases after the beam: solver[key=value;...]:share,... (share of what is left; optional parameters in brackets; a '*' after the name starts ils/eacs from the best so far, a '+' from the sequence of the phase before; a '~' before the name runs the phase on the matrix instance travelled backwards; a solver named twice gets a new seed each time)",
         },
     ],
     make: |p: &Params| {
@@ -160,8 +169,12 @@ pub const SYMMETRIC_BEAM_PLAN: &str = "ils*:1";
 /// to 3 % above the best instead of 0.1 %. With few precedences the walk needs the wider
 /// band to leave the basin that `eacs` hands it (kro124p.3: median 49703 → 49499, its best
 /// known), while on the dense rbg instances the wider band wanders (rbg358a: 2545 → 2565;
-/// notes/sopq5.md, notes/sopq6.md).
-pub const SPARSE_PLAN: &str = "local-search:0.3,eacs:0.5,ils[accept=0.03]*:1";
+/// notes/sopq5.md, notes/sopq6.md). Its colony runs backwards (`~eacs`, on the transposed
+/// twin of the instance) and gets the time `local-search` gave up (0.3 → 0.1): built from
+/// the other end, the ants fall less often into the basin that holds forward colonies on
+/// kro124p.3 (10 s, seeds 1–10: 8 runs at the best known 49499 and 2 at 49519, against 6
+/// and 4 in the 50183–50207 basin; notes/sopq7.md).
+pub const SPARSE_PLAN: &str = "local-search:0.1,~eacs:0.5,ils[accept=0.03]*:1";
 
 /// One phase of a plan: solver name, share of what is left, start from the best so far.
 #[derive(Debug, Clone, PartialEq)]
@@ -170,8 +183,14 @@ pub struct Phase {
     pub solver: String,
     /// Share of the remaining budget.
     pub share: f64,
-    /// Start from the best sequence so far (ils and eacs only).
+    /// Start from the best sequence so far (`*`; ils and eacs only).
     pub chained: bool,
+    /// Start from the sequence of the phase just before (`+`; ils and eacs only): polishes
+    /// one colony's result even when an earlier phase found a cheaper sequence.
+    pub follows: bool,
+    /// Run on the instance travelled backwards (`~` before the name; matrix instances,
+    /// see [`crate::model::Instance::reversed_matrix`]; elsewhere the phase runs forwards).
+    pub reversed: bool,
     /// The phase's own solver parameters (`solver[key=value;...]`), validated.
     pub params: BTreeMap<String, String>,
 }
@@ -195,9 +214,14 @@ pub fn parse_plan(plan: &str) -> Result<Vec<Phase>> {
             .filter(|v: &f64| v.is_finite() && *v > 0.0 && *v <= 1.0)
             .ok_or_else(|| bad(format!("plan phase '{part}': share must be in (0, 1]")))?;
         let name = name.trim();
-        let (name, chained) = match name.strip_suffix('*') {
-            Some(b) => (b.trim_end(), true),
+        let (name, reversed) = match name.strip_prefix('~') {
+            Some(b) => (b.trim_start(), true),
             None => (name, false),
+        };
+        let (name, chained, follows) = match (name.strip_suffix('*'), name.strip_suffix('+')) {
+            (Some(b), _) => (b.trim_end(), true, false),
+            (_, Some(b)) => (b.trim_end(), false, true),
+            _ => (name, false, false),
         };
         let (solver, params) = match name.split_once('[') {
             Some((solver, rest)) => {
@@ -223,15 +247,22 @@ pub fn parse_plan(plan: &str) -> Result<Vec<Phase>> {
         let info = super::find(&solver)?;
         Params::new(&solver, info.params, &params)
             .map_err(|e| bad(format!("plan phase '{part}': {e}")))?;
-        if chained && solver != "ils" && solver != "eacs" {
+        if (chained || follows) && solver != "ils" && solver != "eacs" {
             return Err(bad(format!(
-                "plan phase '{part}': only ils and eacs can start from the best so far"
+                "plan phase '{part}': only ils and eacs can start from an earlier sequence"
+            )));
+        }
+        if follows && out.is_empty() {
+            return Err(bad(format!(
+                "plan phase '{part}': the first phase has no phase before it to follow"
             )));
         }
         out.push(Phase {
             solver,
             share,
             chained,
+            follows,
+            reversed,
             params,
         });
     }
@@ -253,6 +284,13 @@ pub enum Case {
     Sparse,
 }
 
+/// The seed of a plan phase: the run's own seed for the first phase of each solver, so
+/// that a plan naming each solver once draws the streams it always drew, and a different
+/// seed for each repeat (`eacs:0.4,eacs:0.6` runs two independent colonies).
+pub fn phase_seed(seed: u64, repeat: u64) -> u64 {
+    seed.wrapping_add(repeat.wrapping_mul(0x9E37_79B9_7F4A_7C15))
+}
+
 /// A share of `b` (what is left of it after `used_evals` and `used_s`).
 fn share(b: Budget, used_evals: u64, used_s: f64, frac: f64) -> Budget {
     Budget {
@@ -266,6 +304,7 @@ fn share(b: Budget, used_evals: u64, used_s: f64, frac: f64) -> Budget {
 }
 
 impl Auto {
+    #[allow(clippy::too_many_arguments)]
     fn phase(
         &self,
         ctx: &mut Context,
@@ -273,15 +312,26 @@ impl Auto {
         given: &BTreeMap<String, String>,
         budget: Budget,
         start: Option<&Outcome>,
+        repeat: u64,
+        twin: Option<&(Instance, CostModel)>,
     ) -> Result<Outcome> {
         let info = super::find(name)?;
         let params = Params::new(name, info.params, given)?;
         let solver = (info.make)(&params);
         let mut quiet = NoObserver;
-        let mut sub = ctx.sub(&params, budget, &mut quiet);
-        let out = match start {
+        let (instance, model) = match twin {
+            Some((i, m)) => (i, m),
+            None => (ctx.instance, ctx.model),
+        };
+        let seed = phase_seed(ctx.seed, repeat);
+        let mut sub = Context::new(instance, model, &params, seed, budget, &mut quiet);
+        let mut out = match start {
             Some(o) => {
-                let s = Solution::new(&Costs::open(ctx.model), &o.sequence);
+                let seq = match twin {
+                    Some(_) => ctx.instance.reverse_sequence(&o.sequence),
+                    None => o.sequence.clone(),
+                };
+                let s = Solution::new(&Costs::open(model), &seq);
                 match name {
                     "ils" => super::ils::from_params(&params).run(&mut sub, Some(s))?,
                     _ => super::eacs::from_params(&params).run(&mut sub, Some(s))?,
@@ -289,11 +339,15 @@ impl Auto {
             }
             None => solver.solve(&mut sub)?,
         };
+        if twin.is_some() {
+            out.sequence = instance.reverse_sequence(&out.sequence);
+        }
         ctx.count(sub.evaluations());
         ctx.report(out.cost);
         if super::trace_enabled() {
             eprintln!(
-                "auto: {name}{} cost {} after {} evaluations, {:.2} s",
+                "auto: {}{name}{} cost {} after {} evaluations, {:.2} s",
+                if twin.is_some() { "~" } else { "" },
                 if start.is_some() { "*" } else { "" },
                 out.cost,
                 ctx.evaluations(),
@@ -384,7 +438,7 @@ impl Solver for Auto {
         let mut after_beam = false;
         if ctx.model.n() <= self.beam_max_cells && beam_share > 0.0 && !short {
             let b = share(budget, 0, 0.0, beam_share);
-            if let Ok(o) = self.phase(ctx, "beam", &BTreeMap::new(), b, None) {
+            if let Ok(o) = self.phase(ctx, "beam", &BTreeMap::new(), b, None, 0, None) {
                 if o.proven_optimal {
                     return Ok(o);
                 }
@@ -393,11 +447,31 @@ impl Solver for Auto {
             }
         }
         let plan = parse_plan(self.plan_in(case, after_beam))?;
+        let mut runs: BTreeMap<&str, u64> = BTreeMap::new();
+        let mut last: Option<Outcome> = None;
+        let twin = if plan.iter().any(|p| p.reversed) {
+            ctx.instance.reversed_matrix().map(|i| {
+                let m = CostModel::new(&i, ctx.model.objective());
+                (i, m)
+            })
+        } else {
+            None
+        };
         for ph in &plan {
             let b = share(budget, ctx.evaluations(), ctx.elapsed(), ph.share);
-            let start = if ph.chained { best.as_ref() } else { None };
-            let o = self.phase(ctx, &ph.solver, &ph.params, b, start)?;
-            keep(&mut best, o);
+            let start = if ph.chained {
+                best.as_ref()
+            } else if ph.follows {
+                last.as_ref()
+            } else {
+                None
+            };
+            let repeat = runs.entry(ph.solver.as_str()).or_insert(0);
+            let on = if ph.reversed { twin.as_ref() } else { None };
+            let o = self.phase(ctx, &ph.solver, &ph.params, b, start, *repeat, on)?;
+            *repeat += 1;
+            keep(&mut best, o.clone());
+            last = Some(o);
         }
         let mut out = best.expect("at least one phase ran");
         out.proven_optimal = false;
