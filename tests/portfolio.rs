@@ -2,7 +2,7 @@
 //! under an evaluation budget, and solution quality on a small TSPLIB SOP instance.
 
 use cellseq::formats::load_instance;
-use cellseq::solvers::auto::parse_plan;
+use cellseq::solvers::auto::{Start, parse_plan};
 use cellseq::solvers::{Budget, NoObserver, run};
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -24,18 +24,18 @@ fn plans_parse_and_bad_plans_are_rejected() {
     let p = parse_plan("local-search:0.3, eacs*:0.5,ils*:1").unwrap();
     assert_eq!(p.len(), 3);
     assert_eq!(p[1].solver, "eacs");
-    assert!(p[1].chained && !p[0].chained);
+    assert_eq!((p[0].start, p[1].start), (Start::Fresh, Start::Best));
     assert!((p[0].share - 0.3).abs() < 1e-12);
     assert!(p[0].params.is_empty());
     let p = parse_plan("local-search[kicks=0; k=8]:0.3,ils[accept=0.01]*:1").unwrap();
     assert_eq!(p[0].solver, "local-search");
     assert_eq!(p[0].params.get("kicks").map(String::as_str), Some("0"));
     assert_eq!(p[0].params.get("k").map(String::as_str), Some("8"));
-    assert!(p[1].chained && p[1].solver == "ils");
+    assert!(p[1].start == Start::Best && p[1].solver == "ils");
     assert_eq!(p[1].params.get("accept").map(String::as_str), Some("0.01"));
     let p = parse_plan("local-search:0.2,~eacs:0.5,ils[accept=0.01]+:1").unwrap();
     assert!(p[1].reversed && !p[0].reversed && !p[2].reversed);
-    assert!(p[2].follows && !p[2].chained && !p[1].follows);
+    assert_eq!((p[1].start, p[2].start), (Start::Fresh, Start::Previous));
     assert_eq!(p[2].params.get("accept").map(String::as_str), Some("0.01"));
     for bad in [
         "local-search[kicks=0:0.3",

@@ -176,18 +176,27 @@ pub const SYMMETRIC_BEAM_PLAN: &str = "ils*:1";
 /// and 4 in the 50183–50207 basin; notes/sopq7.md).
 pub const SPARSE_PLAN: &str = "local-search:0.1,~eacs:0.5,ils[accept=0.03]*:1";
 
-/// One phase of a plan: solver name, share of what is left, start from the best so far.
+/// Where a plan phase starts.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Start {
+    /// From scratch (the solver's own construction).
+    Fresh,
+    /// From the best sequence so far (`*` after the name; ils and eacs only).
+    Best,
+    /// From the sequence of the phase just before (`+`; ils and eacs only): polishes one
+    /// colony's result even when an earlier phase found a cheaper sequence.
+    Previous,
+}
+
+/// One phase of a plan: solver name, share of what is left, where it starts.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Phase {
     /// Solver name.
     pub solver: String,
     /// Share of the remaining budget.
     pub share: f64,
-    /// Start from the best sequence so far (`*`; ils and eacs only).
-    pub chained: bool,
-    /// Start from the sequence of the phase just before (`+`; ils and eacs only): polishes
-    /// one colony's result even when an earlier phase found a cheaper sequence.
-    pub follows: bool,
+    /// Where the phase starts.
+    pub start: Start,
     /// Run on the instance travelled backwards (`~` before the name; matrix instances,
     /// see [`crate::model::Instance::reversed_matrix`]; elsewhere the phase runs forwards).
     pub reversed: bool,
@@ -195,7 +204,7 @@ pub struct Phase {
     pub params: BTreeMap<String, String>,
 }
 
-/// Parses a plan `solver[key=value;...][*]:share,...` (parameters in brackets are optional and
+/// Parses a plan `[~]solver[key=value;...][*|+]:share,...` (parameters in brackets are optional and
 /// checked against the solver's declared parameters).
 pub fn parse_plan(plan: &str) -> Result<Vec<Phase>> {
     let bad = |msg: String| Error::Solver {
@@ -218,10 +227,10 @@ pub fn parse_plan(plan: &str) -> Result<Vec<Phase>> {
             Some(b) => (b.trim_start(), true),
             None => (name, false),
         };
-        let (name, chained, follows) = match (name.strip_suffix('*'), name.strip_suffix('+')) {
-            (Some(b), _) => (b.trim_end(), true, false),
-            (_, Some(b)) => (b.trim_end(), false, true),
-            _ => (name, false, false),
+        let (name, start) = match (name.strip_suffix('*'), name.strip_suffix('+')) {
+            (Some(b), _) => (b.trim_end(), Start::Best),
+            (_, Some(b)) => (b.trim_end(), Start::Previous),
+            _ => (name, Start::Fresh),
         };
         let (solver, params) = match name.split_once('[') {
             Some((solver, rest)) => {
@@ -247,12 +256,12 @@ pub fn parse_plan(plan: &str) -> Result<Vec<Phase>> {
         let info = super::find(&solver)?;
         Params::new(&solver, info.params, &params)
             .map_err(|e| bad(format!("plan phase '{part}': {e}")))?;
-        if (chained || follows) && solver != "ils" && solver != "eacs" {
+        if start != Start::Fresh && solver != "ils" && solver != "eacs" {
             return Err(bad(format!(
                 "plan phase '{part}': only ils and eacs can start from an earlier sequence"
             )));
         }
-        if follows && out.is_empty() {
+        if start == Start::Previous && out.is_empty() {
             return Err(bad(format!(
                 "plan phase '{part}': the first phase has no phase before it to follow"
             )));
@@ -260,8 +269,7 @@ pub fn parse_plan(plan: &str) -> Result<Vec<Phase>> {
         out.push(Phase {
             solver,
             share,
-            chained,
-            follows,
+            start,
             reversed,
             params,
         });
@@ -447,7 +455,6 @@ impl Solver for Auto {
             }
         }
         let plan = parse_plan(self.plan_in(case, after_beam))?;
-        let mut runs: BTreeMap<&str, u64> = BTreeMap::new();
         let mut last: Option<Outcome> = None;
         let twin = if plan.iter().any(|p| p.reversed) {
             ctx.instance.reversed_matrix().map(|i| {
@@ -457,19 +464,17 @@ impl Solver for Auto {
         } else {
             None
         };
-        for ph in &plan {
+        for (i, ph) in plan.iter().enumerate() {
             let b = share(budget, ctx.evaluations(), ctx.elapsed(), ph.share);
-            let start = if ph.chained {
-                best.as_ref()
-            } else if ph.follows {
-                last.as_ref()
-            } else {
-                None
+            let start = match ph.start {
+                Start::Fresh => None,
+                Start::Best => best.as_ref(),
+                Start::Previous => last.as_ref(),
             };
-            let repeat = runs.entry(ph.solver.as_str()).or_insert(0);
+            // how often this solver ran before in the plan: its seed's repeat index
+            let repeat = plan[..i].iter().filter(|p| p.solver == ph.solver).count() as u64;
             let on = if ph.reversed { twin.as_ref() } else { None };
-            let o = self.phase(ctx, &ph.solver, &ph.params, b, start, *repeat, on)?;
-            *repeat += 1;
+            let o = self.phase(ctx, &ph.solver, &ph.params, b, start, repeat, on)?;
             keep(&mut best, o.clone());
             last = Some(o);
         }
