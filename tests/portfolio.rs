@@ -181,6 +181,8 @@ fn auto_picks_its_plan_by_symmetry_and_precedence_density() {
         symmetric_beam_plan: SYMMETRIC_BEAM_PLAN.to_string(),
         sparse_plan: SPARSE_PLAN.to_string(),
         dense_density: 0.8,
+        dense_beam_share: 0.5,
+        dense_beam_max_cells: 300,
     };
     let model = |name: &str| {
         let inst = sop(name);
@@ -194,19 +196,26 @@ fn auto_picks_its_plan_by_symmetry_and_precedence_density() {
     assert_eq!(auto(PLAN).plan_for(&p42, true), SYMMETRIC_BEAM_PLAN);
     assert_eq!(auto(PLAN).beam_share_for(&p42), 0.3);
     assert_eq!(auto(PLAN).case(&esc), Case::Sparse);
-    assert_eq!(auto(PLAN).case(&rbg), Case::Default);
+    assert_eq!(auto(PLAN).case(&rbg), Case::Dense);
     for after_beam in [false, true] {
         assert_eq!(auto(PLAN).plan_for(&esc, after_beam), SPARSE_PLAN);
         assert_eq!(auto(PLAN).plan_for(&rbg, after_beam), PLAN);
     }
     assert_eq!(auto(PLAN).beam_share_for(&esc), 0.1);
-    assert_eq!(auto(PLAN).beam_share_for(&rbg), 0.1);
+    // dense and at most dense-beam-max-cells cells: the beam gets dense-beam-share
+    assert_eq!(auto(PLAN).beam_share_for(&rbg), 0.5);
+    let small_cap = Auto {
+        dense_beam_max_cells: 100,
+        ..auto(PLAN)
+    };
+    assert_eq!(small_cap.beam_share_for(&rbg), 0.1);
     // a plan the user chose is kept, and so is the beam share
     let own = "local-search:0.5,ils*:1";
     for after_beam in [false, true] {
         assert_eq!(auto(own).plan_for(&p42, after_beam), own);
     }
     assert_eq!(auto(own).beam_share_for(&p42), 0.1);
+    assert_eq!(auto(own).beam_share_for(&rbg), 0.1);
     // geometric instances keep the default plan
     let kv: BTreeMap<String, String> = [("n", "30"), ("modes", "2"), ("reversible", "true")]
         .into_iter()

@@ -17,7 +17,12 @@
 //!    went from 1210.5 to 1172; notes/sopq5.md). On other matrix instances whose
 //!    precedence closure is sparser than `dense-density` (0.8) the default is `sparse-plan`:
 //!    a shorter `local-search`, the colony run backwards, and a wider acceptance band for
-//!    the last `ils` (see [`SPARSE_PLAN`]).
+//!    the last `ils` (see [`SPARSE_PLAN`]). On the other matrix instances (dense
+//!    precedence) of at most `dense-beam-max-cells` (300) cells the beam gets
+//!    `dense-beam-share` (50 %): there its wider passes find what the plan misses (PCGTSPLIB
+//!    rbg174a: 1641, the proven optimum, on 13 of 13 seeds at 10 s, against 1642–1643 with
+//!    10 %; notes/sopq8.md). On larger dense instances (rbg323a–rbg378a) the passes
+//!    do not finish and the time is better spent on the plan.
 //!
 //! Plan syntax: `solver[key=value;...]:share`, with `*` after the name to start from the
 //! best sequence so far, `+` to start from the sequence of the phase just before, and `~`
@@ -101,6 +106,18 @@ pub static INFO: SolverInfo = SolverInfo {
             help: "matrix instances with a precedence closure density (pairs ordered over n(n-1)/2) below this get sparse-plan",
         },
         ParamSpec {
+            name: "dense-beam-share",
+            default: "0.5",
+            kind: ParamKind::Float,
+            help: "share of the budget given to the beam phase on asymmetric matrix instances whose precedence closure is at least dense-density and that have at most dense-beam-max-cells cells (with the default plan)",
+        },
+        ParamSpec {
+            name: "dense-beam-max-cells",
+            default: "300",
+            kind: ParamKind::Int,
+            help: "dense matrix instances with more cells keep beam-share: there the beam's wider passes do not finish in a useful time",
+        },
+        ParamSpec {
             name: "plan",
             default: PLAN,
             kind: ParamKind::Text,
@@ -118,6 +135,8 @@ pub static INFO: SolverInfo = SolverInfo {
             symmetric_beam_plan: p.word("symmetric-beam-plan").to_string(),
             sparse_plan: p.word("sparse-plan").to_string(),
             dense_density: p.float("dense-density"),
+            dense_beam_share: p.float("dense-beam-share").clamp(0.0, 1.0),
+            dense_beam_max_cells: p.int("dense-beam-max-cells") as usize,
             beam_min_seconds: p.float("beam-min-seconds").max(0.0),
         })
     },
@@ -145,6 +164,11 @@ pub struct Auto {
     pub sparse_plan: String,
     /// Precedence closure density at and above which a matrix instance counts as dense.
     pub dense_density: f64,
+    /// Share of the budget for the beam phase on dense matrix instances of at most
+    /// `dense_beam_max_cells` cells.
+    pub dense_beam_share: f64,
+    /// Largest dense matrix instance that gets `dense_beam_share`.
+    pub dense_beam_max_cells: usize,
 }
 
 /// Default phases after the beam.
@@ -290,6 +314,9 @@ pub enum Case {
     Symmetric,
     /// Asymmetric matrix costs with sparse precedence: `sparse-plan` and `beam-share`.
     Sparse,
+    /// Asymmetric matrix costs with dense precedence: `plan`, and `dense-beam-share` up to
+    /// `dense-beam-max-cells` cells (`beam-share` above).
+    Dense,
 }
 
 /// The seed of a plan phase: the run's own seed for the first phase of each solver, so
@@ -375,7 +402,7 @@ impl Auto {
     /// the sparse one, else `plan`.
     fn plan_in(&self, case: Case, after_beam: bool) -> &str {
         match (case, after_beam) {
-            (Case::Default, _) => &self.plan,
+            (Case::Default | Case::Dense, _) => &self.plan,
             (Case::Symmetric, false) => &self.symmetric_plan,
             (Case::Symmetric, true) => &self.symmetric_beam_plan,
             (Case::Sparse, _) => &self.sparse_plan,
@@ -384,7 +411,7 @@ impl Auto {
 
     /// The beam phase's share of the budget for model `m`.
     pub fn beam_share_for(&self, m: &CostModel) -> f64 {
-        self.beam_share_when(self.case(m))
+        self.beam_share_when(self.case(m), m.n())
     }
 
     /// Every plan: `plan`, `symmetric_plan`, `symmetric_beam_plan` and `sparse_plan`.
@@ -397,10 +424,11 @@ impl Auto {
         ]
     }
 
-    /// The beam share in `case`.
-    fn beam_share_when(&self, case: Case) -> f64 {
+    /// The beam share in `case` on an instance of `n` cells.
+    fn beam_share_when(&self, case: Case, n: usize) -> f64 {
         match case {
             Case::Symmetric => self.symmetric_beam_share,
+            Case::Dense if n <= self.dense_beam_max_cells => self.dense_beam_share,
             _ => self.beam_share,
         }
     }
@@ -417,7 +445,7 @@ impl Auto {
         } else if closure_density(&m.dag) < self.dense_density {
             Case::Sparse
         } else {
-            Case::Default
+            Case::Dense
         }
     }
 }
@@ -442,7 +470,7 @@ impl Solver for Auto {
         let short = budget
             .time_limit
             .is_some_and(|t| t.as_secs_f64() < self.beam_min_seconds);
-        let beam_share = self.beam_share_when(case);
+        let beam_share = self.beam_share_when(case, ctx.model.n());
         let mut after_beam = false;
         if ctx.model.n() <= self.beam_max_cells && beam_share > 0.0 && !short {
             let b = share(budget, 0, 0.0, beam_share);
