@@ -515,3 +515,92 @@ proptest! {
         }
     }
 }
+
+/// Brute force: the cheapest cost of `s` with the cells at positions `lo..=hi` put in the
+/// order `cells` and their modes chosen freely (every combination), everything else kept.
+fn best_over_modes(c: &Costs, s: &Solution, lo: usize, cells: &[u32]) -> f64 {
+    let m = c.m;
+    let mut t = s.clone();
+    t.order[lo..lo + cells.len()].copy_from_slice(cells);
+    for (p, &x) in t.order.iter().enumerate() {
+        t.pos[x as usize] = p as u32;
+    }
+    let mut best = f64::INFINITY;
+    let mut digits = vec![0usize; cells.len()];
+    loop {
+        for (k, &x) in cells.iter().enumerate() {
+            t.mode[x as usize] = digits[k] as u32;
+        }
+        best = best.min(t.evaluate(c));
+        // next combination of modes
+        let mut k = 0;
+        loop {
+            if k == cells.len() {
+                return best;
+            }
+            digits[k] += 1;
+            if digits[k] < m.modes(cells[k] as usize) {
+                break;
+            }
+            digits[k] = 0;
+            k += 1;
+        }
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(24))]
+    /// Window moves with modes keep the cached cost exact, never make a sequence worse,
+    /// keep precedence (the checker agrees), and stop where no single-cell move inside a
+    /// window, with every mode of the window and its two neighbours chosen by brute force,
+    /// is cheaper.
+    #[test]
+    fn window_moves_with_modes_reach_their_local_optimum(seed in 0u64..1000, n in 2usize..14, modes in 1usize..4,
+                              tools in 1usize..3, density in prop_oneof![Just(0.0), 0.05f64..0.5],
+                              shuffle in prop::collection::vec(any::<u64>(), 30)) {
+        use cellseq::engine::window::ModeWindow;
+        use cellseq::solvers::{Budget, Context, NoObserver};
+        let inst = instance(seed, n, modes, tools, density, true, false);
+        let m = CostModel::new(&inst, inst.default_objective());
+        let c = Costs::open(&m);
+        let mut s = Solution::new(&c, &shuffled_feasible(&m, &shuffle));
+        let start = s.cost;
+        let params = cellseq::params::Params::new("t", &[], &BTreeMap::new()).unwrap();
+        let mut obs = NoObserver;
+        let budget = Budget { max_evals: Some(50_000_000), ..Budget::default() };
+        let mut ctx = Context::new(&inst, &m, &params, 1, budget, &mut obs);
+        let w = 4;
+        let mut mw = ModeWindow::new(w);
+        mw.improve(&c, &mut s, &mut ctx, None);
+        prop_assert!(!ctx.exhausted());
+        prop_assert!(close(s.cost, s.evaluate(&c)), "tracked {} vs evaluated {}", s.cost, s.evaluate(&c));
+        prop_assert!(s.cost <= start + 1e-9 * start.abs().max(1.0));
+        well_formed(&m, &s)?;
+        let r = cellseq::check(&inst, &s.sequence(), inst.default_objective()).unwrap();
+        prop_assert!(close(r.cost, s.cost + m.constant()));
+        // local optimum against brute force over every window's feasible single-cell moves
+        let w = w.min(n);
+        for i in 0..=n - w {
+            let lo = i.saturating_sub(1);
+            let hi = (i + w).min(n - 1);
+            for a in i..i + w {
+                for b in i..i + w {
+                    let mut cells = s.order[lo..=hi].to_vec();
+                    let x = cells.remove(a - lo);
+                    cells.insert(b - lo, x);
+                    let mut t = s.clone();
+                    t.order[lo..=hi].copy_from_slice(&cells);
+                    for (p, &y) in t.order.iter().enumerate() {
+                        t.pos[y as usize] = p as u32;
+                    }
+                    if !t.feasible(&m) {
+                        continue;
+                    }
+                    let v = best_over_modes(&c, &s, lo, &cells);
+                    prop_assert!(v >= s.cost - 1e-7 * s.cost.abs().max(1.0),
+                                 "window {} move {}->{}: {} < {}", i, a, b, v, s.cost);
+                }
+            }
+        }
+    }
+}

@@ -21,6 +21,7 @@ pub mod search;
 pub mod solution;
 pub mod sop3x;
 pub mod twolevel;
+pub mod window;
 
 pub use neighbours::Neighbours;
 pub use solution::Solution;

@@ -5,6 +5,7 @@ use super::moves::{
     LAZY_REACH_CELLS, Reversal, SegmentMove, apply_segment, mode_delta, reversible_segment, window,
 };
 use super::sop3x::{Labels, forward};
+use super::window::ModeWindow;
 use super::{Costs, Neighbours, Solution};
 use crate::solvers::Context;
 use std::collections::VecDeque;
@@ -65,9 +66,14 @@ pub struct Search<'a> {
     pub nb: Neighbours,
     /// Longest block considered by SOP-3-exchange (each side).
     pub max_block: usize,
+    /// Window moves with modes (cells with several modes only; `w = 0` elsewhere).
+    pub mode_window: ModeWindow,
     labels: Labels,
     rev: Reversal,
 }
+
+/// Window length of [`ModeWindow`] moves on instances with several modes per cell.
+pub const MODE_WINDOW: usize = 5;
 
 impl<'a> Search<'a> {
     /// An engine with `k` neighbours per cell.
@@ -83,6 +89,13 @@ impl<'a> Search<'a> {
             } else {
                 8
             },
+            mode_window: ModeWindow::new(
+                if n <= LAZY_REACH_CELLS && (0..n).any(|x| c.m.modes(x) > 1) {
+                    MODE_WINDOW
+                } else {
+                    0
+                },
+            ),
             labels: Labels::default(),
             rev: Reversal::default(),
         }
@@ -300,8 +313,15 @@ impl<'a> Search<'a> {
         improves(s.cost - before, before)
     }
 
+    /// Window moves with modes ([`ModeWindow`]) over every window, or over those that hold
+    /// a cell of `seeds`. Returns true on improvement.
+    pub fn windows(&mut self, s: &mut Solution, ctx: &mut Context, seeds: Option<&[u32]>) -> bool {
+        let c = self.c;
+        self.mode_window.improve(&c, s, ctx, seeds)
+    }
+
     /// Variable neighbourhood descent: Or-opt, 2-opt, mode change, SOP-3-exchange, mode DP,
-    /// restarting from the first neighbourhood after every improvement.
+    /// window moves with modes (several modes per cell, up to 5000 cells), restarting from the first neighbourhood after every improvement.
     pub fn vnd(&mut self, s: &mut Solution, ctx: &mut Context) {
         loop {
             if ctx.exhausted() {
@@ -313,7 +333,7 @@ impl<'a> Search<'a> {
             if self.sop3(s, ctx) {
                 continue;
             }
-            if !self.modes(s, ctx) {
+            if !self.modes(s, ctx) && !self.windows(s, ctx, None) {
                 return;
             }
         }

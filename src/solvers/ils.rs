@@ -128,6 +128,12 @@ pub static INFO: SolverInfo = SolverInfo {
             help: "partition crossover of every repaired kick with the best (engine::crossover): segments that hold the same cells in both are taken from the cheaper one",
         },
         ParamSpec {
+            name: "window-repair",
+            default: "false",
+            kind: ParamKind::Bool,
+            help: "on instances with several modes per cell, the repair of every kick also runs window moves with modes (engine::window) over the cells the kick disturbed; the polish of a new best always runs them",
+        },
+        ParamSpec {
             name: "stall",
             default: "20000",
             kind: ParamKind::Int,
@@ -161,6 +167,7 @@ pub fn from_params(p: &Params) -> Ils {
         lk_penalty: p.float("lk-penalty").max(0.0),
         lk_max_viol: p.int("lk-max-viol") as u32,
         cross: p.bool("cross"),
+        window_repair: p.bool("window-repair"),
     }
 }
 
@@ -200,6 +207,8 @@ pub struct Ils {
     pub lk_max_viol: u32,
     /// Partition crossover of every repaired kick with the best.
     pub cross: bool,
+    /// Window moves with modes in the repair of every kick.
+    pub window_repair: bool,
 }
 
 /// The kick of [`Ils`].
@@ -447,6 +456,9 @@ impl Ils {
             }
             if multimode {
                 search.modes(&mut trial, ctx);
+                if self.window_repair {
+                    search.windows(&mut trial, ctx, Some(&seeds));
+                }
             }
             since_best += 1;
             since_restart += 1;
