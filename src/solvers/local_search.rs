@@ -1,7 +1,8 @@
 //! `local-search`: greedy start (or the greedy matching start where it applies and is
 //! cheaper, see [`super::edge`]), on large instances without precedence a first Or-opt pass
 //! on a linked list (O(1) moves), then variable neighbourhood descent over every move of the
-//! engine (Or-opt, 2-opt with mode flip, single-cell mode change, SOP-3-exchange, mode DP).
+//! engine (Or-opt, 2-opt with mode flip, single-cell mode change, SOP-3-exchange, mode DP,
+//! and window moves with modes where cells have several).
 //! After the first descent it iterates: kick the best with a few random feasible Or-opt moves,
 //! descend again, keep the result when better (until the budget, or `kicks` failures in a row).
 //!
@@ -23,7 +24,7 @@ use rand_chacha::ChaCha8Rng;
 /// Registry entry.
 pub static INFO: SolverInfo = SolverInfo {
     name: "local-search",
-    summary: "greedy, then (iterated) VND over Or-opt, 2-opt with mode flip, mode change, SOP-3-exchange and the mode DP",
+    summary: "greedy, then (iterated) VND over Or-opt, 2-opt with mode flip, mode change, SOP-3-exchange, the mode DP and (several modes per cell) window moves with modes",
     params: &[
         ParamSpec {
             name: "k",
