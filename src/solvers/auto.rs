@@ -338,18 +338,35 @@ fn share(b: Budget, used_evals: u64, used_s: f64, frac: f64) -> Budget {
     }
 }
 
+/// One phase as it runs: what [`Phase`] says, resolved against the run so far.
+struct Run<'p> {
+    /// Solver name.
+    name: &'p str,
+    /// The phase's own solver parameters.
+    given: &'p BTreeMap<String, String>,
+    /// Its share of the budget.
+    budget: Budget,
+    /// Where it starts ([`Start::Fresh`] for the beam).
+    from: Start,
+    /// The sequence it starts from (`None` with [`Start::Fresh`]).
+    start: Option<&'p Outcome>,
+    /// How often the solver ran before in the plan (its seed's repeat index).
+    repeat: u64,
+    /// The backwards twin it runs on (`~`), if any.
+    twin: Option<&'p (Instance, CostModel)>,
+}
+
 impl Auto {
-    #[allow(clippy::too_many_arguments)]
-    fn phase(
-        &self,
-        ctx: &mut Context,
-        name: &str,
-        given: &BTreeMap<String, String>,
-        budget: Budget,
-        start: Option<&Outcome>,
-        repeat: u64,
-        twin: Option<&(Instance, CostModel)>,
-    ) -> Result<Outcome> {
+    fn phase(&self, ctx: &mut Context, run: Run) -> Result<Outcome> {
+        let Run {
+            name,
+            given,
+            budget,
+            from,
+            start,
+            repeat,
+            twin,
+        } = run;
         let info = super::find(name)?;
         let params = Params::new(name, info.params, given)?;
         let solver = (info.make)(&params);
@@ -383,7 +400,11 @@ impl Auto {
             eprintln!(
                 "auto: {}{name}{} cost {} after {} evaluations, {:.2} s",
                 if twin.is_some() { "~" } else { "" },
-                if start.is_some() { "*" } else { "" },
+                match (from, start.is_some()) {
+                    (Start::Best, true) => "*",
+                    (Start::Previous, true) => "+",
+                    _ => "",
+                },
                 out.cost,
                 ctx.evaluations(),
                 ctx.elapsed()
@@ -474,7 +495,16 @@ impl Solver for Auto {
         let mut after_beam = false;
         if ctx.model.n() <= self.beam_max_cells && beam_share > 0.0 && !short {
             let b = share(budget, 0, 0.0, beam_share);
-            if let Ok(o) = self.phase(ctx, "beam", &BTreeMap::new(), b, None, 0, None) {
+            let beam = Run {
+                name: "beam",
+                given: &BTreeMap::new(),
+                budget: b,
+                from: Start::Fresh,
+                start: None,
+                repeat: 0,
+                twin: None,
+            };
+            if let Ok(o) = self.phase(ctx, beam) {
                 if o.proven_optimal {
                     return Ok(o);
                 }
@@ -502,7 +532,16 @@ impl Solver for Auto {
             // how often this solver ran before in the plan: its seed's repeat index
             let repeat = plan[..i].iter().filter(|p| p.solver == ph.solver).count() as u64;
             let on = if ph.reversed { twin.as_ref() } else { None };
-            let o = self.phase(ctx, &ph.solver, &ph.params, b, start, repeat, on)?;
+            let run = Run {
+                name: &ph.solver,
+                given: &ph.params,
+                budget: b,
+                from: ph.start,
+                start,
+                repeat,
+                twin: on,
+            };
+            let o = self.phase(ctx, run)?;
             keep(&mut best, o.clone());
             last = Some(o);
         }
