@@ -321,7 +321,8 @@ impl<'a> Search<'a> {
     }
 
     /// Variable neighbourhood descent: Or-opt, 2-opt, mode change, SOP-3-exchange, mode DP,
-    /// window moves with modes (several modes per cell, up to 5000 cells), restarting from the first neighbourhood after every improvement.
+    /// window moves with modes (several modes per cell, up to 5000 cells), restarting from
+    /// the first neighbourhood after every improvement.
     pub fn vnd(&mut self, s: &mut Solution, ctx: &mut Context) {
         loop {
             if ctx.exhausted() {

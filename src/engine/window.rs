@@ -11,6 +11,7 @@
 //! `w + 2` layers of modes between the fixed slots outside: O(w³·k²) per window for `k`
 //! modes per cell.
 
+use super::modes::ModeLayers;
 use super::moves::window;
 use super::search::improves;
 use super::{Costs, Slot, Solution};
@@ -24,9 +25,7 @@ pub struct ModeWindow {
     trial: Vec<u32>,
     best_cells: Vec<u32>,
     best_modes: Vec<u32>,
-    dist: Vec<f64>,
-    next: Vec<f64>,
-    back: Vec<Vec<u32>>,
+    layers: ModeLayers,
     starts: Vec<usize>,
 }
 
@@ -99,7 +98,6 @@ impl ModeWindow {
             .sum();
         let mut best = current;
         let mut found = false;
-        self.best_cells.clear();
         // the order as it is (modes only), then each single-cell move a -> b in the window
         for a in i..i + w {
             let (plo, phi) = window(c.m, s, a, 1);
@@ -148,75 +146,27 @@ impl ModeWindow {
     }
 
     /// Cost of the trial cells between the fixed slots `left` and `right` with the best
-    /// modes (layered shortest path; back-pointers kept for [`Self::trace_modes`]). Gives
-    /// up (infinity) once every partial path costs `cap` or more.
+    /// modes, and the arc evaluations made: infinity once every partial path costs `cap`
+    /// or more.
     fn dp(&mut self, c: &Costs, left: Slot, right: Slot, cap: f64) -> (f64, u64) {
-        let m = c.m;
-        let len = self.trial.len();
-        let mut evals = 0u64;
-        if self.back.len() < len {
-            self.back.resize_with(len, Vec::new);
-        }
         let first = self.trial[0] as usize;
-        self.dist.clear();
-        self.dist
-            .extend((0..m.modes(first)).map(|k| c.link(left, Some((first, k)))));
-        evals += self.dist.len() as u64;
-        for p in 1..len {
-            let (a, b) = (self.trial[p - 1] as usize, self.trial[p] as usize);
-            let kb = m.modes(b);
-            self.next.clear();
-            self.next.resize(kb, f64::INFINITY);
-            let bp = &mut self.back[p];
-            bp.clear();
-            bp.resize(kb, 0);
-            let mut low = f64::INFINITY;
-            for mb in 0..kb {
-                for (ma, &d) in self.dist.iter().enumerate() {
-                    let v = d + c.link(Some((a, ma)), Some((b, mb)));
-                    if v < self.next[mb] {
-                        self.next[mb] = v;
-                        bp[mb] = ma as u32;
-                    }
-                }
-                low = low.min(self.next[mb]);
-            }
-            evals += (self.dist.len() * kb) as u64;
-            std::mem::swap(&mut self.dist, &mut self.next);
-            if low >= cap {
-                return (f64::INFINITY, evals);
-            }
+        let (inner, complete) = self.layers.run(c, &self.trial, left, cap);
+        let evals = c.m.modes(first) as u64 + inner;
+        if !complete {
+            return (f64::INFINITY, evals);
         }
-        let last = self.trial[len - 1] as usize;
-        let v = self
-            .dist
-            .iter()
-            .enumerate()
-            .map(|(k, &d)| d + c.link(Some((last, k)), right))
-            .fold(f64::INFINITY, f64::min);
-        (v, evals + self.dist.len() as u64)
+        let last = self.trial[self.trial.len() - 1] as usize;
+        let (v, _) = self.layers.close(c, last, right);
+        (v, evals + self.layers.last_modes() as u64)
     }
 
     /// The modes of the last [`Self::dp`]'s best path into `best_modes`.
     fn trace_modes(&mut self, c: &Costs, right: Slot) {
         let len = self.trial.len();
-        let last = self.trial[len - 1] as usize;
-        let mut k = 0usize;
-        let mut bv = f64::INFINITY;
-        for (mk, &d) in self.dist.iter().enumerate() {
-            let v = d + c.link(Some((last, mk)), right);
-            if v < bv {
-                bv = v;
-                k = mk;
-            }
-        }
+        let (_, k) = self.layers.close(c, self.trial[len - 1] as usize, right);
         self.best_modes.clear();
         self.best_modes.resize(len, 0);
-        for p in (0..len).rev() {
-            self.best_modes[p] = k as u32;
-            if p > 0 {
-                k = self.back[p][k] as usize;
-            }
-        }
+        let modes = &mut self.best_modes;
+        self.layers.trace(len, k, |p, m| modes[p] = m);
     }
 }
