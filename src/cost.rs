@@ -243,6 +243,12 @@ impl CostModel {
     pub fn nodes(&self) -> usize {
         *self.offsets.last().unwrap_or(&0) as usize
     }
+    /// Some cell has more than one mode (every cell has at least one: validation refuses
+    /// a cell without modes, so this is "more nodes than cells", O(1)).
+    #[inline]
+    pub fn multimode(&self) -> bool {
+        self.nodes() > self.n()
+    }
     /// Number of modes of a cell.
     #[inline]
     pub fn modes(&self, cell: usize) -> usize {

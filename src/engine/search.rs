@@ -89,13 +89,11 @@ impl<'a> Search<'a> {
             } else {
                 8
             },
-            mode_window: ModeWindow::new(
-                if n <= LAZY_REACH_CELLS && (0..n).any(|x| c.m.modes(x) > 1) {
-                    MODE_WINDOW
-                } else {
-                    0
-                },
-            ),
+            mode_window: ModeWindow::new(if n <= LAZY_REACH_CELLS && c.m.multimode() {
+                MODE_WINDOW
+            } else {
+                0
+            }),
             labels: Labels::default(),
             rev: Reversal::default(),
         }

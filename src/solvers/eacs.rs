@@ -359,7 +359,7 @@ impl Eacs {
         if n < 3 {
             return Ok(outcome(m, &best));
         }
-        let multimode = (0..n).any(|x| m.modes(x) > 1);
+        let multimode = m.multimode();
         let mut rng = ChaCha8Rng::seed_from_u64(ctx.seed ^ 0xeac5);
         let scale = best.cost.abs().max(1e-9);
         let tau0 = 1.0 / (n as f64 * scale);

@@ -385,7 +385,7 @@ impl Ils {
         }
         let mut best = cur.clone();
         ctx.report(best.cost + m.constant());
-        let multimode = (0..n).any(|x| m.modes(x) > 1);
+        let multimode = m.multimode();
         let max_seg = if self.max_seg > 0 {
             self.max_seg
         } else {

@@ -140,7 +140,7 @@ impl Anneal {
             return;
         }
         let m = c.m;
-        let multi = (0..n).any(|x| m.modes(x) > 1);
+        let multi = m.multimode();
         // initial temperature from the median of sampled worsening moves (robust to the huge
         // "forbidden" arc costs of some matrix instances)
         let mut ups: Vec<f64> = Vec::new();
