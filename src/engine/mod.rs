@@ -18,6 +18,7 @@ pub mod neighbours;
 pub mod order;
 pub mod ruin;
 pub mod search;
+pub mod shift;
 pub mod solution;
 pub mod sop3x;
 pub mod twolevel;

@@ -20,6 +20,7 @@ use crate::engine::lk::Lk;
 use crate::engine::moves::sop3_delta;
 use crate::engine::ruin::Ruin;
 use crate::engine::search::Search;
+use crate::engine::shift::ShiftDp;
 use crate::engine::sop3x::{TwoWay, sop3_two_way};
 use crate::engine::{Costs, Solution};
 use crate::error::Result;
@@ -134,6 +135,12 @@ pub static INFO: SolverInfo = SolverInfo {
             help: "on instances with several modes per cell, the repair of every kick also runs window moves with modes (engine::window) over the cells the kick disturbed; the polish of a new best always runs them",
         },
         ParamSpec {
+            name: "shift-repair",
+            default: "0",
+            kind: ParamKind::Int,
+            help: "every kick's repair ends with the bounded-shift DP (engine::shift, Balas-Simonetti: the best reorder of the kicked span, with modes, in which no cell passes one that lay this many places or more after it) over the kicked span and this many cells either side (0: off)",
+        },
+        ParamSpec {
             name: "stall",
             default: "20000",
             kind: ParamKind::Int,
@@ -168,6 +175,7 @@ pub fn from_params(p: &Params) -> Ils {
         lk_max_viol: p.int("lk-max-viol") as u32,
         cross: p.bool("cross"),
         window_repair: p.bool("window-repair"),
+        shift_repair: p.int("shift-repair") as usize,
     }
 }
 
@@ -209,6 +217,8 @@ pub struct Ils {
     pub cross: bool,
     /// Window moves with modes in the repair of every kick.
     pub window_repair: bool,
+    /// Largest shift of the bounded-shift DP in every kick's repair (0: off).
+    pub shift_repair: usize,
 }
 
 /// The kick of [`Ils`].
@@ -405,6 +415,8 @@ impl Ils {
         let mut px = Crossover::default();
         let mut crosses = 0u64;
         let mut kicks_done = 0u64;
+        let mut shift_repair = ShiftDp::new(self.shift_repair.max(2), 200_000);
+        let mut shift_gains = 0u64;
         while !ctx.exhausted() {
             if !bounded && since_best >= self.stall {
                 break;
@@ -454,6 +466,18 @@ impl Ils {
                     break;
                 }
             }
+            if self.shift_repair > 0 && !seeds.is_empty() {
+                let k = self.shift_repair;
+                let (mut lo, mut hi) = (usize::MAX, 0usize);
+                for &x in &seeds {
+                    let p = trial.pos[x as usize] as usize;
+                    lo = lo.min(p);
+                    hi = hi.max(p);
+                }
+                let lo = lo.saturating_sub(k);
+                let hi = (hi + k + 1).min(n);
+                shift_gains += shift_repair.improve_range(&c, &mut trial, ctx, lo, hi) as u64;
+            }
             if multimode {
                 search.modes(&mut trial, ctx);
                 if self.window_repair {
@@ -494,7 +518,9 @@ impl Ils {
             }
         }
         if super::trace_enabled() {
-            eprintln!("ils: {kicks_done} kicks, {crosses} crossovers gave a new best");
+            eprintln!(
+                "ils: {kicks_done} kicks, {crosses} crossovers gave a new best, {shift_gains} repairs improved by the shift DP"
+            );
         }
         Ok(outcome(m, &best))
     }
