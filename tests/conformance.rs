@@ -58,6 +58,7 @@ const IMPROVERS: &[&str] = &[
     "aco",
     "eacs",
     "ils",
+    "reopt",
 ];
 
 fn budget(evals: u64) -> Budget {

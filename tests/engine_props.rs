@@ -604,3 +604,136 @@ proptest! {
         }
     }
 }
+
+/// Every permutation of `cells` (Heap's algorithm), passed to `f`.
+fn permutations(cells: &[u32], f: &mut impl FnMut(&[u32])) {
+    fn go(k: usize, a: &mut Vec<u32>, f: &mut impl FnMut(&[u32])) {
+        if k <= 1 {
+            f(a);
+            return;
+        }
+        for i in 0..k {
+            go(k - 1, a, f);
+            let j = if k.is_multiple_of(2) { i } else { 0 };
+            a.swap(j, k - 1);
+        }
+    }
+    let mut a = cells.to_vec();
+    go(a.len(), &mut a, f);
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(40))]
+    /// The bounded-shift DP keeps the cached cost exact and precedence intact, and finds the
+    /// cheapest reorder of its window (with the best modes) among those in which no cell
+    /// passes a cell that lay `k` or more places after it: brute force over every such
+    /// permutation and every mode combination agrees.
+    #[test]
+    fn shift_dp_is_exact_over_its_neighbourhood(seed in 0u64..1000, n in 2usize..10, modes in 1usize..4,
+                              tools in 1usize..3, density in prop_oneof![Just(0.0), 0.05f64..0.5],
+                              k in 2usize..6, a in any::<u64>(), len in 2usize..7,
+                              shuffle in prop::collection::vec(any::<u64>(), 30)) {
+        use cellseq::engine::shift::ShiftDp;
+        use cellseq::solvers::{Budget, Context, NoObserver};
+        let inst = instance(seed, n, modes, tools, density, true, false);
+        let m = CostModel::new(&inst, inst.default_objective());
+        let c = Costs::open(&m);
+        let mut s = Solution::new(&c, &shuffled_feasible(&m, &shuffle));
+        let len = len.min(n);
+        let lo = (a % (n - len + 1) as u64) as usize;
+        let hi = lo + len;
+        // brute force first, on the sequence as it is
+        let cells = s.order[lo..hi].to_vec();
+        let mut brute = f64::INFINITY;
+        permutations(&cells, &mut |perm| {
+            let mut t = s.clone();
+            t.order[lo..hi].copy_from_slice(perm);
+            for (p, &y) in t.order.iter().enumerate() {
+                t.pos[y as usize] = p as u32;
+            }
+            if !t.feasible(&m) {
+                return;
+            }
+            for i in 0..len {
+                for j in i + k..len {
+                    if t.pos[cells[i] as usize] > t.pos[cells[j] as usize] {
+                        return;
+                    }
+                }
+            }
+            brute = brute.min(best_over_modes(&c, &s, lo, perm));
+        });
+        let start = s.cost;
+        let params = cellseq::params::Params::new("t", &[], &BTreeMap::new()).unwrap();
+        let mut obs = NoObserver;
+        let budget = Budget { max_evals: Some(50_000_000), ..Budget::default() };
+        let mut ctx = Context::new(&inst, &m, &params, 1, budget, &mut obs);
+        let mut dp = ShiftDp::new(k, 1_000_000);
+        let improved = dp.improve_range(&c, &mut s, &mut ctx, lo, hi);
+        prop_assert!(close(s.cost, s.evaluate(&c)), "tracked {} vs evaluated {}", s.cost, s.evaluate(&c));
+        well_formed(&m, &s)?;
+        prop_assert!(s.feasible(&m));
+        let r = cellseq::check(&inst, &s.sequence(), inst.default_objective()).unwrap();
+        prop_assert!(close(r.cost, s.cost + m.constant()));
+        prop_assert!(close(s.cost, brute.min(start)), "dp {} brute {} start {}", s.cost, brute, start);
+        prop_assert_eq!(improved, s.cost < start - 1e-9 * start.abs().max(1.0));
+        prop_assert_eq!(&s.order[..lo], &shuffled_order(&m, &shuffle)[..lo]);
+    }
+}
+
+fn shuffled_order(m: &CostModel, shuffle: &[u64]) -> Vec<u32> {
+    shuffled_feasible(m, shuffle)
+        .iter()
+        .map(|v| v.cell as u32)
+        .collect()
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(24))]
+    /// Window re-optimization solves its window as an instance of its own: the result is
+    /// feasible, its cost exact, and the window's links cost what brute force over every
+    /// feasible order and every mode combination of the window's cells finds (the beam
+    /// proves windows this small), on open paths and on paths that return home.
+    #[test]
+    fn reopt_window_is_the_brute_force_optimum(seed in 0u64..1000, n in 2usize..10, modes in 1usize..4,
+                              tools in 1usize..3, density in prop_oneof![Just(0.0), 0.05f64..0.5],
+                              rh in any::<bool>(), a in any::<u64>(), len in 1usize..6,
+                              shuffle in prop::collection::vec(any::<u64>(), 30)) {
+        use cellseq::solvers::reopt::Reopt;
+        use cellseq::solvers::{Budget, Context, NoObserver};
+        let inst = instance(seed, n, modes, tools, density, true, rh);
+        let m = CostModel::new(&inst, inst.default_objective());
+        let c = Costs::open(&m);
+        let mut s = Solution::new(&c, &shuffled_feasible(&m, &shuffle));
+        let len = len.min(n);
+        let lo = (a % (n - len + 1) as u64) as usize;
+        let hi = lo + len;
+        let cells = s.order[lo..hi].to_vec();
+        let mut brute = f64::INFINITY;
+        permutations(&cells, &mut |perm| {
+            let mut t = s.clone();
+            t.order[lo..hi].copy_from_slice(perm);
+            for (p, &y) in t.order.iter().enumerate() {
+                t.pos[y as usize] = p as u32;
+            }
+            if t.feasible(&m) {
+                brute = brute.min(best_over_modes(&c, &s, lo, perm));
+            }
+        });
+        let start = s.cost;
+        let params = cellseq::params::Params::new("t", &[], &BTreeMap::new()).unwrap();
+        let mut obs = NoObserver;
+        let budget = Budget { max_evals: Some(500_000_000), ..Budget::default() };
+        let mut ctx = Context::new(&inst, &m, &params, 1, budget, &mut obs);
+        let r = Reopt { window: len, step: 0, window_share: 1.0, max_window: 200, k: 8 };
+        let (gain, proven) = r.window(&c, &mut s, &mut ctx, lo, hi).unwrap();
+        prop_assert!(proven);
+        prop_assert!(close(s.cost, s.evaluate(&c)), "tracked {} vs evaluated {}", s.cost, s.evaluate(&c));
+        well_formed(&m, &s)?;
+        prop_assert!(s.feasible(&m));
+        let rep = cellseq::check(&inst, &s.sequence(), inst.default_objective()).unwrap();
+        prop_assert!(close(rep.cost, s.cost + m.constant()));
+        prop_assert!(close(s.cost, brute.min(start)), "reopt {} brute {} start {}", s.cost, brute, start);
+        prop_assert_eq!(gain, s.cost < start - 1e-9 * start.abs().max(1.0));
+    }
+}

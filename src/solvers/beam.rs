@@ -117,23 +117,26 @@ pub static INFO: SolverInfo = SolverInfo {
             help: "evaluations of an `ils` run that gives the first incumbent (0 = none)",
         },
     ],
-    make: |p: &Params| {
-        Box::new(Beam {
-            max_width: p.int("max_width").max(1) as usize,
-            memory_mb: p.int("memory_mb"),
-            root_bound: p.bool("root_bound"),
-            refine: p.bool("refine"),
-            by_cost: p.word("guide") == "cost",
-            potentials: p.bool("potentials"),
-            warm_evals: p.int("warm_evals"),
-            qpath: p.bool("qpath"),
-            sec: p.bool("sec"),
-            growth: p.int("growth").max(2) as usize,
-            twins: p.bool("twins"),
-            exhaustive_from: p.int("exhaustive_from") as usize,
-        })
-    },
+    make: |p: &Params| Box::new(from_params(p)),
 };
+
+/// Builds the solver from validated parameters.
+pub fn from_params(p: &Params) -> Beam {
+    Beam {
+        max_width: p.int("max_width").max(1) as usize,
+        memory_mb: p.int("memory_mb"),
+        root_bound: p.bool("root_bound"),
+        refine: p.bool("refine"),
+        by_cost: p.word("guide") == "cost",
+        potentials: p.bool("potentials"),
+        warm_evals: p.int("warm_evals"),
+        qpath: p.bool("qpath"),
+        sec: p.bool("sec"),
+        growth: p.int("growth").max(2) as usize,
+        twins: p.bool("twins"),
+        exhaustive_from: p.int("exhaustive_from") as usize,
+    }
+}
 
 /// The iterative beam search solver.
 pub struct Beam {
@@ -171,13 +174,22 @@ pub const MAX_CELLS: usize = 1024;
 
 impl Solver for Beam {
     fn solve(&self, ctx: &mut Context) -> Result<Outcome> {
+        self.solve_from(ctx, None)
+    }
+}
+
+impl Beam {
+    /// The search with `incumbent` (a feasible sequence) as its first upper bound instead of
+    /// the `ils` warm start: the result is never worse than it.
+    pub fn solve_from(&self, ctx: &mut Context, incumbent: Option<Sequence>) -> Result<Outcome> {
         let n = ctx.model.n();
+        let inc = incumbent.map(|seq| (ctx.model.evaluate(&seq), seq));
         match n.div_ceil(64) {
-            0 | 1 => self.run::<1>(ctx),
-            2 => self.run::<2>(ctx),
-            3 | 4 => self.run::<4>(ctx),
-            5..=8 => self.run::<8>(ctx),
-            9..=16 => self.run::<16>(ctx),
+            0 | 1 => self.run::<1>(ctx, inc),
+            2 => self.run::<2>(ctx, inc),
+            3 | 4 => self.run::<4>(ctx, inc),
+            5..=8 => self.run::<8>(ctx, inc),
+            9..=16 => self.run::<16>(ctx, inc),
             _ => Err(Error::Solver {
                 solver: "beam".into(),
                 msg: format!("instance has {n} cells; beam accepts at most {MAX_CELLS}"),
@@ -531,13 +543,20 @@ fn tables(
 }
 
 impl Beam {
-    fn run<const W: usize>(&self, ctx: &mut Context) -> Result<Outcome> {
+    fn run<const W: usize>(
+        &self,
+        ctx: &mut Context,
+        incumbent: Option<(f64, Sequence)>,
+    ) -> Result<Outcome> {
         let m = ctx.model;
         let n = m.n();
         if n == 0 {
             return Ok(super::outcome_of(m, Vec::new()));
         }
-        let mut best: Option<(f64, Sequence)> = self.warm_start(ctx)?;
+        let mut best: Option<(f64, Sequence)> = match incumbent {
+            Some(inc) => Some(inc),
+            None => self.warm_start(ctx)?,
+        };
         if let Some((c, _)) = &best {
             ctx.report(*c);
         }

@@ -16,6 +16,7 @@ pub mod ils;
 pub mod insertion;
 pub mod local_search;
 pub mod process;
+pub mod reopt;
 pub mod rules;
 pub mod sa;
 pub mod start;
@@ -231,6 +232,7 @@ pub fn registry() -> Vec<&'static SolverInfo> {
         &ils::INFO,
         &exact::INFO,
         &beam::INFO,
+        &reopt::INFO,
         &two_opt::INFO,
         &local_search::INFO,
         &sa::INFO,
