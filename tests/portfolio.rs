@@ -168,7 +168,7 @@ fn ils_lin_kernighan_chains_help_on_a_symmetric_instance_and_stay_deterministic(
 fn auto_picks_its_plan_by_symmetry_and_precedence_density() {
     use cellseq::cost::CostModel;
     use cellseq::solvers::auto::{
-        Auto, Case, PLAN, SPARSE_PLAN, SYMMETRIC_BEAM_PLAN, SYMMETRIC_PLAN,
+        Auto, Case, LARGE_DENSE_PLAN, PLAN, SPARSE_PLAN, SYMMETRIC_BEAM_PLAN, SYMMETRIC_PLAN,
     };
     let auto = |plan: &str| Auto {
         seconds: 1.0,
@@ -183,6 +183,7 @@ fn auto_picks_its_plan_by_symmetry_and_precedence_density() {
         dense_density: 0.8,
         dense_beam_share: 0.5,
         dense_beam_max_cells: 300,
+        large_dense_plan: LARGE_DENSE_PLAN.to_string(),
     };
     let model = |name: &str| {
         let inst = sop(name);
@@ -208,7 +209,12 @@ fn auto_picks_its_plan_by_symmetry_and_precedence_density() {
         dense_beam_max_cells: 100,
         ..auto(PLAN)
     };
-    assert_eq!(small_cap.beam_share_for(&rbg), 0.1);
+    // larger dense instances: large-dense-plan (window re-optimization) and no beam phase
+    assert_eq!(small_cap.case(&rbg), Case::LargeDense);
+    assert_eq!(small_cap.beam_share_for(&rbg), 0.0);
+    for after_beam in [false, true] {
+        assert_eq!(small_cap.plan_for(&rbg, after_beam), LARGE_DENSE_PLAN);
+    }
     // a plan the user chose is kept, and so is the beam share
     let own = "local-search:0.5,ils*:1";
     for after_beam in [false, true] {
@@ -227,6 +233,7 @@ fn auto_picks_its_plan_by_symmetry_and_precedence_density() {
     assert!(parse_plan(SYMMETRIC_PLAN).is_ok());
     assert!(parse_plan(SYMMETRIC_BEAM_PLAN).is_ok());
     assert!(parse_plan(SPARSE_PLAN).is_ok());
+    assert!(parse_plan(LARGE_DENSE_PLAN).is_ok());
 }
 
 #[test]

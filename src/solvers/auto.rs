@@ -118,10 +118,16 @@ pub static INFO: SolverInfo = SolverInfo {
             help: "dense matrix instances with more cells keep beam-share: there the beam's wider passes do not finish in a useful time",
         },
         ParamSpec {
+            name: "large-dense-plan",
+            default: LARGE_DENSE_PLAN,
+            kind: ParamKind::Text,
+            help: "the phases used instead of the default plan, without a beam phase, on asymmetric matrix instances whose precedence closure is at least dense-density and that have more than dense-beam-max-cells cells; ignored when plan is given",
+        },
+        ParamSpec {
             name: "plan",
             default: PLAN,
             kind: ParamKind::Text,
-            help: "phases after the beam: solver[key=value;...]:share,... (share of what is left; optional parameters in brackets; a '*' after the name starts ils/eacs from the best so far, a '+' from the sequence of the phase before; a '~' before the name runs the phase on the matrix instance travelled backwards; a solver named twice gets a new seed each time)",
+            help: "phases after the beam: solver[key=value;...]:share,... (share of what is left; optional parameters in brackets; a '*' after the name starts ils, eacs or reopt from the best so far, a '+' from the sequence of the phase before; a '~' before the name runs the phase on the matrix instance travelled backwards; a solver named twice gets a new seed each time)",
         },
     ],
     make: |p: &Params| {
@@ -137,6 +143,7 @@ pub static INFO: SolverInfo = SolverInfo {
             dense_density: p.float("dense-density"),
             dense_beam_share: p.float("dense-beam-share").clamp(0.0, 1.0),
             dense_beam_max_cells: p.int("dense-beam-max-cells") as usize,
+            large_dense_plan: p.word("large-dense-plan").to_string(),
             beam_min_seconds: p.float("beam-min-seconds").max(0.0),
         })
     },
@@ -169,6 +176,8 @@ pub struct Auto {
     pub dense_beam_share: f64,
     /// Largest dense matrix instance that gets `dense_beam_share`.
     pub dense_beam_max_cells: usize,
+    /// Phases used instead of the default `plan` on larger dense matrix instances.
+    pub large_dense_plan: String,
 }
 
 /// Default phases after the beam.
@@ -198,16 +207,27 @@ pub const SYMMETRIC_BEAM_PLAN: &str = "ils*:1";
 /// the other end, the ants fall less often into the basin that holds forward colonies on
 /// kro124p.3 (10 s, seeds 1–10: 8 runs at the best known 49499 and 2 at 49519, against 6
 /// and 4 in the 50183–50207 basin; notes/sopq7.md).
-pub const SPARSE_PLAN: &str = "local-search:0.1,~eacs:0.5,ils[accept=0.03]*:1";
+pub const SPARSE_PLAN: &str = "local-search:0.1,~eacs:0.5,ils[accept=0.03;shift-repair=5]*:1";
+
+/// Default phases on asymmetric matrix instances with dense precedence and more than
+/// `dense-beam-max-cells` cells (TSPLIB rbg323a–rbg378a): a short `local-search`, `ils`
+/// from its sequence, then window re-optimization ([`super::reopt`]) of the best sequence
+/// by the exact tree search, with no beam phase (its passes over the whole instance do not
+/// finish there and never beat `ils`). On rbg323a the windows turn 3141 sequences of `ils`
+/// into the optimum 3140 (notes/sopq9.md).
+pub const LARGE_DENSE_PLAN: &str = "local-search:0.1,ils*:0.4,reopt*:1";
+
+/// The solvers a plan phase can start from an earlier sequence (`*`, `+`).
+pub const STARTABLE: [&str; 3] = ["ils", "eacs", "reopt"];
 
 /// Where a plan phase starts.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Start {
     /// From scratch (the solver's own construction).
     Fresh,
-    /// From the best sequence so far (`*` after the name; ils and eacs only).
+    /// From the best sequence so far (`*` after the name; ils, eacs and reopt only).
     Best,
-    /// From the sequence of the phase just before (`+`; ils and eacs only): polishes one
+    /// From the sequence of the phase just before (`+`; ils, eacs and reopt only): polishes one
     /// colony's result even when an earlier phase found a cheaper sequence.
     Previous,
 }
@@ -280,9 +300,9 @@ pub fn parse_plan(plan: &str) -> Result<Vec<Phase>> {
         let info = super::find(&solver)?;
         Params::new(&solver, info.params, &params)
             .map_err(|e| bad(format!("plan phase '{part}': {e}")))?;
-        if start != Start::Fresh && solver != "ils" && solver != "eacs" {
+        if start != Start::Fresh && !STARTABLE.contains(&solver.as_str()) {
             return Err(bad(format!(
-                "plan phase '{part}': only ils and eacs can start from an earlier sequence"
+                "plan phase '{part}': only ils, eacs and reopt can start from an earlier sequence"
             )));
         }
         if start == Start::Previous && out.is_empty() {
@@ -314,9 +334,12 @@ pub enum Case {
     Symmetric,
     /// Asymmetric matrix costs with sparse precedence: `sparse-plan` and `beam-share`.
     Sparse,
-    /// Asymmetric matrix costs with dense precedence: `plan`, and `dense-beam-share` up to
-    /// `dense-beam-max-cells` cells (`beam-share` above).
+    /// Asymmetric matrix costs with dense precedence, at most `dense-beam-max-cells` cells:
+    /// `plan` and `dense-beam-share`.
     Dense,
+    /// Asymmetric matrix costs with dense precedence, more than `dense-beam-max-cells`
+    /// cells: `large-dense-plan` and no beam phase.
+    LargeDense,
 }
 
 /// The seed of a plan phase: the run's own seed for the first phase of each solver, so
@@ -386,6 +409,7 @@ impl Auto {
                 let s = Solution::new(&Costs::open(model), &seq);
                 match name {
                     "ils" => super::ils::from_params(&params).run(&mut sub, Some(s))?,
+                    "reopt" => super::reopt::from_params(&params).run(&mut sub, Some(s))?,
                     _ => super::eacs::from_params(&params).run(&mut sub, Some(s))?,
                 }
             }
@@ -424,6 +448,7 @@ impl Auto {
     fn plan_in(&self, case: Case, after_beam: bool) -> &str {
         match (case, after_beam) {
             (Case::Default | Case::Dense, _) => &self.plan,
+            (Case::LargeDense, _) => &self.large_dense_plan,
             (Case::Symmetric, false) => &self.symmetric_plan,
             (Case::Symmetric, true) => &self.symmetric_beam_plan,
             (Case::Sparse, _) => &self.sparse_plan,
@@ -432,24 +457,27 @@ impl Auto {
 
     /// The beam phase's share of the budget for model `m`.
     pub fn beam_share_for(&self, m: &CostModel) -> f64 {
-        self.beam_share_when(self.case(m), m.n())
+        self.beam_share_when(self.case(m))
     }
 
-    /// Every plan: `plan`, `symmetric_plan`, `symmetric_beam_plan` and `sparse_plan`.
-    fn plans(&self) -> [&str; 4] {
+    /// Every plan: `plan`, `symmetric_plan`, `symmetric_beam_plan`, `sparse_plan` and
+    /// `large_dense_plan`.
+    fn plans(&self) -> [&str; 5] {
         [
             &self.plan,
             &self.symmetric_plan,
             &self.symmetric_beam_plan,
             &self.sparse_plan,
+            &self.large_dense_plan,
         ]
     }
 
-    /// The beam share in `case` on an instance of `n` cells.
-    fn beam_share_when(&self, case: Case, n: usize) -> f64 {
+    /// The beam share in `case`.
+    fn beam_share_when(&self, case: Case) -> f64 {
         match case {
             Case::Symmetric => self.symmetric_beam_share,
-            Case::Dense if n <= self.dense_beam_max_cells => self.dense_beam_share,
+            Case::Dense => self.dense_beam_share,
+            Case::LargeDense => 0.0,
             _ => self.beam_share,
         }
     }
@@ -465,8 +493,10 @@ impl Auto {
             Case::Symmetric
         } else if closure_density(&m.dag) < self.dense_density {
             Case::Sparse
-        } else {
+        } else if m.n() <= self.dense_beam_max_cells {
             Case::Dense
+        } else {
+            Case::LargeDense
         }
     }
 }
@@ -491,7 +521,7 @@ impl Solver for Auto {
         let short = budget
             .time_limit
             .is_some_and(|t| t.as_secs_f64() < self.beam_min_seconds);
-        let beam_share = self.beam_share_when(case, ctx.model.n());
+        let beam_share = self.beam_share_when(case);
         let mut after_beam = false;
         if ctx.model.n() <= self.beam_max_cells && beam_share > 0.0 && !short {
             let b = share(budget, 0, 0.0, beam_share);
