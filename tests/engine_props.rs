@@ -622,6 +622,62 @@ fn permutations(cells: &[u32], f: &mut impl FnMut(&[u32])) {
     go(a.len(), &mut a, f);
 }
 
+/// After a window search from cost `start`: `s` is well formed, feasible, its cached cost
+/// exact (the checker agrees), it costs the better of `start` and the brute-force optimum
+/// `brute`, and `improved` says whether it fell.
+fn window_result(
+    inst: &cellseq::model::Instance,
+    c: &Costs,
+    s: &Solution,
+    start: f64,
+    brute: f64,
+    improved: bool,
+) -> Result<(), TestCaseError> {
+    let m = c.m;
+    prop_assert!(
+        close(s.cost, s.evaluate(c)),
+        "tracked {} vs evaluated {}",
+        s.cost,
+        s.evaluate(c)
+    );
+    well_formed(m, s)?;
+    prop_assert!(s.feasible(m));
+    let r = cellseq::check(inst, &s.sequence(), inst.default_objective()).unwrap();
+    prop_assert!(close(r.cost, s.cost + m.constant()));
+    prop_assert!(
+        close(s.cost, brute.min(start)),
+        "search {} brute {} start {}",
+        s.cost,
+        brute,
+        start
+    );
+    prop_assert_eq!(improved, s.cost < start - 1e-9 * start.abs().max(1.0));
+    Ok(())
+}
+
+/// The cheapest cost of `s` over every order of its cells at positions `lo..hi` that keeps
+/// precedence and passes `allow`, with every mode combination of those cells.
+fn brute_window(
+    c: &Costs,
+    s: &Solution,
+    lo: usize,
+    hi: usize,
+    allow: impl Fn(&Solution) -> bool,
+) -> f64 {
+    let mut brute = f64::INFINITY;
+    permutations(&s.order[lo..hi], &mut |perm| {
+        let mut t = s.clone();
+        t.order[lo..hi].copy_from_slice(perm);
+        for (p, &y) in t.order.iter().enumerate() {
+            t.pos[y as usize] = p as u32;
+        }
+        if t.feasible(c.m) && allow(&t) {
+            brute = brute.min(best_over_modes(c, s, lo, perm));
+        }
+    });
+    brute
+}
+
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(40))]
     /// The bounded-shift DP keeps the cached cost exact and precedence intact, and finds the
@@ -644,24 +700,8 @@ proptest! {
         let hi = lo + len;
         // brute force first, on the sequence as it is
         let cells = s.order[lo..hi].to_vec();
-        let mut brute = f64::INFINITY;
-        permutations(&cells, &mut |perm| {
-            let mut t = s.clone();
-            t.order[lo..hi].copy_from_slice(perm);
-            for (p, &y) in t.order.iter().enumerate() {
-                t.pos[y as usize] = p as u32;
-            }
-            if !t.feasible(&m) {
-                return;
-            }
-            for i in 0..len {
-                for j in i + k..len {
-                    if t.pos[cells[i] as usize] > t.pos[cells[j] as usize] {
-                        return;
-                    }
-                }
-            }
-            brute = brute.min(best_over_modes(&c, &s, lo, perm));
+        let brute = brute_window(&c, &s, lo, hi, |t| {
+            (0..len).all(|i| (i + k..len).all(|j| t.pos[cells[i] as usize] < t.pos[cells[j] as usize]))
         });
         let start = s.cost;
         let params = cellseq::params::Params::new("t", &[], &BTreeMap::new()).unwrap();
@@ -670,13 +710,7 @@ proptest! {
         let mut ctx = Context::new(&inst, &m, &params, 1, budget, &mut obs);
         let mut dp = ShiftDp::new(k, 1_000_000);
         let improved = dp.improve_range(&c, &mut s, &mut ctx, lo, hi);
-        prop_assert!(close(s.cost, s.evaluate(&c)), "tracked {} vs evaluated {}", s.cost, s.evaluate(&c));
-        well_formed(&m, &s)?;
-        prop_assert!(s.feasible(&m));
-        let r = cellseq::check(&inst, &s.sequence(), inst.default_objective()).unwrap();
-        prop_assert!(close(r.cost, s.cost + m.constant()));
-        prop_assert!(close(s.cost, brute.min(start)), "dp {} brute {} start {}", s.cost, brute, start);
-        prop_assert_eq!(improved, s.cost < start - 1e-9 * start.abs().max(1.0));
+        window_result(&inst, &c, &s, start, brute, improved)?;
         prop_assert_eq!(&s.order[..lo], &shuffled_order(&m, &shuffle)[..lo]);
     }
 }
@@ -708,18 +742,7 @@ proptest! {
         let len = len.min(n);
         let lo = (a % (n - len + 1) as u64) as usize;
         let hi = lo + len;
-        let cells = s.order[lo..hi].to_vec();
-        let mut brute = f64::INFINITY;
-        permutations(&cells, &mut |perm| {
-            let mut t = s.clone();
-            t.order[lo..hi].copy_from_slice(perm);
-            for (p, &y) in t.order.iter().enumerate() {
-                t.pos[y as usize] = p as u32;
-            }
-            if t.feasible(&m) {
-                brute = brute.min(best_over_modes(&c, &s, lo, perm));
-            }
-        });
+        let brute = brute_window(&c, &s, lo, hi, |_| true);
         let start = s.cost;
         let params = cellseq::params::Params::new("t", &[], &BTreeMap::new()).unwrap();
         let mut obs = NoObserver;
@@ -728,12 +751,6 @@ proptest! {
         let r = Reopt { window: len, step: 0, window_share: 1.0, max_window: 200, k: 8 };
         let (gain, proven) = r.window(&c, &mut s, &mut ctx, lo, hi).unwrap();
         prop_assert!(proven);
-        prop_assert!(close(s.cost, s.evaluate(&c)), "tracked {} vs evaluated {}", s.cost, s.evaluate(&c));
-        well_formed(&m, &s)?;
-        prop_assert!(s.feasible(&m));
-        let rep = cellseq::check(&inst, &s.sequence(), inst.default_objective()).unwrap();
-        prop_assert!(close(rep.cost, s.cost + m.constant()));
-        prop_assert!(close(s.cost, brute.min(start)), "reopt {} brute {} start {}", s.cost, brute, start);
-        prop_assert_eq!(gain, s.cost < start - 1e-9 * start.abs().max(1.0));
+        window_result(&inst, &c, &s, start, brute, gain)?;
     }
 }

@@ -206,8 +206,11 @@ pub const SYMMETRIC_BEAM_PLAN: &str = "ils*:1";
 /// twin of the instance) and gets the time `local-search` gave up (0.3 → 0.1): built from
 /// the other end, the ants fall less often into the basin that holds forward colonies on
 /// kro124p.3 (10 s, seeds 1–10: 8 runs at the best known 49499 and 2 at 49519, against 6
-/// and 4 in the 50183–50207 basin; notes/sopq7.md).
-pub const SPARSE_PLAN: &str = "local-search:0.1,~eacs:0.5,ils[accept=0.03;shift-repair=5]*:1";
+/// and 4 in the 50183–50207 basin; notes/sopq7.md). The last `ils` ends every kick's repair
+/// with the bounded-shift DP at shift 2 (adjacent swaps and the modes re-chosen over the
+/// kicked span): PCGTSPLIB p43.2 16/16 and kro124p.4 11/16 seeds at or below the best known,
+/// against 13/16 and 8/16 without; shift 5 lost rbg050c (12/16 against 16/16; notes/sopq9.md).
+pub const SPARSE_PLAN: &str = "local-search:0.1,~eacs:0.5,ils[accept=0.03;shift-repair=2]*:1";
 
 /// Default phases on asymmetric matrix instances with dense precedence and more than
 /// `dense-beam-max-cells` cells (TSPLIB rbg323a–rbg378a): a short `local-search`, `ils`
