@@ -440,7 +440,8 @@ impl Auto {
         Ok(out)
     }
 
-    /// The phases for model `m` (see [`Auto::case`] and [`Auto::plan_in`]).
+    /// The phases for model `m`: the plan of its case ([`Auto::case`]), or
+    /// `symmetric_beam_plan` in the symmetric case after a beam phase that ran (`after_beam`).
     pub fn plan_for(&self, m: &CostModel, after_beam: bool) -> &str {
         self.plan_in(self.case(m), after_beam)
     }

@@ -1134,8 +1134,8 @@ fn may_lead(cl: &Closure, a: usize, b: usize) -> bool {
     })
 }
 
-/// Symmetry breaking: pairs `(a, b)` of cost twins ([`cost_twins`]: copies of each other apart
-/// from the precedence) where `a` may lead `b` ([`may_lead`]; when each may lead the other,
+/// Symmetry breaking: pairs `(a, b)` of cost twins (`cost_twins`: copies of each other apart
+/// from the precedence) where `a` may lead `b` (`may_lead`; when each may lead the other,
 /// the smaller index leads). Any optimum can be turned into one where `a` comes before `b`
 /// for every pair: exchange an inverted pair while there is one; each exchange keeps
 /// feasibility and cost and lowers the number of inversions against a linear extension of
