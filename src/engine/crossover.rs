@@ -69,9 +69,7 @@ impl Crossover {
             let mut next = [0.0f64; 2];
             let mut pick = [0u8; 2];
             for (q, s) in parents.iter().enumerate() {
-                let inner: f64 = (from as isize..k as isize)
-                    .map(|p| s.link(c, p, p + 1))
-                    .sum();
+                let inner = s.links(c, from as isize, k as isize);
                 let first = s.at(from as isize);
                 let mut v = [f64::INFINITY; 2];
                 for (p, t) in parents.iter().enumerate() {

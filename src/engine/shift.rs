@@ -104,9 +104,7 @@ impl ShiftDp {
         }
         let left: Slot = s.at(lo as isize - 1);
         let right: Slot = s.at(hi as isize);
-        let current: f64 = (lo as isize - 1..hi as isize)
-            .map(|p| s.link(c, p, p + 1))
-            .sum();
+        let current = s.links(c, lo as isize - 1, hi as isize);
         if self.stages.len() < len + 1 {
             self.stages.resize_with(len + 1, Vec::new);
         }
@@ -217,10 +215,7 @@ impl ShiftDp {
             modes[p - 1] = st.mode;
             i = st.parent as usize;
         }
-        s.rewrite(lo, &cells, best.0 - current);
-        for (cell, mode) in cells.iter().zip(&modes) {
-            s.mode[*cell as usize] = *mode;
-        }
+        s.rewrite_with_modes(lo, &cells, &modes, best.0 - current);
         true
     }
 }

@@ -61,6 +61,11 @@ impl Solution {
     pub fn link(&self, c: &Costs, p: isize, q: isize) -> f64 {
         c.link(self.at(p), self.at(q))
     }
+    /// Sum of the links from each position `p` in `from..to` to `p + 1` (positions −1 and
+    /// n stand for the path's start and end), in that order.
+    pub fn links(&self, c: &Costs, from: isize, to: isize) -> f64 {
+        (from..to).map(|p| self.link(c, p, p + 1)).sum()
+    }
     /// Full evaluation (without the order-independent constant), O(n).
     pub fn evaluate(&self, c: &Costs) -> f64 {
         let n = self.n() as isize;
@@ -98,6 +103,14 @@ impl Solution {
         self.order[from..from + cells.len()].copy_from_slice(cells);
         self.renumber(from, from + cells.len());
         self.cost += delta;
+    }
+    /// [`Solution::rewrite`], and the cell `cells[i]` takes mode `modes[i]`.
+    pub fn rewrite_with_modes(&mut self, from: usize, cells: &[u32], modes: &[u32], delta: f64) {
+        debug_assert_eq!(cells.len(), modes.len());
+        self.rewrite(from, cells, delta);
+        for (&cell, &mode) in cells.iter().zip(modes) {
+            self.mode[cell as usize] = mode;
+        }
     }
     fn renumber(&mut self, from: usize, to: usize) {
         for p in from..to {

@@ -93,9 +93,7 @@ impl ModeWindow {
         let hi = (i + w).min(n - 1); // inclusive
         let left = s.at(lo as isize - 1);
         let right = s.at(hi as isize + 1);
-        let current: f64 = (lo as isize - 1..=hi as isize)
-            .map(|p| s.link(c, p, p + 1))
-            .sum();
+        let current = s.links(c, lo as isize - 1, hi as isize + 1);
         let mut best = current;
         let mut found = false;
         // the order as it is (modes only), then each single-cell move a -> b in the window
@@ -138,10 +136,7 @@ impl ModeWindow {
             return false;
         }
         let delta = best - current;
-        s.rewrite(lo, &self.best_cells, delta);
-        for (k, &cell) in self.best_cells.iter().enumerate() {
-            s.mode[cell as usize] = self.best_modes[k];
-        }
+        s.rewrite_with_modes(lo, &self.best_cells, &self.best_modes, delta);
         true
     }
 

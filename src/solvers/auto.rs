@@ -22,7 +22,8 @@
 //!    `dense-beam-share` (50 %): there its wider passes find what the plan misses (PCGTSPLIB
 //!    rbg174a: 1641, the proven optimum, on 13 of 13 seeds at 10 s, against 1642–1643 with
 //!    10 %; notes/sopq8.md). On larger dense instances (rbg323a–rbg378a) the passes
-//!    do not finish and the time is better spent on the plan.
+//!    do not finish: there is no beam phase, and the default is `large-dense-plan`, which
+//!    ends with window re-optimization by the exact tree search (see [`LARGE_DENSE_PLAN`]).
 //!
 //! Plan syntax: `solver[key=value;...]:share`, with `*` after the name to start from the
 //! best sequence so far, `+` to start from the sequence of the phase just before, and `~`
@@ -115,7 +116,7 @@ pub static INFO: SolverInfo = SolverInfo {
             name: "dense-beam-max-cells",
             default: "300",
             kind: ParamKind::Int,
-            help: "dense matrix instances with more cells keep beam-share: there the beam's wider passes do not finish in a useful time",
+            help: "dense matrix instances with more cells get large-dense-plan and no beam phase: there the beam's passes over the whole instance do not finish in a useful time",
         },
         ParamSpec {
             name: "large-dense-plan",
@@ -448,7 +449,7 @@ impl Auto {
 
     /// The phases in `case`: `symmetric_beam_plan` after a beam phase that ran
     /// (`after_beam`) and `symmetric_plan` otherwise in the symmetric case, `sparse_plan` in
-    /// the sparse one, else `plan`.
+    /// the sparse one, `large_dense_plan` in the large dense one, else `plan`.
     fn plan_in(&self, case: Case, after_beam: bool) -> &str {
         match (case, after_beam) {
             (Case::Default | Case::Dense, _) => &self.plan,
@@ -489,7 +490,8 @@ impl Auto {
     /// Which settings apply to model `m`: the default ones when the user gave a `plan` or
     /// for geometric instances; else the symmetric ones when the matrix reads the same
     /// backwards, the sparse ones when the precedence closure is sparser than
-    /// `dense_density`.
+    /// `dense_density`, else the dense ones up to `dense_beam_max_cells` cells and the large
+    /// dense ones above.
     pub fn case(&self, m: &CostModel) -> Case {
         if self.plan != PLAN || m.is_geometric() {
             Case::Default

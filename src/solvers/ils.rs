@@ -341,7 +341,7 @@ fn shuffle(
         return false;
     }
     let (lo, hi) = (a as isize - 1, (a + w) as isize);
-    let old: f64 = (lo..hi).map(|p| s.link(c, p, p + 1)).sum();
+    let old = s.links(c, lo, hi);
     let slot = |x: u32| Some((x as usize, s.mode[x as usize] as usize));
     let mut new =
         c.link(s.at(lo), slot(scratch.out[0])) + c.link(slot(scratch.out[w - 1]), s.at(hi));

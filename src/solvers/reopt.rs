@@ -177,13 +177,6 @@ pub fn window_instance(c: &Costs, s: &Solution, lo: usize, hi: usize) -> (Instan
     (inst, cells)
 }
 
-/// Cost of the links from position `lo − 1` to position `hi` (the window's share of `s`).
-fn window_cost(c: &Costs, s: &Solution, lo: usize, hi: usize) -> f64 {
-    (lo as isize - 1..hi as isize)
-        .map(|p| s.link(c, p, p + 1))
-        .sum()
-}
-
 /// One window's budget: a share `frac` of the whole budget `b`, but no more than what is left
 /// of it after `used_evals` evaluations and `used_s` seconds.
 fn window_budget(b: Budget, used_evals: u64, used_s: f64, frac: f64) -> Budget {
@@ -234,7 +227,8 @@ impl Reopt {
         let out = beam.solve_from(&mut sub_ctx, Some(current.clone()));
         ctx.count(sub_ctx.evaluations());
         let out = out?;
-        let before = window_cost(c, s, lo, hi);
+        // the window's share of `s`: the links from position lo − 1 to position hi
+        let before = s.links(c, lo as isize - 1, hi as isize);
         let now = sm.evaluate(&current);
         // the sub-instance's costs are the window's links (computed by the same calls)
         debug_assert!((now - before).abs() <= 1e-6 * before.abs().max(1.0));
@@ -245,12 +239,10 @@ impl Reopt {
         let seq = &out.sequence;
         debug_assert_eq!(seq.len(), len + 2);
         let order: Vec<u32> = seq[1..=len].iter().map(|v| cells[v.cell - 1]).collect();
-        s.rewrite(lo, &order, 0.0);
-        for v in &seq[1..=len] {
-            s.mode[cells[v.cell - 1] as usize] = v.mode as u32;
-        }
+        let modes: Vec<u32> = seq[1..=len].iter().map(|v| v.mode as u32).collect();
+        s.rewrite_with_modes(lo, &order, &modes, 0.0);
         // the exact change, whatever rounding the sub-instance's sums carried
-        s.cost += window_cost(c, s, lo, hi) - before;
+        s.cost += s.links(c, lo as isize - 1, hi as isize) - before;
         Ok((true, out.proven_optimal))
     }
 
