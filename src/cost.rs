@@ -5,9 +5,15 @@
 //! It is the solvers' incremental evaluator; the independent checker in [`crate::check()`]
 //! recomputes everything from the raw instance without using this module.
 
+use crate::bound::closure::Closure;
 use crate::geom::Point3;
 use crate::model::{CostMatrix, Instance, Objective, Sequence};
 use crate::precedence::Dag;
+use std::sync::OnceLock;
+
+/// Up to this many cells (with precedence) [`CostModel::closure`] builds the transitive
+/// closure as bitsets: 2·n²/8 bytes, 4 MiB at the limit.
+pub const CLOSURE_MAX_CELLS: usize = 4096;
 
 /// Geometry and machine data flattened for fast arc evaluation.
 #[derive(Debug, Clone)]
@@ -56,6 +62,8 @@ pub struct CostModel {
     geo: Option<Geo>,
     /// precedence (transitive reduction where affordable)
     pub dag: Dag,
+    /// the closure of `dag`, built on first use (see [`CostModel::closure`])
+    closure: OnceLock<Option<Closure>>,
 }
 
 impl CostModel {
@@ -174,6 +182,7 @@ impl CostModel {
             matrix,
             geo,
             dag,
+            closure: OnceLock::new(),
         };
         cm.turn = (0..cm.nodes())
             .map(|nd| {
@@ -242,6 +251,18 @@ impl CostModel {
     #[inline]
     pub fn nodes(&self) -> usize {
         *self.offsets.last().unwrap_or(&0) as usize
+    }
+    /// The transitive closure of the precedence (ancestor and descendant bitsets), built on
+    /// first use and shared by every search on this model; `None` without precedence or
+    /// above [`CLOSURE_MAX_CELLS`] cells.
+    pub fn closure(&self) -> Option<&Closure> {
+        self.closure
+            .get_or_init(|| {
+                (self.n() <= CLOSURE_MAX_CELLS && !self.dag.is_empty())
+                    .then(|| Closure::new(&self.dag))
+                    .flatten()
+            })
+            .as_ref()
     }
     /// Some cell has more than one mode (every cell has at least one: validation refuses
     /// a cell without modes, so this is "more nodes than cells", O(1)).

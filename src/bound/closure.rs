@@ -58,6 +58,23 @@ impl Closure {
         self.desc[a * self.words + b / 64] >> (b % 64) & 1 == 1
     }
 
+    /// Words per bitset row.
+    pub fn words(&self) -> usize {
+        self.words
+    }
+
+    /// Bitset of the strict descendants of `v` (bit `b` of word `b / 64`).
+    #[inline]
+    pub fn desc_row(&self, v: usize) -> &[u64] {
+        &self.desc[v * self.words..(v + 1) * self.words]
+    }
+
+    /// Bitset of the strict ancestors of `v`.
+    #[inline]
+    pub fn anc_row(&self, v: usize) -> &[u64] {
+        &self.anc[v * self.words..(v + 1) * self.words]
+    }
+
     /// Number of strict ancestors of a cell.
     pub fn ancestors(&self, v: usize) -> usize {
         self.anc[v * self.words..(v + 1) * self.words]

@@ -258,13 +258,14 @@ impl<'a> Search<'a> {
 
     fn sop3_from(&mut self, s: &mut Solution, ctx: &mut Context, mut queue: Queue) -> bool {
         let c = self.c;
+        let cl = c.m.closure();
         let mut improved = false;
         while let Some(x) = queue.pop() {
             if ctx.exhausted() {
                 break;
             }
             let mut evals = 0u64;
-            let found = forward(&c, s, &mut self.labels, x, self.max_block, &mut evals);
+            let found = forward(&c, cl, s, &mut self.labels, x, self.max_block, &mut evals);
             ctx.count(evals);
             if let Some((d, h, i, j)) = found {
                 for cell in s.swap_blocks_touched(h, i as usize, j as usize, d) {

@@ -9,10 +9,20 @@
 //! stops growing at the first stamped cell (a predecessor of a cell of R cannot follow it).
 //! The transitive reduction suffices, as in the forward search: a chain from a cell of L to a
 //! cell of R enters R from a cell of L, and that cell is stamped.
+//!
+//! Early end of a scan, exact: with the precedence closure ([`CostModel::closure`]), the
+//! forward scan keeps the union of the descendants of L. When every cell that could start R
+//! at a later i (positions i+2..) is such a descendant, no later i has a candidate and the
+//! scan of this h ends; the backward scan does the same with the ancestors of R. On dense
+//! precedence (TSPLIB rbg*: 90–95 % of the pairs ordered) this cuts the blocks that were
+//! grown only to stamp cells, with the same moves found and the same evaluation count.
+//!
+//! [`CostModel::closure`]: crate::cost::CostModel::closure
 
 use super::moves::sop3_sum;
 use super::search::{Search, improves};
 use super::{Costs, Solution};
+use crate::bound::closure::Closure;
 use crate::solvers::Context;
 
 /// Labelling scratch space of SOP-3-exchange: a stamp per cell and the current label.
@@ -23,6 +33,31 @@ pub(crate) struct Labels {
     /// Links of the current path along a scan (`links[k]`: from the k-th scanned position to
     /// the next), filled as the scan first reaches them and reused for every block.
     links: Vec<f64>,
+    /// Per scanned position, the link between its cell and the scan's fixed end cell (the
+    /// left block's first cell in the forward search, the right block's last cell in the
+    /// backward one): fixed while the other block grows, so each is looked up once per scan.
+    ends: Vec<f64>,
+    /// Per scanned position, the slot after it (forward) or at it (backward).
+    slots: Vec<super::Slot>,
+    /// Union of the closure's descendant rows of the left block (forward) or ancestor rows
+    /// of the right block (backward), for the scan's early end.
+    reach: Vec<u64>,
+    /// Blocks grown so far (a work count for tests).
+    steps: usize,
+}
+
+/// Bit `cell` of a closure bitset.
+#[inline]
+fn has(set: &[u64], cell: u32) -> bool {
+    set[cell as usize / 64] >> (cell % 64) & 1 == 1
+}
+
+/// `set |= row`.
+#[inline]
+fn union(set: &mut [u64], row: &[u64]) {
+    for (a, b) in set.iter_mut().zip(row) {
+        *a |= b;
+    }
 }
 
 impl Labels {
@@ -59,8 +94,11 @@ impl TwoWay {
 }
 
 /// Forward search from cell `x`: the first improving (h, i) with its best j, h ∈ {px−1, px}.
+/// With the precedence closure `cl` the scan of a left block ends as soon as no cell that
+/// could start the right block is left (the same result, fewer steps on dense precedence).
 pub(crate) fn forward(
     c: &Costs,
+    cl: Option<&Closure>,
     s: &Solution,
     w: &mut Labels,
     x: u32,
@@ -79,10 +117,27 @@ pub(crate) fn forward(
         // the links that stay fixed while j (and i) scan; w.links[k] = link(h+2+k, h+3+k)
         let old_h = s.link(c, h, h + 1);
         let first_l = s.at(h + 1);
+        // per k = j − h − 2: link(j, j+1), link(j → first of L), the slot at j + 1
         w.links.clear();
+        w.ends.clear();
+        w.slots.clear();
+        // early end (exact): the highest position in i+2..=imax+1 that may still start R,
+        // i.e. whose cell is no descendant of L; none left means no later i has a candidate
+        let mut free = imax + 1;
+        if let Some(cl) = cl {
+            w.reach.clear();
+            w.reach.resize(cl.words(), 0);
+        }
         for i in (h + 1)..=imax {
+            w.steps += 1;
             for &q in &m.dag.succs[s.order[i as usize] as usize] {
                 w.stamp[q as usize] = label;
+            }
+            if let Some(cl) = cl {
+                union(&mut w.reach, cl.desc_row(s.order[i as usize] as usize));
+                while free >= i + 2 && has(&w.reach, s.order[free as usize]) {
+                    free -= 1;
+                }
             }
             let jmax = (i + max_block as isize).min(n - 1);
             let mut best = (0.0, 0isize);
@@ -94,16 +149,18 @@ pub(crate) fn forward(
                     break;
                 }
                 *evals += 1;
-                let (sj, sj1) = (s.at(j), s.at(j + 1));
                 let k = (j - h - 2) as usize;
                 while w.links.len() <= k {
                     let p = h + 2 + w.links.len() as isize;
-                    w.links.push(s.link(c, p, p + 1));
+                    let (sp, sp1) = (s.at(p), s.at(p + 1));
+                    w.links.push(c.link(sp, sp1));
+                    w.ends.push(c.link(sp, first_l));
+                    w.slots.push(sp1);
                 }
                 let d = sop3_sum(
                     new_h,
-                    c.link(sj, first_l),
-                    c.link(last_l, sj1),
+                    w.ends[k],
+                    c.link(last_l, w.slots[k]),
                     old_h,
                     old_i,
                     w.links[k],
@@ -115,14 +172,19 @@ pub(crate) fn forward(
             if improves(best.0, s.cost) {
                 return Some((best.0, h, i, best.1));
             }
+            if cl.is_some() && free < i + 2 {
+                break;
+            }
         }
     }
     None
 }
 
 /// Backward search from cell `x`: the first improving (j, i) with its best h, j ∈ {px, px−1}.
+/// `cl` ends a scan early as in [`forward`].
 fn backward(
     c: &Costs,
+    cl: Option<&Closure>,
     s: &Solution,
     w: &mut Labels,
     x: u32,
@@ -141,12 +203,29 @@ fn backward(
         // the links that stay fixed while h (and i) scan; w.links[k] = link(j-2-k, j-1-k)
         let old_j = s.link(c, j, j + 1);
         let last_r = s.at(j);
+        // per k = j − 2 − h: link(h, h+1), link(last of R → h+1), the slot at h
         w.links.clear();
+        w.ends.clear();
+        w.slots.clear();
+        // early end (exact): the lowest position in imin..=i−1 that may still end L next to
+        // R, i.e. whose cell is no ancestor of R; none left means no later i has a candidate
+        let mut free = imin;
+        if let Some(cl) = cl {
+            w.reach.clear();
+            w.reach.resize(cl.words(), 0);
+        }
         // R = [i+1..=j] grows leftwards
         let mut i = j - 1;
         while i >= imin {
+            w.steps += 1;
             for &q in &m.dag.preds[s.order[(i + 1) as usize] as usize] {
                 w.stamp[q as usize] = label;
+            }
+            if let Some(cl) = cl {
+                union(&mut w.reach, cl.anc_row(s.order[(i + 1) as usize] as usize));
+                while free <= i - 1 && has(&w.reach, s.order[free as usize]) {
+                    free += 1;
+                }
             }
             let hmin = (i - max_block as isize).max(-1);
             let mut best = (0.0, 0isize);
@@ -160,15 +239,17 @@ fn backward(
                     break;
                 }
                 *evals += 1;
-                let (sh, sh1) = (s.at(h), s.at(h + 1));
                 let k = (j - 2 - h) as usize;
                 while w.links.len() <= k {
                     let p = j - 2 - w.links.len() as isize;
-                    w.links.push(s.link(c, p, p + 1));
+                    let (sp, sp1) = (s.at(p), s.at(p + 1));
+                    w.links.push(c.link(sp, sp1));
+                    w.ends.push(c.link(last_r, sp1));
+                    w.slots.push(sp);
                 }
                 let d = sop3_sum(
-                    c.link(sh, first_r),
-                    c.link(last_r, sh1),
+                    c.link(w.slots[k], first_r),
+                    w.ends[k],
                     new_i,
                     w.links[k],
                     old_i,
@@ -181,6 +262,9 @@ fn backward(
             }
             if improves(best.0, s.cost) {
                 return Some((best.0, best.1, i, j));
+            }
+            if cl.is_some() && free > i - 1 {
+                break;
             }
             i -= 1;
         }
@@ -199,6 +283,7 @@ pub fn sop3_two_way(
     seeds: &[u32],
 ) -> bool {
     let c = search.c;
+    let cl = c.m.closure();
     let n = s.n();
     if n < 3 {
         return false;
@@ -216,8 +301,8 @@ pub fn sop3_two_way(
             break;
         }
         let mut evals = 0u64;
-        let found = forward(&c, s, &mut w.labels, x, search.max_block, &mut evals)
-            .or_else(|| backward(&c, s, &mut w.labels, x, search.max_block, &mut evals));
+        let found = forward(&c, cl, s, &mut w.labels, x, search.max_block, &mut evals)
+            .or_else(|| backward(&c, cl, s, &mut w.labels, x, search.max_block, &mut evals));
         ctx.count(evals);
         if let Some((d, h, i, j)) = found {
             for cell in s.swap_blocks_touched(h, i as usize, j as usize, d) {
@@ -242,6 +327,11 @@ mod tests {
     /// A random TSPLIB SOP instance: random costs, each pair a < b ordered with
     /// probability 0.05 (so the identity order is feasible).
     fn instance(n: usize, seed: u64) -> Instance {
+        instance_with(n, seed, 0.05)
+    }
+
+    /// As [`instance`], each pair ordered with probability `p`.
+    fn instance_with(n: usize, seed: u64, p: f64) -> Instance {
         let mut rng = ChaCha8Rng::seed_from_u64(seed);
         let mut text = format!(
             "NAME: t\nTYPE: SOP\nDIMENSION: {n}\nEDGE_WEIGHT_TYPE: EXPLICIT\nEDGE_WEIGHT_FORMAT: FULL_MATRIX\nEDGE_WEIGHT_SECTION\n{n}\n"
@@ -250,7 +340,7 @@ mod tests {
             for j in 0..n {
                 let v = if i == j {
                     0
-                } else if j < i && rng.random_bool(0.05) {
+                } else if j < i && rng.random_bool(p) {
                     -1
                 } else {
                     rng.random_range(1..100)
@@ -292,6 +382,62 @@ mod tests {
                 assert!((s.cost - s.evaluate(&c)).abs() < 1e-6);
                 rounds += 1;
                 assert!(rounds < 100);
+            }
+        }
+    }
+
+    /// The closure's early end changes nothing but the work: on random feasible orders of
+    /// instances from sparse to dense precedence, forward and backward searches from every
+    /// cell find the same move with the same evaluation count with and without it.
+    #[test]
+    fn early_end_finds_the_same_moves() {
+        for (seed, p) in [(1, 0.05), (2, 0.2), (3, 0.5), (4, 0.9)] {
+            let n = 60;
+            let inst = instance_with(n, seed, p);
+            let m = CostModel::new(&inst, Objective::Matrix);
+            let c = Costs::open(&m);
+            let cl = m.closure().expect("instance has precedence");
+            let mut rng = ChaCha8Rng::seed_from_u64(seed);
+            let (mut w1, mut w2) = (Labels::default(), Labels::default());
+            for _ in 0..20 {
+                // a random topological order
+                let mut missing: Vec<usize> = (0..n).map(|v| m.dag.preds[v].len()).collect();
+                let mut ready: Vec<u32> = (0..n as u32)
+                    .filter(|&v| missing[v as usize] == 0)
+                    .collect();
+                let mut seq = crate::model::Sequence::new();
+                while !ready.is_empty() {
+                    let v = ready.swap_remove(rng.random_range(0..ready.len()));
+                    seq.push(crate::model::Visit::new(v as usize, 0));
+                    for &q in &m.dag.succs[v as usize] {
+                        missing[q as usize] -= 1;
+                        if missing[q as usize] == 0 {
+                            ready.push(q);
+                        }
+                    }
+                }
+                let s = Solution::new(&c, &seq);
+                assert!(s.feasible(&m));
+                for x in 0..n as u32 {
+                    for block in [8, n] {
+                        let (mut e1, mut e2) = (0, 0);
+                        let a = forward(&c, None, &s, &mut w1, x, block, &mut e1);
+                        let b = forward(&c, Some(cl), &s, &mut w2, x, block, &mut e2);
+                        assert_eq!(a, b, "forward, seed {seed}, cell {x}");
+                        assert_eq!(e1, e2);
+                        let a = backward(&c, None, &s, &mut w1, x, block, &mut e1);
+                        let b = backward(&c, Some(cl), &s, &mut w2, x, block, &mut e2);
+                        assert_eq!(a, b, "backward, seed {seed}, cell {x}");
+                        assert_eq!(e1, e2);
+                    }
+                }
+            }
+            assert!(w2.steps <= w1.steps);
+            if p >= 0.5 {
+                assert!(
+                    w2.steps < w1.steps,
+                    "the early end never fired at density {p}"
+                );
             }
         }
     }
