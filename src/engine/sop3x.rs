@@ -223,7 +223,7 @@ fn backward(
             }
             if let Some(cl) = cl {
                 union(&mut w.reach, cl.anc_row(s.order[(i + 1) as usize] as usize));
-                while free <= i - 1 && has(&w.reach, s.order[free as usize]) {
+                while free < i && has(&w.reach, s.order[free as usize]) {
                     free += 1;
                 }
             }
@@ -263,7 +263,7 @@ fn backward(
             if improves(best.0, s.cost) {
                 return Some((best.0, best.1, i, j));
             }
-            if cl.is_some() && free > i - 1 {
+            if cl.is_some() && free >= i {
                 break;
             }
             i -= 1;
