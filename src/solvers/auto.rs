@@ -12,12 +12,12 @@
 //!    from greedy. On matrix instances whose costs read the same backwards the
 //!    default is `symmetric-plan` (`local-search:0.2,eacs*:0.3,ils*:1`), which gives `ils`
 //!    and its Lin–Kernighan chains more of the time; there, when the beam phase ran, it gets
-//!    `symmetric-beam-share` (30 %) and is followed by `symmetric-beam-plan` (`ils*:1`):
+//!    `symmetric-beam-share` (30 %) and is followed by `symmetric-beam-plan` (`ils` in a 1 % band):
 //!    `ils` started from the beam's sequence (on prob.100 at 10 s the median of 16 seeds
 //!    went from 1210.5 to 1172; notes/sopq5.md). On other matrix instances whose
 //!    precedence closure is sparser than `dense-density` (0.8) the default is `sparse-plan`:
-//!    a shorter `local-search`, the colony run backwards, and a wider acceptance band for
-//!    the last `ils` (see [`SPARSE_PLAN`]). On the other matrix instances (dense
+//!    a shorter `local-search`, the colony run backwards, `ils` in a narrow and then a
+//!    wider acceptance band, and a short window re-optimization (see [`SPARSE_PLAN`]). On the other matrix instances (dense
 //!    precedence) of at most `dense-beam-max-cells` (300) cells the beam gets
 //!    `dense-beam-share` (50 %): there its wider passes find what the plan misses (PCGTSPLIB
 //!    rbg174a: 1641, the proven optimum, on 13 of 13 seeds at 10 s, against 1642–1643 with
@@ -194,8 +194,11 @@ pub const SYMMETRIC_PLAN: &str = "local-search:0.2,eacs*:0.3,ils*:1";
 /// `ils` from the beam's sequence. The beam builds its paths with bounds over the whole
 /// remainder and lands in a better basin for `ils` than greedy, `local-search` or `eacs`
 /// starts: on prob.100 at 10 s, median of 16 seeds 1172 against the symmetric plan's 1210.5
-/// (and 1205 from local-search, 1217 from eacs; notes/sopq5.md).
-pub const SYMMETRIC_BEAM_PLAN: &str = "ils*:1";
+/// (and 1205 from local-search, 1217 from eacs; notes/sopq5.md). Its acceptance band is
+/// 1 % (the default 0.1 % stalls: a walk that finds no new best in 2000 kicks goes back
+/// to the best): prob.100 at 10 s, seeds 1–20, 12 runs at or below the best known 1163
+/// and median 1161, against 6 and 1172 (notes/sopq10.md).
+pub const SYMMETRIC_BEAM_PLAN: &str = "ils[accept=0.01]*:1";
 
 /// Default phases on asymmetric matrix instances whose precedence closure is sparser than
 /// `dense-density` (on TSPLIB SOP every instance but rbg109a–rbg378a, which lie at
@@ -211,7 +214,13 @@ pub const SYMMETRIC_BEAM_PLAN: &str = "ils*:1";
 /// with the bounded-shift DP at shift 2 (adjacent swaps and the modes re-chosen over the
 /// kicked span): PCGTSPLIB p43.2 16/16 and kro124p.4 11/16 seeds at or below the best known,
 /// against 13/16 and 8/16 without; shift 5 lost rbg050c (12/16 against 16/16; notes/sopq9.md).
-pub const SPARSE_PLAN: &str = "local-search:0.1,~eacs:0.5,ils[accept=0.03;shift-repair=2]*:1";
+/// The `ils` time is split: first a walk in a 1 % band from the colony's sequence, which
+/// stays in that basin and settles there (PCGTSPLIB kro124p.4 reaches 62818 or 62831, where
+/// the 3 % band wanders to 62915–62953), then the 3 % walk from the best, which leaves a poor
+/// basin that the narrow one cannot (PCGTSPLIB ft70.2: 33912 from the colony), then window
+/// re-optimization ([`super::reopt`], windows of 16) of the best, which turns 62831 into
+/// 62818: kro124p.4 at 10 s, seeds 101–112, 8/12 at 62818 against 6/12 (notes/sopq10.md).
+pub const SPARSE_PLAN: &str = "local-search:0.1,~eacs:0.5,ils[accept=0.01;shift-repair=2]*:0.25,ils[accept=0.03;shift-repair=2]*:0.85,reopt[window=16]*:1";
 
 /// Default phases on asymmetric matrix instances with dense precedence and more than
 /// `dense-beam-max-cells` cells (TSPLIB rbg323a–rbg378a): a short `local-search`, `ils`
