@@ -33,12 +33,6 @@ pub(crate) struct Labels {
     /// Links of the current path along a scan (`links[k]`: from the k-th scanned position to
     /// the next), filled as the scan first reaches them and reused for every block.
     links: Vec<f64>,
-    /// Per scanned position, the link between its cell and the scan's fixed end cell (the
-    /// left block's first cell in the forward search, the right block's last cell in the
-    /// backward one): fixed while the other block grows, so each is looked up once per scan.
-    ends: Vec<f64>,
-    /// Per scanned position, the slot after it (forward) or at it (backward).
-    slots: Vec<super::Slot>,
     /// Union of the closure's descendant rows of the left block (forward) or ancestor rows
     /// of the right block (backward), for the scan's early end.
     reach: Vec<u64>,
@@ -117,10 +111,7 @@ pub(crate) fn forward(
         // the links that stay fixed while j (and i) scan; w.links[k] = link(h+2+k, h+3+k)
         let old_h = s.link(c, h, h + 1);
         let first_l = s.at(h + 1);
-        // per k = j − h − 2: link(j, j+1), link(j → first of L), the slot at j + 1
         w.links.clear();
-        w.ends.clear();
-        w.slots.clear();
         // early end (exact): the highest position in i+2..=imax+1 that may still start R,
         // i.e. whose cell is no descendant of L; none left means no later i has a candidate
         let mut free = imax + 1;
@@ -149,18 +140,16 @@ pub(crate) fn forward(
                     break;
                 }
                 *evals += 1;
+                let (sj, sj1) = (s.at(j), s.at(j + 1));
                 let k = (j - h - 2) as usize;
                 while w.links.len() <= k {
                     let p = h + 2 + w.links.len() as isize;
-                    let (sp, sp1) = (s.at(p), s.at(p + 1));
-                    w.links.push(c.link(sp, sp1));
-                    w.ends.push(c.link(sp, first_l));
-                    w.slots.push(sp1);
+                    w.links.push(s.link(c, p, p + 1));
                 }
                 let d = sop3_sum(
                     new_h,
-                    w.ends[k],
-                    c.link(last_l, w.slots[k]),
+                    c.link(sj, first_l),
+                    c.link(last_l, sj1),
                     old_h,
                     old_i,
                     w.links[k],
@@ -203,10 +192,7 @@ fn backward(
         // the links that stay fixed while h (and i) scan; w.links[k] = link(j-2-k, j-1-k)
         let old_j = s.link(c, j, j + 1);
         let last_r = s.at(j);
-        // per k = j − 2 − h: link(h, h+1), link(last of R → h+1), the slot at h
         w.links.clear();
-        w.ends.clear();
-        w.slots.clear();
         // early end (exact): the lowest position in imin..=i−1 that may still end L next to
         // R, i.e. whose cell is no ancestor of R; none left means no later i has a candidate
         let mut free = imin;
@@ -239,17 +225,15 @@ fn backward(
                     break;
                 }
                 *evals += 1;
+                let (sh, sh1) = (s.at(h), s.at(h + 1));
                 let k = (j - 2 - h) as usize;
                 while w.links.len() <= k {
                     let p = j - 2 - w.links.len() as isize;
-                    let (sp, sp1) = (s.at(p), s.at(p + 1));
-                    w.links.push(c.link(sp, sp1));
-                    w.ends.push(c.link(last_r, sp1));
-                    w.slots.push(sp);
+                    w.links.push(s.link(c, p, p + 1));
                 }
                 let d = sop3_sum(
-                    c.link(w.slots[k], first_r),
-                    w.ends[k],
+                    c.link(sh, first_r),
+                    c.link(last_r, sh1),
                     new_i,
                     w.links[k],
                     old_i,
