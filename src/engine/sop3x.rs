@@ -384,22 +384,14 @@ mod tests {
             let mut rng = ChaCha8Rng::seed_from_u64(seed);
             let (mut w1, mut w2) = (Labels::default(), Labels::default());
             for _ in 0..20 {
-                // a random topological order
-                let mut missing: Vec<usize> = (0..n).map(|v| m.dag.preds[v].len()).collect();
-                let mut ready: Vec<u32> = (0..n as u32)
-                    .filter(|&v| missing[v as usize] == 0)
-                    .collect();
-                let mut seq = crate::model::Sequence::new();
-                while !ready.is_empty() {
-                    let v = ready.swap_remove(rng.random_range(0..ready.len()));
-                    seq.push(crate::model::Visit::new(v as usize, 0));
-                    for &q in &m.dag.succs[v as usize] {
-                        missing[q as usize] -= 1;
-                        if missing[q as usize] == 0 {
-                            ready.push(q);
-                        }
-                    }
-                }
+                // a random topological order: the ready cell of the lowest random rank first
+                let rank: Vec<usize> = (0..n).map(|_| rng.random::<u32>() as usize).collect();
+                let seq: crate::model::Sequence =
+                    crate::precedence::ranked_topological_order(&m.dag, &rank)
+                        .expect("acyclic")
+                        .into_iter()
+                        .map(|v| crate::model::Visit::new(v, 0))
+                        .collect();
                 let s = Solution::new(&c, &seq);
                 assert!(s.feasible(&m));
                 for x in 0..n as u32 {

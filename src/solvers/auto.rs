@@ -12,18 +12,19 @@
 //!    from greedy. On matrix instances whose costs read the same backwards the
 //!    default is `symmetric-plan` (`local-search:0.2,eacs*:0.3,ils*:1`), which gives `ils`
 //!    and its Lin–Kernighan chains more of the time; there, when the beam phase ran, it gets
-//!    `symmetric-beam-share` (30 %) and is followed by `symmetric-beam-plan` (`ils` in a 1 % band):
-//!    `ils` started from the beam's sequence (on prob.100 at 10 s the median of 16 seeds
-//!    went from 1210.5 to 1172; notes/sopq5.md). On other matrix instances whose
+//!    `symmetric-beam-share` (30 %) and is followed by `symmetric-beam-plan` (`ils` in a
+//!    1 % band): `ils` started from the beam's sequence (on prob.100 at 10 s the median of
+//!    16 seeds went from 1210.5 to 1172; notes/sopq5.md). On other matrix instances whose
 //!    precedence closure is sparser than `dense-density` (0.8) the default is `sparse-plan`:
 //!    a shorter `local-search`, the colony run backwards, `ils` in a narrow and then a
-//!    wider acceptance band, and a short window re-optimization (see [`SPARSE_PLAN`]). On the other matrix instances (dense
-//!    precedence) of at most `dense-beam-max-cells` (300) cells the beam gets
-//!    `dense-beam-share` (50 %): there its wider passes find what the plan misses (PCGTSPLIB
-//!    rbg174a: 1641, the proven optimum, on 13 of 13 seeds at 10 s, against 1642–1643 with
-//!    10 %; notes/sopq8.md). On larger dense instances (rbg323a–rbg378a) the passes
-//!    do not finish: there is no beam phase, and the default is `large-dense-plan`, which
-//!    ends with window re-optimization by the exact tree search (see [`LARGE_DENSE_PLAN`]).
+//!    wider acceptance band, and a short window re-optimization (see [`SPARSE_PLAN`]). On
+//!    the other matrix instances (dense precedence) of at most `dense-beam-max-cells` (300)
+//!    cells the beam gets `dense-beam-share` (50 %): there its wider passes find what the
+//!    plan misses (PCGTSPLIB rbg174a: 1641, the proven optimum, on 13 of 13 seeds at 10 s,
+//!    against 1642–1643 with 10 %; notes/sopq8.md). On larger dense instances
+//!    (rbg323a–rbg378a) the passes do not finish: there is no beam phase, and the default is
+//!    `large-dense-plan`, which ends with window re-optimization by the exact tree search
+//!    (see [`LARGE_DENSE_PLAN`]).
 //!
 //! Plan syntax: `solver[key=value;...]:share`, with `*` after the name to start from the
 //! best sequence so far, `+` to start from the sequence of the phase just before, and `~`
