@@ -209,7 +209,7 @@ fn auto_picks_its_plan_by_symmetry_and_precedence_density() {
         dense_beam_max_cells: 100,
         ..auto(PLAN)
     };
-    // larger dense instances: large-dense-plan (window re-optimization) and no beam phase
+    // larger dense instances: large-dense-plan (ils with longer kicks) and no beam phase
     assert_eq!(small_cap.case(&rbg), Case::LargeDense);
     assert_eq!(small_cap.beam_share_for(&rbg), 0.0);
     for after_beam in [false, true] {

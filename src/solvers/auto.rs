@@ -23,8 +23,7 @@
 //!    plan misses (PCGTSPLIB rbg174a: 1641, the proven optimum, on 13 of 13 seeds at 10 s,
 //!    against 1642–1643 with 10 %; notes/sopq8.md). On larger dense instances
 //!    (rbg323a–rbg378a) the passes do not finish: there is no beam phase, and the default is
-//!    `large-dense-plan`, which ends with window re-optimization by the exact tree search
-//!    (see [`LARGE_DENSE_PLAN`]).
+//!    `large-dense-plan`: `ils` with longer kicks (see [`LARGE_DENSE_PLAN`]).
 //!
 //! Plan syntax: `solver[key=value;...]:share`, with `*` after the name to start from the
 //! best sequence so far, `+` to start from the sequence of the phase just before, and `~`
@@ -224,12 +223,16 @@ pub const SYMMETRIC_BEAM_PLAN: &str = "ils[accept=0.01]*:1";
 pub const SPARSE_PLAN: &str = "local-search:0.1,~eacs:0.5,ils[accept=0.01;shift-repair=2]*:0.25,ils[accept=0.03;shift-repair=2]*:0.85,reopt[window=16]*:1";
 
 /// Default phases on asymmetric matrix instances with dense precedence and more than
-/// `dense-beam-max-cells` cells (TSPLIB rbg323a–rbg378a): a short `local-search`, `ils`
-/// from its sequence, then window re-optimization ([`super::reopt`]) of the best sequence
-/// by the exact tree search, with no beam phase (its passes over the whole instance do not
-/// finish there and never beat `ils`). On rbg323a the windows turn 3141 sequences of `ils`
-/// into the optimum 3140 (notes/sopq9.md).
-pub const LARGE_DENSE_PLAN: &str = "local-search:0.1,ils*:0.4,reopt*:1";
+/// `dense-beam-max-cells` cells (TSPLIB rbg323a–rbg378a): a short `local-search`, then `ils`
+/// from its sequence for the rest, with no beam phase (its passes over the whole instance do
+/// not finish there and never beat `ils`). Its kicks reorder stretches of up to 45 cells
+/// (`max-seg`; the automatic length is 30): the gains left at 3141/2569/2548/2818 lie in
+/// reorders of 40–90 consecutive cells, which shorter kicks reach too rarely and longer ones
+/// (60, 80) bury in repair. At 10 s, seeds 101–108 on the four instances, 23 of 32 runs
+/// reach the best known value, against 5 with the plan before (`ils` for 40 %, then window
+/// re-optimization by the exact tree search, [`super::reopt`]) and 15 and 15 with kicks of
+/// 60 and 80; seeds 109–116 gave 17 of 32 (notes/sopq11.md).
+pub const LARGE_DENSE_PLAN: &str = "local-search:0.1,ils[max-seg=45]*:1";
 
 /// The solvers a plan phase can start from an earlier sequence (`*`, `+`).
 pub const STARTABLE: [&str; 3] = ["ils", "eacs", "reopt"];

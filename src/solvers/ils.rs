@@ -417,6 +417,7 @@ impl Ils {
         let mut kicks_done = 0u64;
         let mut shift_repair = ShiftDp::new(self.shift_repair.max(2), 200_000);
         let mut shift_gains = 0u64;
+        let trace = super::trace_enabled();
         while !ctx.exhausted() {
             if !bounded && since_best >= self.stall {
                 break;
@@ -506,6 +507,13 @@ impl Ils {
                 }
                 best.clone_from(&trial);
                 ctx.report(best.cost + m.constant());
+                if trace {
+                    eprintln!(
+                        "ils: best {} at kick {kicks_done}, {:.2} s",
+                        best.cost + m.constant(),
+                        ctx.elapsed()
+                    );
+                }
                 since_best = 0;
                 since_restart = 0;
             }
@@ -517,7 +525,7 @@ impl Ils {
                 since_restart = 0;
             }
         }
-        if super::trace_enabled() {
+        if trace {
             eprintln!(
                 "ils: {kicks_done} kicks, {crosses} crossovers gave a new best, {shift_gains} repairs improved by the shift DP"
             );
