@@ -23,7 +23,7 @@ use clap::{Parser, Subcommand};
 
 /// Sequencing of CNC machining cells.
 #[derive(Parser, Debug)]
-#[command(name = "cellseq", version, about, long_about = None)]
+#[command(name = "cellseq", version = cellseq::harness::provenance::VERSION, about, long_about = None)]
 pub struct Cli {
     #[command(subcommand)]
     command: Command,

@@ -12,6 +12,7 @@ pub mod layers;
 pub mod paper;
 pub mod plan;
 pub mod plots;
+pub mod provenance;
 pub mod report;
 pub mod results;
 pub mod run;

@@ -367,7 +367,7 @@ pub fn write_manifest(
     summary: Option<&RunSummary>,
 ) -> Result<()> {
     let dir = std::env::current_dir().unwrap_or_else(|_| PathBuf::from("."));
-    let m = serde_json::json!({
+    let mut m = serde_json::json!({
         "format": "cellseq-manifest/1",
         "crate_version": env!("CARGO_PKG_VERSION"),
         "git_commit": command_output("git", &["rev-parse", "HEAD"], &dir)
@@ -387,6 +387,7 @@ pub fn write_manifest(
         "trials_failed": summary.map(|s| s.failed),
         "complete": summary.is_some(),
     });
+    super::provenance::stamp(&mut m, &files.manifest, summary.is_some());
     crate::formats::write_atomic(
         &files.manifest,
         serde_json::to_string_pretty(&m)
