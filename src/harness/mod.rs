@@ -7,7 +7,10 @@
 //! [`report::report`] turns a results directory into Markdown/CSV tables and PNG/SVG plots.
 //! Everything goes through the solver and generator registries, so new entries just work.
 
+pub mod estimate;
+pub mod figures;
 pub mod hash;
+pub mod latex;
 pub mod layers;
 pub mod paper;
 pub mod plan;

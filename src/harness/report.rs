@@ -1,9 +1,10 @@
 //! `cellseq report`: tables, tests and plots from a results directory, deterministically
 //! (same input files, same output bytes for the tables; plots depend on the same data only).
 
+use super::figures;
 use super::hash::stable_hash;
+use super::latex;
 use super::plan::PlanFile;
-use super::plots;
 use super::results::{Row, TraceRow, read_lenient, read_strict};
 use super::stats::{
     bootstrap_ci_mean, friedman, holm, mean, median, quantile, std_dev, wilcoxon_signed_rank,
@@ -15,8 +16,8 @@ use std::path::{Path, PathBuf};
 
 /// Bootstrap resamples for the confidence intervals.
 pub const BOOTSTRAP_RESAMPLES: usize = 2000;
-/// Relative gap to the best found cost that counts as reaching the target (ECDF of time).
-pub const TARGET_GAP: f64 = 0.01;
+/// Relative gap to the best found cost that counts as reaching the target (ECDF).
+pub const TARGET_GAP: f64 = figures::TARGET_GAP;
 
 /// What the report wrote.
 #[derive(Debug, Clone)]
@@ -218,18 +219,31 @@ pub fn report(dir: &Path, out: &Path) -> Result<ReportFiles> {
         ordered(rows.iter().map(|r| r.objective.as_str())).join(", ")
     );
     if let Some(m) = &manifest {
+        let txt = |k: &str| m[k].as_str().unwrap_or("?").to_string();
+        let dirty = if m["git_dirty"].as_str() == Some("true") {
+            ", dirty tree"
+        } else {
+            ""
+        };
         let _ = writeln!(
             md,
-            "Run: cellseq {} (commit {}), plan hash `{}`, {} thread(s) on {}, calibration unit {} s.\n",
-            m["crate_version"].as_str().unwrap_or("?"),
+            "Run: cellseq {} (commit {}{dirty}), plan hash `{}`, {} thread(s) on host {} ({} × {}; {}, kernel {}), \
+             calibration unit {} s; started {}, ended {}.\n",
+            txt("crate_version"),
             m["git_commit"].as_str().unwrap_or("unknown"),
-            m["plan_hash"].as_str().unwrap_or("?"),
+            txt("plan_hash"),
             m["threads"],
-            m["cpu_model"].as_str().unwrap_or("?"),
+            txt("host"),
+            m["cpu_count"],
+            txt("cpu_model"),
+            txt("os"),
+            txt("kernel"),
             m["calibration_seconds"]
                 .as_f64()
                 .map(fmt)
-                .unwrap_or_else(|| "?".into())
+                .unwrap_or_else(|| "?".into()),
+            txt("started_utc"),
+            m["ended_utc"].as_str().unwrap_or("– (not finished)")
         );
     }
 
@@ -285,6 +299,8 @@ pub fn report(dir: &Path, out: &Path) -> Result<ReportFiles> {
     }
     let sum_csv = out.join("summary.csv");
     write_csv(&sum_csv, &summary)?;
+    let objective = ordered(rows.iter().map(|r| r.objective.as_str())).join(", ");
+    let mut tex_tables = vec![("summary.tex", latex::summary_table(&summary, &objective))];
     files.push(sum_csv);
     let _ = writeln!(md, "## Per instance and solver\n");
     let _ = writeln!(
@@ -354,7 +370,16 @@ pub fn report(dir: &Path, out: &Path) -> Result<ReportFiles> {
             fmt(mean(&tc)),
             fmt(mean(&wall))
         );
-        overview.push((s.clone(), red, lifts));
+        overview.push(latex::SolverLine {
+            solver: s.clone(),
+            ok: ok.len(),
+            runs: g.len(),
+            mean_red: mean(&red),
+            median_red: median(&red),
+            lifts: mean(&lifts),
+            tool_changes: mean(&tc),
+            wall: mean(&wall),
+        });
     }
     let _ = writeln!(md);
 
@@ -460,6 +485,11 @@ pub fn report(dir: &Path, out: &Path) -> Result<ReportFiles> {
         &tests_csv,
         &pooled.iter().chain(&tests).cloned().collect::<Vec<_>>(),
     )?;
+    tex_tables.push(("solvers.tex", latex::solver_table(&overview)));
+    tex_tables.push((
+        "wilcoxon.tex",
+        latex::wilcoxon_table(&pooled, &tests, &reference),
+    ));
     files.push(tests_csv);
 
     // Friedman over instances (blocks) with solvers feasible everywhere
@@ -493,13 +523,17 @@ pub fn report(dir: &Path, out: &Path) -> Result<ReportFiles> {
             order.sort_by(|&a, &b| f.avg_ranks[a].total_cmp(&f.avg_ranks[b]));
             let _ = writeln!(md, "| solver | average rank (1 = best) |\n|---|---|");
             let mut csv_rows = Vec::new();
-            for k in order {
+            for k in order.iter().copied() {
                 let _ = writeln!(md, "| {} | {} |", complete[k], fmt(f.avg_ranks[k]));
                 csv_rows.push((complete[k].clone(), f.avg_ranks[k]));
             }
             let p = out.join("friedman.csv");
             let mut w = csv::Writer::from_writer(Vec::new());
             let _ = w.write_record(["solver", "average_rank", "statistic", "df", "p"]);
+            tex_tables.push((
+                "friedman.tex",
+                latex::friedman_table(&csv_rows, f.statistic, f.df, f.p, blocks.len()),
+            ));
             for (s, r) in csv_rows {
                 let _ = w.write_record([
                     s,
@@ -587,256 +621,52 @@ pub fn report(dir: &Path, out: &Path) -> Result<ReportFiles> {
         }
     }
 
-    // plots
+    // LaTeX versions of the tables (booktabs)
+    for (name, t) in &tex_tables {
+        let p = out.join(name);
+        crate::formats::write_atomic(&p, latex::render(t).as_bytes())?;
+        files.push(p);
+    }
+    let _ = writeln!(
+        md,
+        "LaTeX (booktabs) versions of the tables: {}.\n",
+        tex_tables
+            .iter()
+            .map(|(n, _)| format!("[{n}]({n})"))
+            .collect::<Vec<_>>()
+            .join(", ")
+    );
+
+    // figures
     let plot_dir = out.join("plots");
     std::fs::create_dir_all(&plot_dir).map_err(|e| Error::io(plot_dir.display().to_string(), e))?;
-    let perr = |e: String| {
+    let plots_written = figures::write_figures(
+        &plot_dir,
+        &figures::FigureData {
+            rows: &rows,
+            traces: &traces,
+            instances: &instances,
+            solvers: &solvers,
+            reference: &reference,
+        },
+    )
+    .map_err(|e| {
         Error::invalid(
             plot_dir.display().to_string(),
             format!("plotting failed: {e}"),
         )
-    };
-    let mut plots_written = Vec::new();
-    let red_groups: plots::Groups = overview
-        .iter()
-        .map(|(s, r, _)| (s.clone(), r.clone()))
-        .collect();
-    plots_written.extend(
-        plots::box_plot(
-            &plot_dir,
-            "reduction_box",
-            "Reduction against as-given per solver",
-            "reduction %",
-            &red_groups,
-        )
-        .map_err(perr)?,
+    })?;
+    let _ = writeln!(
+        md,
+        "## Plots\n\nEach figure is written as PNG (shown) and SVG (text kept as text, for papers).\n"
     );
-    let lift_groups: plots::Groups = overview
-        .iter()
-        .map(|(s, _, l)| (s.clone(), l.clone()))
-        .collect();
-    plots_written.extend(
-        plots::box_plot(
-            &plot_dir,
-            "lifts_box",
-            "Lifts per solver",
-            "lifts",
-            &lift_groups,
-        )
-        .map_err(perr)?,
-    );
-    let scaling: plots::Scaling = solvers
-        .iter()
-        .map(|s| {
-            let pts = instances
-                .iter()
-                .filter_map(|i| {
-                    // feasible trials only: a quick refusal says nothing about scaling
-                    let g = by.get(&(i.clone(), s.clone()))?;
-                    let t: Vec<f64> = g
-                        .iter()
-                        .filter(|r| r.feasible)
-                        .map(|r| r.wall_elapsed_s)
-                        .collect();
-                    (!t.is_empty()).then(|| (g[0].n as f64, mean(&t)))
-                })
-                .collect();
-            (s.clone(), pts)
-        })
-        .collect();
-    plots_written.extend(plots::scaling_plot(&plot_dir, &scaling).map_err(perr)?);
-
-    // best found per instance (for convergence and time-to-target)
-    let best_found: BTreeMap<&str, f64> = instances
-        .iter()
-        .filter_map(|i| {
-            let b = rows
-                .iter()
-                .filter(|r| &r.instance == i && r.feasible)
-                .filter_map(|r| r.cost)
-                .fold(f64::INFINITY, f64::min);
-            b.is_finite().then_some((i.as_str(), b))
-        })
-        .collect();
-    let mut runs: BTreeMap<&str, Vec<&TraceRow>> = BTreeMap::new();
-    for t in &traces {
-        runs.entry(t.run_key.as_str()).or_default().push(t);
-    }
-    let row_of: BTreeMap<&str, &Row> = rows.iter().map(|r| (r.run_key.as_str(), r)).collect();
-    let tmin = traces
-        .iter()
-        .map(|t| t.wall_elapsed_s)
-        .filter(|x| *x > 0.0)
-        .fold(f64::INFINITY, f64::min);
-    let tmax = rows.iter().map(|r| r.wall_elapsed_s).fold(0.0, f64::max);
-    let grid: Vec<f64> = if tmin.is_finite() && tmax > tmin {
-        (0..60)
-            .map(|k| tmin * (tmax / tmin).powf(k as f64 / 59.0))
-            .collect()
-    } else {
-        Vec::new()
-    };
-    let mut conv: plots::Bands = Vec::new();
-    let mut ttt: plots::Bands = Vec::new();
-    for s in &solvers {
-        let keys: Vec<&str> = rows
-            .iter()
-            .filter(|r| &r.solver_id == s)
-            .map(|r| r.run_key.as_str())
-            .collect();
-        let mut pts = Vec::new();
-        for &t in &grid {
-            let gaps: Vec<f64> = keys
-                .iter()
-                .filter_map(|k| {
-                    let r = row_of.get(k)?;
-                    let bf = *best_found.get(r.instance.as_str())?;
-                    let tr = runs.get(k)?;
-                    let b = tr
-                        .iter()
-                        .filter(|p| p.wall_elapsed_s <= t)
-                        .map(|p| p.best)
-                        .fold(f64::INFINITY, f64::min);
-                    (b.is_finite() && bf.abs() > 0.0).then(|| 100.0 * (b - bf) / bf.abs())
-                })
-                .collect();
-            if !gaps.is_empty() {
-                pts.push((
-                    t,
-                    median(&gaps),
-                    quantile(&gaps, 0.25),
-                    quantile(&gaps, 0.75),
-                ));
-            }
-        }
-        conv.push((s.clone(), pts));
-        // time to target
-        let mut times: Vec<f64> = keys
-            .iter()
-            .filter_map(|k| {
-                let r = row_of.get(k)?;
-                let bf = *best_found.get(r.instance.as_str())?;
-                let target = bf + TARGET_GAP * bf.abs();
-                runs.get(k)?
-                    .iter()
-                    .find(|p| p.best <= target)
-                    .map(|p| p.wall_elapsed_s.max(1e-7))
-            })
-            .collect();
-        times.sort_by(f64::total_cmp);
-        let total = keys.len().max(1) as f64;
-        let e: Vec<_> = times
-            .iter()
-            .enumerate()
-            .map(|(k, &t)| {
-                let y = (k + 1) as f64 / total;
-                (t, y, y, y)
-            })
-            .collect();
-        ttt.push((s.clone(), e));
-    }
-    plots_written.extend(
-        plots::curve_plot(
-            &plot_dir,
-            "convergence",
-            "Convergence: median gap to best found, runs with a solution by then (band: quartiles)",
-            "wall seconds",
-            "gap to best found %",
-            &conv,
-            None,
-            true,
-        )
-        .map_err(perr)?,
-    );
-    plots_written.extend(
-        plots::curve_plot(
-            &plot_dir,
-            "ecdf_time_to_target",
-            &format!(
-                "ECDF of time to reach {} % of the best found",
-                TARGET_GAP * 100.0
-            ),
-            "wall seconds",
-            "fraction of runs",
-            &ttt,
-            Some((0.0, 1.02)),
-            true,
-        )
-        .map_err(perr)?,
-    );
-    // Dolan-More performance profile over (instance, replicate) problems
-    let mut problems: BTreeMap<(String, u32), BTreeMap<String, f64>> = BTreeMap::new();
-    for r in &rows {
-        let e = problems
-            .entry((r.instance.clone(), r.replicate))
-            .or_default();
-        e.insert(
-            r.solver_id.clone(),
-            if r.feasible {
-                r.cost.unwrap_or(f64::INFINITY)
-            } else {
-                f64::INFINITY
-            },
-        );
-    }
-    let mut ratios: BTreeMap<String, Vec<f64>> = BTreeMap::new();
-    for costs in problems.values() {
-        let best = costs.values().copied().fold(f64::INFINITY, f64::min);
-        for s in &solvers {
-            let c = costs.get(s).copied().unwrap_or(f64::INFINITY);
-            let r = if best > 0.0 && best.is_finite() {
-                c / best
-            } else if c == best && c.is_finite() {
-                1.0
-            } else {
-                f64::INFINITY
-            };
-            ratios.entry(s.clone()).or_default().push(r);
-        }
-    }
-    let tau_max = ratios
-        .values()
-        .flatten()
-        .copied()
-        .filter(|r| r.is_finite())
-        .fold(1.0, f64::max)
-        .max(1.0001)
-        * 1.05;
-    let taus: Vec<f64> = (0..80).map(|k| tau_max.powf(k as f64 / 79.0)).collect();
-    let profile: plots::Bands = solvers
-        .iter()
-        .map(|s| {
-            let rs = &ratios[s];
-            let pts = taus
-                .iter()
-                .map(|&t| {
-                    let y = rs.iter().filter(|&&r| r <= t).count() as f64 / rs.len().max(1) as f64;
-                    (t, y, y, y)
-                })
-                .collect();
-            (s.clone(), pts)
-        })
-        .collect();
-    plots_written.extend(
-        plots::curve_plot(
-            &plot_dir,
-            "performance_profile",
-            "Dolan-Moré performance profile",
-            "tau (cost / best cost on the problem)",
-            "fraction of problems within tau",
-            &profile,
-            Some((0.0, 1.02)),
-            true,
-        )
-        .map_err(perr)?,
-    );
-    let _ = writeln!(md, "## Plots\n");
     for p in plots_written
         .iter()
         .filter(|p| p.extension().is_some_and(|e| e == "png"))
     {
         let name = p.file_name().and_then(|s| s.to_str()).unwrap_or("");
-        let _ = writeln!(md, "![{name}](plots/{name})\n");
+        let svg = name.replace(".png", ".svg");
+        let _ = writeln!(md, "![{name}](plots/{name})  \n[SVG](plots/{svg})\n");
     }
     files.extend(plots_written);
     let md_path = out.join("report.md");
