@@ -11,6 +11,12 @@ use std::path::{Path, PathBuf};
 pub struct CheckArgs {
     /// Experiment plan (TOML).
     plan: PathBuf,
+    /// Shards the plan will run as (for the time-per-shard estimate).
+    #[arg(long, default_value_t = 1)]
+    shards: usize,
+    /// Threads per shard (for the estimate; default: all cores here).
+    #[arg(long)]
+    threads: Option<usize>,
 }
 
 #[derive(Args, Debug)]
@@ -74,6 +80,11 @@ pub fn check(a: CheckArgs) -> Result<()> {
         plan.trials().len(),
         plan.reference
     );
+    let threads = a.threads.unwrap_or_else(rayon::current_num_threads);
+    let e = cellseq::harness::estimate::estimate(&plan, a.shards, threads, || {
+        cellseq::harness::run::calibrate()
+    })?;
+    say!("{e}");
     Ok(())
 }
 
