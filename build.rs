@@ -27,7 +27,14 @@ fn main() {
     println!("cargo:rerun-if-env-changed=CELLSEQ_GIT_COMMIT");
     // Sources whose change can make the tree dirty or the commit different. Listing any path
     // replaces Cargo's default (rerun on every package file), so the list is explicit.
-    for p in ["build.rs", "Cargo.toml", "Cargo.lock", "src", "assets", "experiments"] {
+    for p in [
+        "build.rs",
+        "Cargo.toml",
+        "Cargo.lock",
+        "src",
+        "assets",
+        "experiments",
+    ] {
         println!("cargo:rerun-if-changed={p}");
     }
     let env_commit = std::env::var("CELLSEQ_GIT_COMMIT")
@@ -44,7 +51,10 @@ fn main() {
         if let Some(common) = git(&root, &["rev-parse", "--git-common-dir"]) {
             let common = root.join(common);
             println!("cargo:rerun-if-changed={}", common.join("refs").display());
-            println!("cargo:rerun-if-changed={}", common.join("packed-refs").display());
+            println!(
+                "cargo:rerun-if-changed={}",
+                common.join("packed-refs").display()
+            );
         }
     }
     let (commit, dirty) = match (env_commit, head) {

@@ -115,9 +115,7 @@ pub fn gather() -> Provenance {
 
 /// The current UTC time, RFC 3339 to the second (`2026-11-26T10:50:07Z`).
 pub fn utc_now() -> String {
-    chrono::Utc::now()
-        .format("%Y-%m-%dT%H:%M:%SZ")
-        .to_string()
+    chrono::Utc::now().format("%Y-%m-%dT%H:%M:%SZ").to_string()
 }
 
 /// Adds the provenance to a manifest object: the fields of [`Provenance`] (`git_commit` becomes
@@ -198,11 +196,15 @@ mod tests {
         stamp(&mut end, &path, true);
         assert_eq!(end["started_utc"], "2000-01-01T00:00:00Z");
         assert!(end["ended_utc"].as_str().unwrap() >= started.as_str());
-        for k in ["host", "os", "kernel", "cpu_model", "git_commit", "git_dirty"] {
-            assert!(
-                end[k].as_str().is_some_and(|s| !s.is_empty()),
-                "{k}: {end}"
-            );
+        for k in [
+            "host",
+            "os",
+            "kernel",
+            "cpu_model",
+            "git_commit",
+            "git_dirty",
+        ] {
+            assert!(end[k].as_str().is_some_and(|s| !s.is_empty()), "{k}: {end}");
         }
         assert!(end["cpu_count"].as_u64().unwrap() >= 1);
         assert_eq!(end["threads"], 2);
