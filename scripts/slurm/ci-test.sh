@@ -172,7 +172,7 @@ EOF
 cd "$T/out"
 CPUS_PER_TASK=1 TIME_PER_SHARD=00:10:00 SUBMIT_WAIT=1 \
     timeout "$TIMEOUT" bash "$ROOT/scripts/slurm/submit.sh" "$T/plan.toml" "$T/cluster" 3 ||
-    fail "the jobs did not complete within ${TIMEOUT} s (or failed)"
+    fail "the array job or the merge step failed, or they took more than ${TIMEOUT} s"
 cd "$ROOT"
 
 for i in 1 2 3; do

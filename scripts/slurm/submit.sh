@@ -53,7 +53,14 @@ if [ "${SUBMIT_WAIT:-0}" = 1 ]; then
     echo "merge job after $JOB (waiting for it)"
     rc=0
     MJOB=$(sbatch --wait "${merge[@]}" "$DIR/merge.sbatch" "$OUT") || rc=$?
-    echo "merge job ${MJOB%%;*} ended with status $rc"
+    MJOB=${MJOB%%;*}
+    # a merge step cancelled because a shard failed can end with status 0: ask for its state
+    state=$(scontrol show job "$MJOB" 2>/dev/null | grep -o 'JobState=[A-Z_]*' | cut -d= -f2 || true)
+    echo "merge job $MJOB ended: ${state:-state no longer known}, status $rc"
+    if [ "$rc" -eq 0 ] && [ -n "$state" ] && [ "$state" != COMPLETED ]; then
+        echo "submit.sh: the merge step did not run ($state): a shard failed; see its slurm-${JOB}_*.out" >&2
+        rc=1
+    fi
     exit "$rc"
 else
     MJOB=$(sbatch "${merge[@]}" "$DIR/merge.sbatch" "$OUT")

@@ -158,9 +158,12 @@ fn best_found<'a>(d: &'a FigureData) -> BTreeMap<&'a str, f64> {
     b
 }
 
+/// A trial's row and its anytime points (clock, best so far).
+type Run<'a> = (&'a Row, Vec<(f64, f64)>);
+
 /// Each trial's anytime points, in clock order, with the trial's row.
-fn runs<'a>(d: &'a FigureData, clock: Clock) -> BTreeMap<&'a str, (&'a Row, Vec<(f64, f64)>)> {
-    let mut m: BTreeMap<&str, (&Row, Vec<(f64, f64)>)> = d
+fn runs<'a>(d: &'a FigureData, clock: Clock) -> BTreeMap<&'a str, Run<'a>> {
+    let mut m: BTreeMap<&str, Run> = d
         .rows
         .iter()
         .map(|r| (r.run_key.as_str(), (r, Vec::new())))
@@ -222,8 +225,7 @@ fn convergence(dir: &Path, d: &FigureData, clock: Clock) -> Files {
         .collect();
     let mut curves = Vec::new();
     for (i, s) in d.solvers.iter().enumerate() {
-        let mine: Vec<&(&Row, Vec<(f64, f64)>)> =
-            runs.values().filter(|r| &r.0.solver_id == s).collect();
+        let mine: Vec<&Run> = runs.values().filter(|r| &r.0.solver_id == s).collect();
         let pts = grid
             .iter()
             .filter_map(|&t| {

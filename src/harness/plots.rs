@@ -476,6 +476,9 @@ impl Ranged for TickRange {
 }
 
 type Coord = Cartesian2d<TickRange, TickRange>;
+type Area<DB> = DrawingArea<DB, Shift>;
+/// Points in drawing coordinates.
+type Points = Vec<(f64, f64)>;
 type Chart<'a, DB> = ChartContext<'a, DB, Coord>;
 
 /// Label sizes of a full figure and of a facet panel.
@@ -697,7 +700,7 @@ where
 fn split_with_legend<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     title: &str,
-) -> std::result::Result<(DrawingArea<DB, Shift>, DrawingArea<DB, Shift>), String>
+) -> std::result::Result<(Area<DB>, Area<DB>), String>
 where
     DB::ErrorType: 'static,
 {
@@ -940,7 +943,8 @@ pub struct CurveSpec {
     pub step: bool,
 }
 
-fn mapped(x: &Ticks, y: &Ticks, c: &Curve, step: bool) -> (Vec<(f64, f64)>, Vec<(f64, f64)>) {
+/// A curve in drawing coordinates: its line and the outline of its band.
+fn mapped(x: &Ticks, y: &Ticks, c: &Curve, step: bool) -> (Points, Points) {
     let mut pts: Vec<(f64, f64, f64, f64)> = Vec::new();
     for p in &c.points {
         let (Some(px), Some(py)) = (x.map(p.0), y.map(p.1)) else {
