@@ -71,6 +71,9 @@ pub fn parse_shard(s: &str) -> Result<(usize, usize)> {
 }
 
 pub fn check(a: CheckArgs) -> Result<()> {
+    if a.shards == 0 || a.threads == Some(0) {
+        bail!("--shards and --threads must be at least 1");
+    }
     let plan = Plan::load(&a.plan)?;
     say!(
         "ok: {} instances x {} solvers x {} replicates = {} trials (reference {})",
