@@ -88,7 +88,8 @@ munged --force --socket="$SOCK" --key-file="$T/munge/munge.key" \
 PIDS+=("$(cat "$T/run/munged.pid")")
 munge --socket="$SOCK" -n | unmunge --socket="$SOCK" >/dev/null || fail "munge round trip"
 
-# --- a minimal cgroup-free slurm.conf for this host ---
+# --- a minimal cgroup-free slurm.conf for this host (reached at 127.0.0.1, so the host name
+# need not resolve) ---
 HOST=$(hostname -s 2>/dev/null || hostname)
 NODE=$(slurmd -C | head -n 1 | sed -e "s/^NodeName=[^ ]*/NodeName=$HOST/" -e 's/ RealMemory=[0-9]*//')
 # free ports near the defaults, so a real cluster on this machine is left alone
@@ -99,7 +100,7 @@ SLURMD_PORT=$((CTLD_PORT + 1))
 while ! port_free "$SLURMD_PORT"; do SLURMD_PORT=$((SLURMD_PORT + 2)); done
 cat >"$T/slurm.conf" <<EOF
 ClusterName=cellseqci
-SlurmctldHost=$HOST
+SlurmctldHost=$HOST(127.0.0.1)
 SlurmctldPort=$CTLD_PORT
 SlurmdPort=$SLURMD_PORT
 SlurmUser=root
@@ -126,7 +127,7 @@ SelectTypeParameters=CR_CPU
 MpiDefault=none
 ReturnToService=2
 MinJobAge=600
-$NODE State=UNKNOWN
+$NODE NodeAddr=127.0.0.1 State=UNKNOWN
 PartitionName=ci Nodes=$HOST Default=YES MaxTime=INFINITE State=UP
 EOF
 export SLURM_CONF=$T/slurm.conf
