@@ -1077,7 +1077,7 @@ where
                 .color(&BLACK)
                 .pos(Pos::new(HPos::Center, VPos::Center));
             area.draw(&Text::new(
-                "no curve: fewer than half of the runs have a value",
+                "no median: most runs without a value",
                 (w as i32 / 2 + PANEL.y_area as i32 / 2, h as i32 / 2),
                 font,
             ))
