@@ -225,15 +225,45 @@ pub fn report(dir: &Path, out: &Path) -> Result<ReportFiles> {
         } else {
             ""
         };
+        // merged shards: the earliest start, the latest end (when every shard ended), every host
+        let parts: Vec<&serde_json::Value> = m["merged_from"]
+            .as_array()
+            .filter(|a| !a.is_empty())
+            .map(|a| a.iter().collect())
+            .unwrap_or_else(|| vec![m]);
+        let started = parts
+            .iter()
+            .filter_map(|p| p["started_utc"].as_str())
+            .min()
+            .unwrap_or("?");
+        let ends: Vec<&str> = parts
+            .iter()
+            .filter_map(|p| p["ended_utc"].as_str())
+            .collect();
+        let ended = if ends.len() == parts.len() {
+            ends.into_iter().max().unwrap_or("?")
+        } else {
+            "– (not finished)"
+        };
+        let hosts: BTreeSet<&str> = parts.iter().filter_map(|p| p["host"].as_str()).collect();
+        let hosts = if hosts.is_empty() {
+            "?".to_string()
+        } else {
+            hosts.into_iter().collect::<Vec<_>>().join(", ")
+        };
+        let shards = if parts.len() > 1 {
+            format!(" ({} merged parts)", parts.len())
+        } else {
+            String::new()
+        };
         let _ = writeln!(
             md,
-            "Run: cellseq {} (commit {}{dirty}), plan hash `{}`, {} thread(s) on host {} ({} × {}; {}, kernel {}), \
-             calibration unit {} s; started {}, ended {}.\n",
+            "Run{shards}: cellseq {} (commit {}{dirty}), plan hash `{}`, {} thread(s) on host {hosts} ({} × {}; {}, kernel {}), \
+             calibration unit {} s; started {started}, ended {ended}.\n",
             txt("crate_version"),
             m["git_commit"].as_str().unwrap_or("unknown"),
             txt("plan_hash"),
             m["threads"],
-            txt("host"),
             m["cpu_count"],
             txt("cpu_model"),
             txt("os"),
@@ -242,8 +272,6 @@ pub fn report(dir: &Path, out: &Path) -> Result<ReportFiles> {
                 .as_f64()
                 .map(fmt)
                 .unwrap_or_else(|| "?".into()),
-            txt("started_utc"),
-            m["ended_utc"].as_str().unwrap_or("– (not finished)")
         );
     }
 
