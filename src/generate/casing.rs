@@ -478,6 +478,37 @@ mod tests {
         }
     }
 
+    /// The model's own optimum of the example (Held-Karp over all orders and directions):
+    /// 1-2-6-5-4-3-7-8, one lift, 7105.3 mm; tabu reaches it.
+    #[test]
+    fn paper_example_optimum() {
+        let inst = paper_example();
+        let solve = |name: &str| {
+            crate::solvers::run(
+                name,
+                &inst,
+                Objective::Air,
+                &BTreeMap::new(),
+                1,
+                crate::solvers::Budget {
+                    time_limit: None,
+                    max_evals: Some(200_000),
+                },
+                &mut crate::solvers::NoObserver,
+            )
+            .unwrap()
+        };
+        let exact = solve("exact");
+        assert!(exact.outcome.proven_optimal);
+        let best = seq(&[(0, 0), (2, 1), (1, 1), (3, 0)]);
+        let r = check(&inst, &best, Objective::Air).unwrap();
+        assert!((r.path_length - 7105.3).abs() < 0.05, "{}", r.path_length);
+        assert_eq!(r.lifts, 1);
+        assert!((exact.outcome.cost - r.cost).abs() < 1e-6);
+        let tabu = check(&inst, &solve("tabu").outcome.sequence, Objective::Air).unwrap();
+        assert!((tabu.cost - r.cost).abs() < 1e-6);
+    }
+
     #[test]
     fn blocks_stop_links_across_them_but_not_past_their_ends() {
         let inst = paper_example();
