@@ -116,3 +116,32 @@ fn blocks_and_corridors() {
     );
     assert_eq!(along, Some(8.0));
 }
+
+/// A keep-out area with its corners swapped or a value that is not finite is refused with the
+/// file and the area's index.
+#[test]
+fn bad_keep_out_areas_are_refused() {
+    for bad in [
+        KeepOut {
+            x0: 5.0,
+            y0: 0.0,
+            x1: 1.0,
+            y1: 1.0,
+            top: 0.0,
+        },
+        KeepOut {
+            x0: 0.0,
+            y0: 0.0,
+            x1: 1.0,
+            y1: 1.0,
+            top: f64::NAN,
+        },
+    ] {
+        let mut inst = instance(&[(0, 0), (1, 1), (2, 2), (3, 3)], &[]);
+        inst.machine.keep_out.push(bad);
+        let e = cellseq::validate::validate(&inst, "part.json")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("part.json") && e.contains("keep_out 0"), "{e}");
+    }
+}
