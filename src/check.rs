@@ -4,7 +4,7 @@
 //! walks the raw instance, re-derives every move from the machine description, and so catches
 //! any disagreement between what a solver believes and what the sequence really costs.
 
-use crate::model::{Instance, Objective, Sequence};
+use crate::model::{Instance, Machine, Objective, Sequence};
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
@@ -186,6 +186,53 @@ fn dist3(a: [f64; 3], b: [f64; 3]) -> f64 {
     ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
 }
 
+/// The length of a same-depth move from `from` to `to` that stays at depth: the straight line
+/// when no keep-out area stands in its way, else an axis-parallel dog-leg (x first or y first)
+/// that passes them, else `None` (the cutter must lift).
+pub fn at_depth_length(m: &Machine, from: [f64; 3], to: [f64; 3]) -> Option<f64> {
+    let (dx, dy) = (to[0] - from[0], to[1] - from[1]);
+    if !link_blocked(m, from, to) {
+        return Some((dx * dx + dy * dy).sqrt());
+    }
+    for corner in [[to[0], from[1], from[2]], [from[0], to[1], from[2]]] {
+        if !link_blocked(m, from, corner) && !link_blocked(m, corner, to) {
+            return Some(dx.abs() + dy.abs());
+        }
+    }
+    None
+}
+
+/// Whether a same-depth move from `from` to `to` crosses material of one of the machine's
+/// keep-out areas standing above that depth, so that the cutter must lift. Separating-axis
+/// test of the segment against each area shrunk by 1 µm (touching the boundary is free).
+pub fn link_blocked(m: &Machine, from: [f64; 3], to: [f64; 3]) -> bool {
+    const EPS: f64 = 1e-6;
+    m.keep_out.iter().any(|k| {
+        if k.top <= from[2] + 1e-9 {
+            return false;
+        }
+        let (x0, x1, y0, y1) = (k.x0 + EPS, k.x1 - EPS, k.y0 + EPS, k.y1 - EPS);
+        if x0 >= x1 || y0 >= y1 {
+            return false;
+        }
+        // the box's own axes
+        if from[0].max(to[0]) <= x0 || from[0].min(to[0]) >= x1 {
+            return false;
+        }
+        if from[1].max(to[1]) <= y0 || from[1].min(to[1]) >= y1 {
+            return false;
+        }
+        // the segment's normal: every corner on one side (or on the line) separates
+        let (nx, ny) = (from[1] - to[1], to[0] - from[0]);
+        if nx == 0.0 && ny == 0.0 {
+            return true; // a point strictly inside the box
+        }
+        let side = |x: f64, y: f64| nx * (x - from[0]) + ny * (y - from[1]);
+        let c = [side(x0, y0), side(x0, y1), side(x1, y0), side(x1, y1)];
+        !(c.iter().all(|&v| v >= 0.0) || c.iter().all(|&v| v <= 0.0))
+    })
+}
+
 fn geometric_report(inst: &Instance, seq: &Sequence, objective: Objective) -> Report {
     let m = &inst.machine;
     let h = m.clearance;
@@ -238,9 +285,14 @@ fn geometric_report(inst: &Instance, seq: &Sequence, objective: Objective) -> Re
                     let planar =
                         ((pexit[0] - entry[0]).powi(2) + (pexit[1] - entry[1]).powi(2)).sqrt();
                     let same_depth = (pexit[2] - entry[2]).abs() <= 1e-9;
-                    if same_depth && planar <= m.link_distance + 1e-9 {
-                        r.air_length += planar;
-                        link_time += planar * 60.0 / feed;
+                    let link = if same_depth && planar <= m.link_distance + 1e-9 {
+                        at_depth_length(m, pexit, entry).filter(|&d| d <= m.link_distance + 1e-9)
+                    } else {
+                        None
+                    };
+                    if let Some(d) = link {
+                        r.air_length += d;
+                        link_time += d * 60.0 / feed;
                     } else {
                         r.lifts += 1;
                         rapid += (h - pexit[2]) + planar + (h - entry[2]);

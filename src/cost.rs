@@ -32,6 +32,8 @@ struct Geo {
     initial_tool: Option<u32>,
     /// highest entry point of any node
     max_entry_z: f64,
+    /// keep-out areas of at-depth links: x0, y0, x1, y1, top
+    keep_out: Vec<[f64; 5]>,
 }
 
 /// Arc costs, mode layout, tools and precedence of an instance, ready for search.
@@ -135,6 +137,11 @@ impl CostModel {
             let max_entry_z = entry.iter().map(|p| p.z).fold(f64::NEG_INFINITY, f64::max);
             let geo = Geo {
                 max_entry_z,
+                keep_out: m
+                    .keep_out
+                    .iter()
+                    .map(|k| [k.x0, k.y0, k.x1, k.y1, k.top])
+                    .collect(),
                 entry,
                 exit,
                 clearance: m.clearance,
@@ -412,11 +419,18 @@ impl CostModel {
         if self.tools[a] == self.tools[b] {
             let dxy = ex.dist_xy(&en);
             if (ex.z - en.z).abs() <= 1e-9 && dxy <= g.link_distance + 1e-9 {
-                // linked at cutting feed, no lift
-                return match self.objective {
-                    Objective::Time => dxy * self.cut_rate[b],
-                    _ => dxy,
+                let d = if g.keep_out.is_empty() {
+                    Some(dxy)
+                } else {
+                    link_path(&g.keep_out, ex, en, dxy)
                 };
+                if let Some(d) = d.filter(|&d| d <= g.link_distance + 1e-9) {
+                    // linked at cutting feed, no lift
+                    return match self.objective {
+                        Objective::Time => d * self.cut_rate[b],
+                        _ => d,
+                    };
+                }
             }
             let air = (g.clearance - ex.z) + dxy + (g.clearance - en.z);
             self.scale(g, air, 1, 0, 0.0)
@@ -484,4 +498,50 @@ impl CostModel {
         }
         best
     }
+}
+
+/// The length of the at-depth move from `a` to `b` (planar distance `dxy`) past the keep-out
+/// areas: the straight move when it is clear, else the shorter clear dog-leg of an axial and
+/// a circumferential leg (either order, `|dx| + |dy|`), else `None` (the cutter lifts).
+fn link_path(keep_out: &[[f64; 5]], a: Point3, b: Point3, dxy: f64) -> Option<f64> {
+    if !link_blocked(keep_out, a, b) {
+        return Some(dxy);
+    }
+    let corners = [Point3::new(b.x, a.y, a.z), Point3::new(a.x, b.y, a.z)];
+    corners
+        .iter()
+        .any(|&c| !link_blocked(keep_out, a, c) && !link_blocked(keep_out, c, b))
+        .then(|| (b.x - a.x).abs() + (b.y - a.y).abs())
+}
+
+/// Whether the straight at-depth move from `a` to `b` crosses the inside of a keep-out area
+/// (`[x0, y0, x1, y1, top]`) whose top stands above `a.z`: Liang–Barsky clipping of the
+/// segment against the area shrunk by 1 µm, so a move that touches or follows the boundary
+/// is free.
+fn link_blocked(keep_out: &[[f64; 5]], a: Point3, b: Point3) -> bool {
+    const EPS: f64 = 1e-6;
+    keep_out.iter().any(|k| {
+        if k[4] <= a.z + 1e-9 {
+            return false;
+        }
+        let (mut t0, mut t1) = (0.0f64, 1.0f64);
+        for (p, d, lo, hi) in [
+            (a.x, b.x - a.x, k[0] + EPS, k[2] - EPS),
+            (a.y, b.y - a.y, k[1] + EPS, k[3] - EPS),
+        ] {
+            if lo >= hi {
+                return false;
+            }
+            if d.abs() < 1e-12 {
+                if p <= lo || p >= hi {
+                    return false;
+                }
+            } else {
+                let (u, v) = ((lo - p) / d, (hi - p) / d);
+                t0 = t0.max(u.min(v));
+                t1 = t1.min(u.max(v));
+            }
+        }
+        t0 < t1
+    })
 }

@@ -198,6 +198,27 @@ pub struct Machine {
     /// Tool in the spindle at the start; loading a different first tool counts as a change.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub initial_tool: Option<String>,
+    /// Material that stands in the way of at-depth links (islands, bosses): a same-depth move
+    /// whose straight path crosses the inside of one of these areas, below its top, lifts
+    /// whatever its length. Empty: links depend on depth and `link_distance` alone.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub keep_out: Vec<KeepOut>,
+}
+
+/// An axis-aligned area the tool centre cannot cross at depths below `top` (a boss or island
+/// grown by the tool radius). Its boundary is free: a move may touch or follow it.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct KeepOut {
+    /// Lowest x of the area (mm).
+    pub x0: f64,
+    /// Lowest y of the area (mm).
+    pub y0: f64,
+    /// Highest x of the area (mm).
+    pub x1: f64,
+    /// Highest y of the area (mm).
+    pub y1: f64,
+    /// Height of the material's top: moves at z below it are blocked (mm).
+    pub top: f64,
 }
 
 impl Default for Machine {
@@ -213,6 +234,7 @@ impl Default for Machine {
             return_home: false,
             link_distance: 0.0,
             initial_tool: None,
+            keep_out: Vec::new(),
         }
     }
 }

@@ -91,6 +91,18 @@ pub fn validate(inst: &Instance, file: &str) -> Result<()> {
         if !m.home.is_finite() || !m.tool_change.is_finite() {
             return bad("machine home or tool-change point is not finite".into());
         }
+        for (i, k) in m.keep_out.iter().enumerate() {
+            if ![k.x0, k.y0, k.x1, k.y1, k.top]
+                .iter()
+                .all(|v| v.is_finite())
+                || k.x0 > k.x1
+                || k.y0 > k.y1
+            {
+                return bad(format!(
+                    "machine keep_out {i}: x0 <= x1, y0 <= y1 and finite values expected"
+                ));
+            }
+        }
         for t in &inst.tools {
             if !(t.diameter.is_finite() && t.diameter > 0.0) {
                 return bad(format!(

@@ -240,7 +240,16 @@ fn panel_reversed_rule4_reverses_edges() {
 
 #[test]
 fn casing_layers_and_regions() {
-    let inst = generate("casing", &params(&[("regions", "3"), ("features", "6")]), 5).unwrap();
+    let inst = generate(
+        "casing",
+        &params(&[
+            ("regions", "3"),
+            ("features", "6"),
+            ("region_first", "true"),
+        ]),
+        5,
+    )
+    .unwrap();
     // first layer (w = 0.15): no features yet, one sub-region per region
     assert_eq!(inst.cells.iter().filter(|c| c.layer == 0).count(), 3);
     assert_eq!(inst.tools.len(), 1);

@@ -91,8 +91,15 @@ pub fn breakdown(inst: &Instance, seq: &Sequence) -> Option<Breakdown> {
             }
             Some((pexit, _)) => {
                 let planar = ((pexit[0] - entry[0]).powi(2) + (pexit[1] - entry[1]).powi(2)).sqrt();
-                if (pexit[2] - entry[2]).abs() <= 1e-9 && planar <= m.link_distance + 1e-9 {
-                    link = planar;
+                let at_depth =
+                    if (pexit[2] - entry[2]).abs() <= 1e-9 && planar <= m.link_distance + 1e-9 {
+                        crate::check::at_depth_length(m, pexit, entry)
+                            .filter(|&d| d <= m.link_distance + 1e-9)
+                    } else {
+                        None
+                    };
+                if let Some(d) = at_depth {
+                    link = d;
                 } else {
                     lift = 1;
                     rapid = (h - pexit[2]) + planar + (h - entry[2]);

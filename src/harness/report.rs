@@ -613,7 +613,7 @@ pub fn report(dir: &Path, out: &Path) -> Result<ReportFiles> {
                 .unwrap_or_default();
             let vals: Vec<f64> = rows
                 .iter()
-                .filter(|r| r.solver_id == solver && r.feasible)
+                .filter(|r| r.solver_id == solver && r.feasible && super::paper::in_figures(r))
                 .filter_map(|r| match f.metric.as_str() {
                     "reduction_pct" => r.reduction_pct,
                     "air_reduction_pct" => r.air_reduction_pct,
