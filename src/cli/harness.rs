@@ -1,16 +1,39 @@
 //! `check`, `run`, `merge`, `report`: the research harness (see `cellseq::harness`).
 
 use anyhow::{Result, bail};
-use cellseq::harness::plan::Plan;
+use cellseq::harness::plan::{Limits, Plan};
 use cellseq::harness::run::{RunOptions, run_plan};
 use cellseq::harness::{report, results};
 use clap::Args;
 use std::path::{Path, PathBuf};
 
+/// Caps on the size of a plan (the same for `check` and `run`).
+#[derive(Args, Debug, Clone, Copy)]
+pub struct LimitArgs {
+    /// Refuse plans with more trials than this (default 100000, or the plan's `max_trials`).
+    #[arg(long, value_name = "N", value_parser = crate::cli::parse_count)]
+    max_trials: Option<u64>,
+    /// Stop a file pattern that looks at more directory entries than this (default 100000, or
+    /// the plan's `max_files`).
+    #[arg(long, value_name = "N", value_parser = crate::cli::parse_count)]
+    max_files: Option<u64>,
+}
+
+impl LimitArgs {
+    fn limits(self) -> Limits {
+        Limits {
+            max_trials: self.max_trials,
+            max_files: self.max_files,
+        }
+    }
+}
+
 #[derive(Args, Debug)]
 pub struct CheckArgs {
     /// Experiment plan (TOML).
     plan: PathBuf,
+    #[command(flatten)]
+    limits: LimitArgs,
 }
 
 #[derive(Args, Debug)]
@@ -29,6 +52,8 @@ pub struct RunArgs {
     /// Testing hook: sleep this many milliseconds after each trial.
     #[arg(long, hide = true, default_value_t = 0)]
     throttle_ms: u64,
+    #[command(flatten)]
+    limits: LimitArgs,
 }
 
 #[derive(Args, Debug)]
@@ -65,13 +90,13 @@ pub fn parse_shard(s: &str) -> Result<(usize, usize)> {
 }
 
 pub fn check(a: CheckArgs) -> Result<()> {
-    let plan = Plan::load(&a.plan)?;
+    let plan = Plan::load_with(&a.plan, a.limits.limits())?;
     say!(
         "ok: {} instances x {} solvers x {} replicates = {} trials (reference {})",
         plan.instances.len(),
         plan.solvers.len(),
         plan.file.replicates,
-        plan.trials().len(),
+        plan.trial_count(),
         plan.reference
     );
     Ok(())
@@ -94,7 +119,7 @@ pub fn execute(plan: &Plan, opts: &RunOptions) -> Result<()> {
 }
 
 pub fn run(a: RunArgs) -> Result<()> {
-    let plan = Plan::load(&a.plan)?;
+    let plan = Plan::load_with(&a.plan, a.limits.limits())?;
     let shard = a.shard.as_deref().map(parse_shard).transpose()?;
     if a.threads == Some(0) {
         bail!("--threads must be at least 1");
