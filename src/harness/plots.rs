@@ -49,15 +49,25 @@ fn color(i: usize) -> RGBColor {
 macro_rules! both {
     ($dir:expr, $name:expr, $out:expr, $f:expr) => {{
         register();
+        // drawn in memory, written through the safe write of `formats::write_atomic`
         let png: PathBuf = $dir.join(format!("{}.png", $name));
         {
-            let root = BitMapBackend::new(&png, SIZE).into_drawing_area();
-            $f(root)?;
+            let mut rgb = vec![0u8; SIZE.0 as usize * SIZE.1 as usize * 3];
+            {
+                let root = BitMapBackend::with_buffer(&mut rgb, SIZE).into_drawing_area();
+                $f(root)?;
+            }
+            let bytes = crate::plot::encode_png(&rgb, SIZE.0, SIZE.1).map_err(err)?;
+            crate::formats::write_atomic(&png, &bytes).map_err(err)?;
         }
         let svg: PathBuf = $dir.join(format!("{}.svg", $name));
         {
-            let root = SVGBackend::new(&svg, SIZE).into_drawing_area();
-            $f(root)?;
+            let mut text = String::new();
+            {
+                let root = SVGBackend::with_string(&mut text, SIZE).into_drawing_area();
+                $f(root)?;
+            }
+            crate::formats::write_atomic(&svg, text.as_bytes()).map_err(err)?;
         }
         $out.push(png);
         $out.push(svg);

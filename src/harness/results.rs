@@ -368,6 +368,34 @@ impl OutFiles {
     }
 }
 
+impl OutFiles {
+    /// Refuses a run directory where any of the files is a symbolic link or not a regular
+    /// file: a link planted there would otherwise be read as this run's results (and its
+    /// target's content copied into them).
+    pub fn refuse_links(&self) -> Result<()> {
+        for p in [
+            &self.results,
+            &self.traces,
+            &self.layers,
+            &self.instances,
+            &self.manifest,
+        ] {
+            if let Ok(m) = std::fs::symlink_metadata(p) {
+                let why = if m.file_type().is_symlink() {
+                    "is a symbolic link; a run never reads or writes its tables through links \
+                     (remove it or choose another --out directory)"
+                } else if !m.is_file() {
+                    "is not a regular file"
+                } else {
+                    continue;
+                };
+                return Err(Error::invalid(p.display().to_string(), why));
+            }
+        }
+        Ok(())
+    }
+}
+
 fn files_matching(dir: &Path, prefix: &str, ext: &str) -> Result<Vec<PathBuf>> {
     let name = dir.display().to_string();
     let mut out: Vec<PathBuf> = std::fs::read_dir(dir)
