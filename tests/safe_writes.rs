@@ -228,3 +228,36 @@ fn run_refuses_a_planted_results_symlink() {
     assert!(stderr(&o).contains("symbolic link"), "{}", stderr(&o));
     assert_eq!(std::fs::read_to_string(&victim).unwrap(), "precious");
 }
+
+#[test]
+fn a_write_that_runs_out_of_room_leaves_no_temporary_file() {
+    // RLIMIT_FSIZE makes the kernel refuse writes past 16 KiB (EFBIG), as a full disk refuses
+    // them with ENOSPC: the write fails part-way, and the temporary file must go.
+    use std::os::unix::process::CommandExt;
+    let d = tempfile::tempdir().unwrap();
+    let out = d.path().join("u.json");
+    std::fs::write(&out, "old").unwrap();
+    let mut cmd = Command::new(BIN);
+    cmd.args(["generate", "uniform", "--param", "n=5000", "-o", s(&out)]);
+    // SAFETY: only async-signal-safe calls (signal, setrlimit) between fork and exec.
+    unsafe {
+        cmd.pre_exec(|| {
+            libc::signal(libc::SIGXFSZ, libc::SIG_IGN);
+            let lim = libc::rlimit {
+                rlim_cur: 16 * 1024,
+                rlim_max: 16 * 1024,
+            };
+            if libc::setrlimit(libc::RLIMIT_FSIZE, &lim) != 0 {
+                return Err(std::io::Error::last_os_error());
+            }
+            Ok(())
+        });
+    }
+    let o = cmd.output().unwrap();
+    assert!(!o.status.success());
+    let e = stderr(&o);
+    assert!(e.contains("u.json") && e.contains("too large"), "{e}");
+    assert!(!e.contains("panicked"), "{e}");
+    assert_eq!(std::fs::read_to_string(&out).unwrap(), "old");
+    assert_eq!(names(d.path()), ["u.json"], "temporary file left behind");
+}

@@ -538,6 +538,22 @@ mod tests {
     }
 
     #[test]
+    fn socket_target_is_refused() {
+        let d = tempfile::tempdir().unwrap();
+        let p = d.path().join("sock");
+        let _l = std::os::unix::net::UnixListener::bind(&p).unwrap();
+        let e = write_file(&p, b"x").unwrap_err().to_string();
+        assert!(e.contains("socket"), "{e}");
+        assert!(
+            std::fs::symlink_metadata(&p)
+                .unwrap()
+                .file_type()
+                .is_socket()
+        );
+        assert_eq!(names(d.path()), vec!["sock"]);
+    }
+
+    #[test]
     fn failed_fill_leaves_target_and_no_temporary() {
         let d = tempfile::tempdir().unwrap();
         let p = d.path().join("out.csv");
