@@ -2,7 +2,7 @@
 //!
 //! [`load_instance`] picks the reader from the extension (`.json`, `.sop`, `.pcglns`) or, failing
 //! that, from the `TYPE:` header, and validates the result. Every file cellseq writes goes
-//! through [`write`] ([`write_atomic`]).
+//! through [`write`](mod@write) ([`write_atomic`]).
 
 pub mod json;
 pub mod tsplib;
@@ -100,7 +100,7 @@ pub fn save_instance(path: &Path, inst: &Instance) -> Result<()> {
 /// Writes a whole file safely: through an exclusively created temporary sibling with a random
 /// name, `fsync` and a rename, so readers never see half a file and no planted link is followed;
 /// FIFOs and character devices are written directly, directories and other special files are
-/// refused (see [`write`] for every rule).
+/// refused (see [`write`](mod@write) for every rule).
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
     write::write_file(path, bytes)
 }
