@@ -9,7 +9,7 @@
 //!   O_NOFOLLOW`: an existing file or symbolic link at that name makes creation fail rather than
 //!   being followed). The file is written, flushed to disk (`fsync`), renamed over the target and
 //!   the directory is flushed too where the system allows it. An existing target keeps its
-//!   permission bits.
+//!   read, write and execute permission bits (set-user-id and similar bits are dropped).
 //! - **Symbolic link at the target**: the link itself is replaced by the new file; it is never
 //!   written through — unless it leads to a FIFO or a character device (`-o /dev/stdout`,
 //!   `/dev/fd/3`), which is written directly as below. This is the behaviour of `sed -i`
@@ -147,7 +147,7 @@ fn classify(path: &Path) -> Result<Target> {
         #[cfg(unix)]
         {
             use std::os::unix::fs::PermissionsExt;
-            return Ok(Target::Replace(Some(meta.permissions().mode() & 0o7777)));
+            return Ok(Target::Replace(Some(meta.permissions().mode() & 0o777)));
         }
         #[cfg(not(unix))]
         return Ok(Target::Replace(None));
