@@ -67,19 +67,40 @@ pub fn plot(inst: &Instance, seq: Option<&Sequence>, caption: &str, out: &Path) 
     let file = out.display().to_string();
     let (w, h) = picture_size(inst);
     let err = |e: String| Error::invalid(&file, format!("drawing failed: {e}"));
-    match fmt {
+    // Drawn in memory and written once, through the safe write of `formats::write_atomic`.
+    let bytes = match fmt {
         PictureFormat::Svg => {
-            let root = SVGBackend::new(out, (w, h)).into_drawing_area();
-            draw(&root, inst, seq, caption).map_err(err)?;
-            root.present().map_err(|e| err(e.to_string()))?;
+            let mut text = String::new();
+            {
+                let root = SVGBackend::with_string(&mut text, (w, h)).into_drawing_area();
+                draw(&root, inst, seq, caption).map_err(err)?;
+                root.present().map_err(|e| err(e.to_string()))?;
+            }
+            text.into_bytes()
         }
         PictureFormat::Png => {
-            let root = BitMapBackend::new(out, (w, h)).into_drawing_area();
-            draw(&root, inst, seq, caption).map_err(err)?;
-            root.present().map_err(|e| err(e.to_string()))?;
+            let mut rgb = vec![0u8; w as usize * h as usize * 3];
+            {
+                let root = BitMapBackend::with_buffer(&mut rgb, (w, h)).into_drawing_area();
+                draw(&root, inst, seq, caption).map_err(err)?;
+                root.present().map_err(|e| err(e.to_string()))?;
+            }
+            encode_png(&rgb, w, h).map_err(err)?
         }
-    }
-    Ok(())
+    };
+    crate::formats::write_atomic(out, &bytes)
+}
+
+/// Encodes an RGB8 buffer of `w` × `h` pixels as PNG.
+pub fn encode_png(rgb: &[u8], w: u32, h: u32) -> std::result::Result<Vec<u8>, String> {
+    let mut bytes = Vec::new();
+    let mut enc = png::Encoder::new(&mut bytes, w, h);
+    enc.set_color(png::ColorType::Rgb);
+    enc.set_depth(png::BitDepth::Eight);
+    let mut writer = enc.write_header().map_err(|e| e.to_string())?;
+    writer.write_image_data(rgb).map_err(|e| e.to_string())?;
+    writer.finish().map_err(|e| e.to_string())?;
+    Ok(bytes)
 }
 
 /// The XY bounding box of every entry/exit point: (xmin, xmax, ymin, ymax), padded.

@@ -29,7 +29,7 @@ pub fn demo(a: DemoArgs) -> Result<()> {
         plan.instances.len(),
         plan.solvers.len(),
         plan.file.replicates,
-        plan.trials().len(),
+        plan.trial_count(),
         plan.file.budget.label()
     );
     let opts = RunOptions {

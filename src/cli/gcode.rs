@@ -1,6 +1,7 @@
 //! `optimize`, `import` and `verify-gcode`: real programs in, better programs out.
 
 use anyhow::{Context as _, bail};
+use cellseq::formats::write::ensure_not_input;
 use cellseq::formats::{read_text, save_instance, write_atomic};
 use cellseq::io::gcode::{self, Figures, Options};
 use cellseq::io::svg;
@@ -15,6 +16,9 @@ pub struct OptimizeArgs {
     /// Output file (default: report only).
     #[arg(short = 'o', long)]
     pub output: Option<PathBuf>,
+    /// Allow the output to be the input file itself (by any path or link).
+    #[arg(long)]
+    pub overwrite_input: bool,
     /// Solver from the registry (default: greedy for G-code; for SVG/DXF the built-in
     /// `drawing` sequencer: grid greedy + 2-opt with reversal).
     #[arg(long)]
@@ -104,6 +108,9 @@ pub struct ImportArgs {
     /// Instance file to write.
     #[arg(short = 'o', long)]
     pub output: PathBuf,
+    /// Allow the output to be the input file itself (by any path or link).
+    #[arg(long)]
+    pub overwrite_input: bool,
     /// Merge blocks of the same tool.
     #[arg(long)]
     pub merge_tool_blocks: bool,
@@ -186,6 +193,9 @@ fn print_figures(before: &Figures, after: &Figures) {
 
 /// Runs `optimize`.
 pub fn optimize(a: OptimizeArgs) -> anyhow::Result<()> {
+    if let Some(o) = &a.output {
+        ensure_not_input(&a.input, o, a.overwrite_input)?;
+    }
     let fmt = format_of(&a.input, a.format.as_deref())?;
     if fmt == "svg" {
         return optimize_svg(&a);
@@ -278,6 +288,7 @@ pub fn optimize(a: OptimizeArgs) -> anyhow::Result<()> {
 
 /// Runs `import`.
 pub fn import(a: ImportArgs) -> anyhow::Result<()> {
+    ensure_not_input(&a.input, &a.output, a.overwrite_input)?;
     let fmt = format_of(&a.input, a.format.as_deref())?;
     if fmt == "svg" || fmt == "dxf" {
         let file = a.input.display().to_string();

@@ -1,11 +1,32 @@
 //! `check`, `run`, `merge`, `report`: the research harness (see `cellseq::harness`).
 
 use anyhow::{Result, bail};
-use cellseq::harness::plan::Plan;
+use cellseq::harness::plan::{Limits, Plan};
 use cellseq::harness::run::{RunOptions, run_plan};
 use cellseq::harness::{report, results};
 use clap::Args;
 use std::path::{Path, PathBuf};
+
+/// Caps on the size of a plan (the same for `check` and `run`).
+#[derive(Args, Debug, Clone, Copy)]
+pub struct LimitArgs {
+    /// Refuse plans with more trials than this (default 100000, or the plan's `max_trials`).
+    #[arg(long, value_name = "N", value_parser = crate::cli::parse_count)]
+    max_trials: Option<u64>,
+    /// Stop a file pattern that looks at more directory entries than this (default 100000, or
+    /// the plan's `max_files`).
+    #[arg(long, value_name = "N", value_parser = crate::cli::parse_count)]
+    max_files: Option<u64>,
+}
+
+impl LimitArgs {
+    fn limits(self) -> Limits {
+        Limits {
+            max_trials: self.max_trials,
+            max_files: self.max_files,
+        }
+    }
+}
 
 #[derive(Args, Debug)]
 pub struct CheckArgs {
@@ -17,6 +38,8 @@ pub struct CheckArgs {
     /// Threads per shard (for the estimate; default: all cores here).
     #[arg(long)]
     threads: Option<usize>,
+    #[command(flatten)]
+    limits: LimitArgs,
 }
 
 #[derive(Args, Debug)]
@@ -35,6 +58,8 @@ pub struct RunArgs {
     /// Testing hook: sleep this many milliseconds after each trial.
     #[arg(long, hide = true, default_value_t = 0)]
     throttle_ms: u64,
+    #[command(flatten)]
+    limits: LimitArgs,
 }
 
 #[derive(Args, Debug)]
@@ -74,13 +99,13 @@ pub fn check(a: CheckArgs) -> Result<()> {
     if a.shards == 0 || a.threads == Some(0) {
         bail!("--shards and --threads must be at least 1");
     }
-    let plan = Plan::load(&a.plan)?;
+    let plan = Plan::load_with(&a.plan, a.limits.limits())?;
     say!(
         "ok: {} instances x {} solvers x {} replicates = {} trials (reference {})",
         plan.instances.len(),
         plan.solvers.len(),
         plan.file.replicates,
-        plan.trials().len(),
+        plan.trial_count(),
         plan.reference
     );
     let threads = a.threads.unwrap_or_else(rayon::current_num_threads);
@@ -108,7 +133,7 @@ pub fn execute(plan: &Plan, opts: &RunOptions) -> Result<()> {
 }
 
 pub fn run(a: RunArgs) -> Result<()> {
-    let plan = Plan::load(&a.plan)?;
+    let plan = Plan::load_with(&a.plan, a.limits.limits())?;
     let shard = a.shard.as_deref().map(parse_shard).transpose()?;
     if a.threads == Some(0) {
         bail!("--threads must be at least 1");

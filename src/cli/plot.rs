@@ -15,10 +15,16 @@ pub struct PlotArgs {
     /// Output picture (.svg or .png).
     #[arg(short, long, value_name = "OUT.svg|OUT.png")]
     out: PathBuf,
+    /// Allow the picture to be written over the instance or solution file.
+    #[arg(long)]
+    overwrite_input: bool,
 }
 
 pub fn plot(a: PlotArgs) -> Result<()> {
     cellseq::plot::PictureFormat::of(&a.out)?;
+    for input in std::iter::once(&a.file).chain(&a.solution) {
+        formats::write::ensure_not_input(input, &a.out, a.overwrite_input)?;
+    }
     let inst = super::solve::load(&a.file)?;
     let mut caption = format!(
         "{} — {} cells, {} tools",

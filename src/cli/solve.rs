@@ -47,6 +47,9 @@ pub struct SolveArgs {
     /// Write the solution here (cellseq-solution/1 JSON).
     #[arg(long, value_name = "SOLUTION.json")]
     pub out: Option<PathBuf>,
+    /// Allow `--out` to be the instance file itself (by any path or link).
+    #[arg(long)]
+    pub overwrite_input: bool,
     /// Print one JSON object instead of the human-readable report.
     #[arg(long)]
     pub json: bool,
@@ -145,6 +148,9 @@ pub fn validate(a: ValidateArgs) -> Result<()> {
 }
 
 pub fn solve(a: SolveArgs) -> Result<()> {
+    if let Some(out) = &a.out {
+        formats::write::ensure_not_input(&a.file, out, a.overwrite_input)?;
+    }
     let inst = load(&a.file)?;
     let objective = objective_of(&inst, a.objective.as_deref())?;
     let params = parse_kv(&a.params)?;

@@ -1,10 +1,12 @@
 //! Reading and writing instances and solutions.
 //!
 //! [`load_instance`] picks the reader from the extension (`.json`, `.sop`, `.pcglns`) or, failing
-//! that, from the `TYPE:` header, and validates the result.
+//! that, from the `TYPE:` header, and validates the result. Every file cellseq writes goes
+//! through [`write`](mod@write) ([`write_atomic`]).
 
 pub mod json;
 pub mod tsplib;
+pub mod write;
 
 use crate::error::{Error, Result};
 use crate::model::Instance;
@@ -95,20 +97,12 @@ pub fn save_instance(path: &Path, inst: &Instance) -> Result<()> {
     write_atomic(path, json::instance_to_json(inst).as_bytes())
 }
 
-/// Writes a file through a temporary sibling and a rename, so readers never see half a file.
+/// Writes a whole file safely: through an exclusively created temporary sibling with a random
+/// name, `fsync` and a rename, so readers never see half a file and no planted link is followed;
+/// FIFOs and character devices are written directly, directories and other special files are
+/// refused (see [`write`](mod@write) for every rule).
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
-    let file = path.display().to_string();
-    let dir = path
-        .parent()
-        .filter(|p| !p.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
-    let name = path.file_name().and_then(|s| s.to_str()).unwrap_or("out");
-    let tmp = dir.join(format!(".{name}.tmp{}", std::process::id()));
-    std::fs::write(&tmp, bytes).map_err(|e| Error::io(&file, e))?;
-    std::fs::rename(&tmp, path).map_err(|e| {
-        let _ = std::fs::remove_file(&tmp);
-        Error::io(&file, e)
-    })
+    write::write_file(path, bytes)
 }
 
 /// The name an instance file is known by in `bks.csv`: the file name without its extension.

@@ -38,7 +38,7 @@ pub fn estimate(
     threads: usize,
     calibration: impl FnOnce() -> Result<f64>,
 ) -> Result<Estimate> {
-    let trials = plan.trials().len();
+    let trials = plan.trial_count();
     let shards = shards.max(1);
     let b = &plan.file.budget;
     let mut limit: Option<f64> = b.seconds;

@@ -5,6 +5,13 @@
 //! solver. [`Plan::load`] / [`Plan::parse`] validate everything that can be validated without
 //! running: unknown solvers, generators or parameters, malformed values, missing files, globs
 //! that match nothing, empty grids, duplicate ids and a reference that is not in the plan.
+//!
+//! Hostile or mistaken plans are refused before anything runs: the `name` must be a name (it
+//! becomes the directory `results/<name>`), file patterns stay inside the plan's directory tree
+//! and are capped ([`files`]), and the number of trials is capped ([`Limits`]), counted without
+//! listing them, so `check` and `run` refuse the same plans.
+
+pub mod files;
 
 use super::hash::{hex, stable_hash, trial_seed};
 use crate::error::{Error, Result};
@@ -15,6 +22,20 @@ use crate::solvers;
 use serde::Deserialize;
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
+
+/// Default cap on the trials of a plan (plan key `max_trials`, flag `--max-trials`).
+pub const DEFAULT_MAX_TRIALS: u64 = 100_000;
+
+/// Caps a plan must stay within. Each is taken from the command line when given there, else
+/// from the plan's own key, else the default.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Limits {
+    /// Cap on instances × solver configurations × replicates (default [`DEFAULT_MAX_TRIALS`]).
+    pub max_trials: Option<u64>,
+    /// Cap on the directory entries one file pattern may visit (default
+    /// [`files::DEFAULT_MAX_FILES`]).
+    pub max_files: Option<u64>,
+}
 
 /// The plan file as written.
 #[derive(Debug, Clone, Deserialize)]
@@ -43,6 +64,12 @@ pub struct PlanFile {
     /// Published figures to print beside ours.
     #[serde(default)]
     pub paper: Option<Paper>,
+    /// Raises (or lowers) the cap on the number of trials.
+    #[serde(default)]
+    pub max_trials: Option<u64>,
+    /// Raises (or lowers) the cap on the directory entries one file pattern may visit.
+    #[serde(default)]
+    pub max_files: Option<u64>,
 }
 
 fn one() -> u64 {
@@ -229,6 +256,33 @@ pub struct Plan {
     pub reference: String,
 }
 
+/// Checks that a plan `name` is a plain name, usable as one directory name under `results/`:
+/// not empty, at most 100 characters, no `/`, `\\`, `:` or control characters, not starting with
+/// `.` (so neither `.`, `..` nor a hidden name).
+pub fn check_name(name: &str) -> std::result::Result<(), String> {
+    let why = if name.trim().is_empty() {
+        "is empty"
+    } else if name.chars().count() > 100 {
+        "is longer than 100 characters"
+    } else if name.contains(['/', '\\']) {
+        "holds a path separator ('/' or '\\')"
+    } else if name.contains(':') {
+        "holds ':'"
+    } else if name.chars().any(char::is_control) {
+        "holds a control character"
+    } else if name.starts_with('.') {
+        "starts with '.'"
+    } else if name != name.trim() {
+        "starts or ends with white space"
+    } else {
+        return Ok(());
+    };
+    Err(format!(
+        "plan name {name:?} {why}; the name becomes the directory results/<name>, so it must be \
+         a plain name such as \"sop-quick\""
+    ))
+}
+
 fn value_text(v: &toml::Value) -> Option<String> {
     match v {
         toml::Value::String(s) => Some(s.clone()),
@@ -244,7 +298,21 @@ fn expand_grid(
     file: &str,
     what: &str,
     grid: &BTreeMap<String, toml::Value>,
+    cap: u64,
 ) -> Result<Vec<BTreeMap<String, String>>> {
+    let points = grid.values().try_fold(1u64, |acc, v| match v {
+        toml::Value::Array(a) => acc.checked_mul(a.len().max(1) as u64),
+        _ => Some(acc),
+    });
+    if points.is_none_or(|p| p > cap) {
+        return Err(Error::invalid(
+            file,
+            format!(
+                "{what}: the grid has more than {cap} points (the trial cap); shrink it, or \
+                 raise the cap with the plan key max_trials or the --max-trials flag"
+            ),
+        ));
+    }
     let mut out = vec![BTreeMap::new()];
     for (k, v) in grid {
         let values: Vec<String> = match v {
@@ -296,15 +364,34 @@ fn params_suffix(p: &BTreeMap<String, String>) -> String {
 impl Plan {
     /// Reads and validates a plan file; relative paths are resolved against its directory.
     pub fn load(path: &Path) -> Result<Plan> {
+        Plan::load_with(path, Limits::default())
+    }
+
+    /// [`Plan::load`] with caps given on the command line.
+    pub fn load_with(path: &Path, limits: Limits) -> Result<Plan> {
         let text = crate::formats::read_text(path)?;
         let base = path.parent().unwrap_or(Path::new(".")).to_path_buf();
-        Plan::parse(&path.display().to_string(), &text, &base)
+        Plan::parse_with(&path.display().to_string(), &text, &base, limits)
     }
 
     /// Parses and validates plan text. `file` names the plan in errors.
     pub fn parse(file: &str, text: &str, base: &Path) -> Result<Plan> {
+        Plan::parse_with(file, text, base, Limits::default())
+    }
+
+    /// [`Plan::parse`] with caps given on the command line.
+    pub fn parse_with(file: &str, text: &str, base: &Path, limits: Limits) -> Result<Plan> {
         let pf: PlanFile = toml::from_str(text).map_err(|e| Error::invalid(file, e.to_string()))?;
         let bad = |m: String| Error::invalid(file, m);
+        check_name(&pf.name).map_err(bad)?;
+        let max_trials = limits
+            .max_trials
+            .or(pf.max_trials)
+            .unwrap_or(DEFAULT_MAX_TRIALS);
+        let max_files = limits
+            .max_files
+            .or(pf.max_files)
+            .unwrap_or(files::DEFAULT_MAX_FILES);
         if pf.replicates == 0 {
             return Err(bad("replicates must be at least 1".into()));
         }
@@ -355,16 +442,17 @@ impl Plan {
                         )));
                     }
                     for pat in &spec.files {
-                        let full = base.join(pat);
-                        let full_s = full.display().to_string();
-                        let mut found: Vec<PathBuf> = glob::glob(&full_s)
-                            .map_err(|e| bad(format!("{what}: bad pattern '{pat}': {e}")))?
-                            .filter_map(|p| p.ok())
-                            .filter(|p| p.is_file())
-                            .collect();
-                        found.sort();
+                        let full_s = base.join(pat).display().to_string();
+                        let found = files::expand(base, pat, max_files)
+                            .map_err(|e| bad(format!("{what}: {e}")))?;
                         if found.is_empty() {
                             return Err(bad(format!("{what}: '{pat}' matches no file ({full_s})")));
+                        }
+                        if (instances.len() + found.len()) as u64 > max_trials {
+                            return Err(bad(format!(
+                                "{what}: more than {max_trials} instances (the trial cap); \
+                                 raise it with the plan key max_trials or --max-trials"
+                            )));
                         }
                         for p in found {
                             instances.push(InstanceRef {
@@ -385,7 +473,7 @@ impl Plan {
                     if seeds.is_empty() {
                         return Err(bad(format!("{what}: empty seeds list")));
                     }
-                    for params in expand_grid(file, &what, &spec.grid)? {
+                    for params in expand_grid(file, &what, &spec.grid, max_trials)? {
                         Params::new(kind, info.params, &params)
                             .map_err(|e| bad(format!("{what}: {e}")))?;
                         for &seed in &seeds {
@@ -434,7 +522,7 @@ impl Plan {
                 continue;
             }
             let info = solvers::find(&spec.name).map_err(|e| bad(format!("{what}: {e}")))?;
-            for params in expand_grid(file, &what, &spec.params)? {
+            for params in expand_grid(file, &what, &spec.params, max_trials)? {
                 Params::new(info.name, info.params, &params)
                     .map_err(|e| bad(format!("{what}: {e}")))?;
                 let id = if params.is_empty() {
@@ -487,6 +575,20 @@ impl Plan {
                 }
             }
         }
+        let trials = (instances.len() as u64)
+            .checked_mul(solvers_out.len() as u64)
+            .and_then(|x| x.checked_mul(u64::from(pf.replicates)));
+        if trials.is_none_or(|t| t > max_trials) {
+            return Err(bad(format!(
+                "{} instances x {} solvers x {} replicates = {} trials, more than the cap of \
+                 {max_trials}; shrink the plan, or raise the cap with the plan key max_trials \
+                 or the --max-trials flag",
+                instances.len(),
+                solvers_out.len(),
+                pf.replicates,
+                trials.map_or_else(|| "too many".to_string(), |t| t.to_string()),
+            )));
+        }
         Ok(Plan {
             hash: hex(stable_hash(&[text.as_bytes()])),
             text: text.to_string(),
@@ -496,6 +598,11 @@ impl Plan {
             objective,
             reference,
         })
+    }
+
+    /// The number of trials, counted without listing them (at most the plan's trial cap).
+    pub fn trial_count(&self) -> u64 {
+        self.instances.len() as u64 * self.solvers.len() as u64 * u64::from(self.file.replicates)
     }
 
     /// Every trial in plan order: instance-major, then solver, then replicate.
@@ -595,6 +702,79 @@ name = "as-given"
             assert!(e.contains(want), "{e} should mention {want}");
             assert!(e.starts_with("plan.toml"), "{e}");
         }
+    }
+
+    #[test]
+    fn plan_names_are_names_not_paths() {
+        for bad in [
+            "../../x", "/tmp/x", "a/b", "a\\b", "", "  ", ".", "..", ".hidden", "a\nb", "c:x", " x",
+        ] {
+            let text = OK.replace("name = \"t\"", &format!("name = {bad:?}"));
+            let e = parse(&text).unwrap_err().to_string();
+            assert!(e.contains("plan name"), "{bad:?}: {e}");
+            assert!(e.starts_with("plan.toml"), "{e}");
+        }
+        for good in ["sop-quick", "paper casing", "run_2", "ünïcode"] {
+            let text = OK.replace("name = \"t\"", &format!("name = {good:?}"));
+            assert!(parse(&text).is_ok(), "{good:?} refused");
+        }
+    }
+
+    #[test]
+    fn a_million_replicates_are_refused_without_listing_trials() {
+        let text = OK.replace("replicates = 2", "replicates = 1000000");
+        let e = parse(&text).unwrap_err().to_string();
+        assert!(
+            e.contains("8000000 trials") && e.contains("max_trials"),
+            "{e}"
+        );
+        let text = OK.replace("replicates = 2", "replicates = 4294967295");
+        assert!(parse(&text).is_err());
+        // the cap can be raised by the plan or by the caller, and the count is arithmetic
+        let raised = OK.replace(
+            "replicates = 2",
+            "replicates = 1000000\nmax_trials = 8000000",
+        );
+        let p = parse(&raised).unwrap();
+        assert_eq!(p.trial_count(), 8_000_000);
+        let limits = Limits {
+            max_trials: Some(8_000_000),
+            max_files: None,
+        };
+        let text = OK.replace("replicates = 2", "replicates = 1000000");
+        let p = Plan::parse_with("plan.toml", &text, Path::new("."), limits).unwrap();
+        assert_eq!(p.trial_count(), 8_000_000);
+        // a lowered cap refuses a small plan
+        let low = OK.replace("replicates = 2", "replicates = 2\nmax_trials = 15");
+        assert!(parse(&low).unwrap_err().to_string().contains("16 trials"));
+    }
+
+    #[test]
+    fn huge_grids_are_refused_before_expansion() {
+        let big: Vec<String> = (1..=1000).map(|i| i.to_string()).collect();
+        let axis = format!("[{}]", big.join(","));
+        let text = OK.replace(
+            "grid = { n = [5, 8], tools = 2 }",
+            &format!("grid = {{ n = {axis}, seed_offset = {axis}, x = {axis} }}"),
+        );
+        let e = parse(&text).unwrap_err().to_string();
+        assert!(e.contains("grid has more than"), "{e}");
+    }
+
+    #[test]
+    fn file_patterns_outside_the_plan_tree_are_refused() {
+        let text = OK.replace(
+            "[[instances]]\ngenerator = \"uniform\"\nseeds = [1, 2]\ngrid = { n = [5, 8], tools = 2 }",
+            "[[instances]]\nfiles = [\"../../**/*.sop\"]",
+        );
+        let e = parse(&text).unwrap_err().to_string();
+        assert!(e.contains("absolute pattern"), "{e}");
+        let text = OK.replace(
+            "[[instances]]\ngenerator = \"uniform\"\nseeds = [1, 2]\ngrid = { n = [5, 8], tools = 2 }",
+            "[[instances]]\nfiles = [\"/**/*\"]",
+        );
+        let e = parse(&text).unwrap_err().to_string();
+        assert!(e.contains("more than 100000"), "{e}");
     }
 
     #[test]

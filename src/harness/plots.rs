@@ -713,15 +713,25 @@ where
 macro_rules! both {
     ($dir:expr, $name:expr, $size:expr, $f:expr) => {{
         register();
+        // drawn in memory, written through the safe write of `formats::write_atomic`
         let png: PathBuf = $dir.join(format!("{}.png", $name));
         {
-            let root = BitMapBackend::new(&png, $size).into_drawing_area();
-            $f(root)?;
+            let mut rgb = vec![0u8; $size.0 as usize * $size.1 as usize * 3];
+            {
+                let root = BitMapBackend::with_buffer(&mut rgb, $size).into_drawing_area();
+                $f(root)?;
+            }
+            let bytes = crate::plot::encode_png(&rgb, $size.0, $size.1).map_err(err)?;
+            crate::formats::write_atomic(&png, &bytes).map_err(err)?;
         }
         let svg: PathBuf = $dir.join(format!("{}.svg", $name));
         {
-            let root = SVGBackend::new(&svg, $size).into_drawing_area();
-            $f(root)?;
+            let mut text = String::new();
+            {
+                let root = SVGBackend::with_string(&mut text, $size).into_drawing_area();
+                $f(root)?;
+            }
+            crate::formats::write_atomic(&svg, text.as_bytes()).map_err(err)?;
         }
         Ok(vec![png, svg])
     }};

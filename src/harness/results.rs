@@ -7,7 +7,7 @@
 use crate::error::{Error, Result};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeSet;
-use std::fs::{File, OpenOptions};
+use std::fs::File;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
@@ -313,17 +313,11 @@ pub struct Appender {
 }
 
 impl Appender {
-    /// Opens (creating with a header when new or empty) for appending.
+    /// Opens (creating with a header when new or empty) for appending. A symbolic link or any
+    /// other non-regular file at `path` is refused, never followed.
     pub fn open<T: Serialize + Default>(path: &Path) -> Result<Appender> {
         let name = path.display().to_string();
-        let fresh = std::fs::metadata(path)
-            .map(|m| m.len() == 0)
-            .unwrap_or(true);
-        let mut file = OpenOptions::new()
-            .create(true)
-            .append(true)
-            .open(path)
-            .map_err(|e| Error::io(&name, e))?;
+        let (mut file, fresh) = crate::formats::write::open_append(path)?;
         if fresh {
             file.write_all(&header::<T>()?)
                 .map_err(|e| Error::io(&name, e))?;
@@ -371,6 +365,34 @@ impl OutFiles {
             instances: dir.join(format!("instances{suffix}.csv")),
             manifest: dir.join(format!("manifest{suffix}.json")),
         }
+    }
+}
+
+impl OutFiles {
+    /// Refuses a run directory where any of the files is a symbolic link or not a regular
+    /// file: a link planted there would otherwise be read as this run's results (and its
+    /// target's content copied into them).
+    pub fn refuse_links(&self) -> Result<()> {
+        for p in [
+            &self.results,
+            &self.traces,
+            &self.layers,
+            &self.instances,
+            &self.manifest,
+        ] {
+            if let Ok(m) = std::fs::symlink_metadata(p) {
+                let why = if m.file_type().is_symlink() {
+                    "is a symbolic link; a run never reads or writes its tables through links \
+                     (remove it or choose another --out directory)"
+                } else if !m.is_file() {
+                    "is not a regular file"
+                } else {
+                    continue;
+                };
+                return Err(Error::invalid(p.display().to_string(), why));
+            }
+        }
+        Ok(())
     }
 }
 

@@ -408,6 +408,7 @@ pub fn run_plan(plan: &Plan, opts: &RunOptions) -> Result<RunSummary> {
     let out = &opts.out;
     std::fs::create_dir_all(out).map_err(|e| Error::io(out.display().to_string(), e))?;
     let files = OutFiles::new(out, opts.shard);
+    files.refuse_links()?;
     let threads = opts
         .threads
         .unwrap_or_else(rayon::current_num_threads)
