@@ -38,7 +38,7 @@ pub fn estimate(
     threads: usize,
     calibration: impl FnOnce() -> Result<f64>,
 ) -> Result<Estimate> {
-    let trials = plan.trial_count();
+    let trials = usize::try_from(plan.trial_count()).unwrap_or(usize::MAX);
     let shards = shards.max(1);
     let b = &plan.file.budget;
     let mut limit: Option<f64> = b.seconds;
