@@ -376,10 +376,8 @@ fn replay(calls: &[Call]) -> Replay {
                 e[ax] = n[5];
                 centre[f] = n[2];
                 centre[sec] = n[3];
-                for k in 0..3 {
-                    if let Some(v) = n.get(6 + k) {
-                        e[3 + k] = *v;
-                    }
+                for (k, v) in n.iter().skip(6).take(3).enumerate() {
+                    e[3 + k] = *v;
                 }
                 r.feeds.push(Move {
                     arc: true,
@@ -735,12 +733,9 @@ impl Outcome {
 fn refusal_ok(msg: &str, file: &str) -> bool {
     let names_file = msg.contains(file);
     let after = msg.split(file).nth(1).unwrap_or("");
-    let has_line = after.starts_with(':') && after[1..].starts_with(|c: char| c.is_ascii_digit())
-        || msg.contains("line ")
-            && msg
-                .split("line ")
-                .skip(1)
-                .any(|s| s.starts_with(|c: char| c.is_ascii_digit()));
+    let digit_after = |s: &str| s.starts_with(|c: char| c.is_ascii_digit());
+    let has_line = (after.starts_with(':') && digit_after(&after[1..]))
+        || msg.split("line ").skip(1).any(digit_after);
     let lower = msg.to_lowercase();
     let advice = [
         "use ", "remove", "expand", "replace", "instead", "convert", "try ", "--",
@@ -764,7 +759,7 @@ fn figures(v: &serde_json::Value) -> Figures {
 }
 
 fn worse(after: f64, before: f64) -> bool {
-    !(after <= before * (1.0 + 1e-9) + 1e-9)
+    after.is_nan() || after > before * (1.0 + 1e-9) + 1e-9
 }
 
 /// Runs cellseq with `flags` on `path` and judges the result against the original.
