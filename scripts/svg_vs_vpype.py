@@ -1,0 +1,147 @@
+#!/usr/bin/env python3
+"""Benchmark: `cellseq optimize` (default options) against `vpype linesort --two-opt` on every
+SVG of the real-drawing corpus (tests/fixtures/svg/real/, sources in its SOURCES.md).
+
+For each file:
+  vpype read FILE linesort --two-opt write OUT_vpype.svg
+  cellseq optimize FILE -o OUT_cellseq.svg
+and the original and both outputs are read by ONE reader, vpype's own
+`vpype.read_multilayer_svg(path, quantization, crop=False)`, so every figure comes from the same
+code: pen-up travel = sum over layers of `LineCollection.pen_up_length()` (end of a path to the
+start of the next in the same layer; the travel from the origin and between layers is not
+counted, for either tool), pen-down length = sum of `LineCollection.length()`; both in mm
+(vpype works in CSS px, 96 per inch). The table says whether cellseq's pen-up travel is at or
+below vpype's, and the pen-down lengths beside each other (they should agree up to curve
+flattening). Not a timed test: wall times are printed for information only.
+
+  python3 -m venv /tmp/corpus-vpenv && /tmp/corpus-vpenv/bin/pip install vpype==1.15.0
+  cargo build --release
+  /tmp/corpus-vpenv/bin/python scripts/svg_vs_vpype.py [--cellseq target/release/cellseq]
+      [--dir tests/fixtures/svg/real] [--timeout 600] [--out notes/table.md] [FILE ...]
+
+Every tool runs in a child process with a timeout; a refusal or a timeout is a row of the table,
+never a silent gap.
+"""
+
+import argparse
+import glob
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import time
+
+PX_PER_MM = 96.0 / 25.4
+QUANTIZATION = 0.1  # px: curve flattening of the reader (vpype's default)
+
+
+def measure(path):
+    """(pen-up mm, pen-down mm, paths, layers) of an SVG, read by vpype's reader."""
+    import vpype
+
+    doc = vpype.read_multilayer_svg(path, QUANTIZATION, crop=False)
+    up = sum(float(layer.pen_up_length()[0]) for layer in doc.layers.values())
+    down = sum(float(layer.length()) for layer in doc.layers.values())
+    paths = sum(len(layer) for layer in doc.layers.values())
+    return up / PX_PER_MM, down / PX_PER_MM, paths, len(doc.layers)
+
+
+def run(cmd, timeout):
+    t0 = time.perf_counter()
+    try:
+        p = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout)
+    except subprocess.TimeoutExpired:
+        return None, "timeout after %ss" % timeout, time.perf_counter() - t0
+    return p.returncode, (p.stderr or p.stdout).strip(), time.perf_counter() - t0
+
+
+def one(svg, args, tmp):
+    name = os.path.basename(svg)
+    row = {"file": name}
+    try:
+        row["orig"] = measure(svg)
+    except Exception as e:  # the reader itself refuses the file
+        row["orig_error"] = "%s: %s" % (type(e).__name__, e)
+    vout = os.path.join(tmp, "vpype_" + name)
+    vpype_exe = os.path.join(os.path.dirname(sys.executable), "vpype")
+    rc, msg, dt = run([vpype_exe, "read", svg, "linesort", "--two-opt", "write", vout],
+                      args.timeout)
+    row["vpype_s"] = dt
+    if rc == 0 and os.path.exists(vout):
+        row["vpype"] = measure(vout)
+    else:
+        row["vpype_error"] = msg.splitlines()[-1] if msg else "exit %s" % rc
+    cout = os.path.join(tmp, "cellseq_" + name)
+    rc, msg, dt = run([args.cellseq, "optimize", svg, "-o", cout], args.timeout)
+    row["cellseq_s"] = dt
+    if rc == 0 and os.path.exists(cout):
+        row["cellseq"] = measure(cout)
+    else:
+        row["cellseq_error"] = msg.splitlines()[-1] if msg else "exit %s" % rc
+    return row
+
+
+def fmt(row):
+    cell = lambda s: str(s).replace("|", "\\|")[:150]
+    o, v, c = row.get("orig"), row.get("vpype"), row.get("cellseq")
+    up = lambda m: "%.1f" % m[0] if m else "—"
+    down = lambda m: "%.1f" % m[1] if m else "—"
+    ratio, verdict = "—", "**no** (no output)"
+    if v and c:
+        ratio = "%.3f" % (c[0] / v[0]) if v[0] > 0 else ("1.000" if c[0] == 0 else "inf")
+        verdict = "yes" if c[0] <= v[0] * (1 + 1e-9) + 1e-6 else "**no**"
+    elif not v:
+        verdict = "n/a (vpype failed)"
+    notes = []
+    for k in ("orig_error", "vpype_error", "cellseq_error"):
+        if k in row:
+            notes.append("%s: %s" % (k.split("_")[0], cell(row[k])))
+    if o and c and o[1] > 0 and abs(c[1] - o[1]) > 0.01 * o[1]:
+        notes.append("cellseq pen-down differs from the original by %.1f %%"
+                     % (100 * (c[1] - o[1]) / o[1]))
+    paths = "%d / %d" % (o[2], o[3]) if o else "—"
+    return "| %s | %s | %s | %s | %s | %s | %s | %s / %s / %s | %.1f / %.1f | %s |" % (
+        row["file"], paths, up(o), up(v), up(c), ratio, verdict, down(o), down(v), down(c),
+        row.get("vpype_s", 0), row.get("cellseq_s", 0), "; ".join(notes))
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    ap.add_argument("files", nargs="*")
+    ap.add_argument("--dir", default=os.path.join(root, "tests/fixtures/svg/real"))
+    ap.add_argument("--cellseq", default=os.path.join(root, "target/release/cellseq"))
+    ap.add_argument("--timeout", type=float, default=600)
+    ap.add_argument("--out", help="also write the Markdown table here")
+    args = ap.parse_args()
+    files = args.files or sorted(glob.glob(os.path.join(args.dir, "*.svg")))
+    if not files:
+        sys.exit("no SVG files found")
+    head = ["| file | paths / layers | pen-up original (mm) | vpype two-opt | cellseq default "
+            "| cellseq / vpype | cellseq ≤ vpype | pen-down orig / vpype / cellseq (mm) "
+            "| wall s vpype / cellseq | notes |",
+            "|---|---|---:|---:|---:|---:|---|---|---|---|"]
+    print("\n".join(head), flush=True)
+    lines, rows = list(head), []
+    with tempfile.TemporaryDirectory() as tmp:
+        for f in files:
+            row = one(f, args, tmp)
+            rows.append(row)
+            lines.append(fmt(row))
+            print(lines[-1], flush=True)
+    ok = sum(1 for r in rows if r.get("vpype") and r.get("cellseq")
+             and r["cellseq"][0] <= r["vpype"][0] * (1 + 1e-9) + 1e-6)
+    refused = sum(1 for r in rows if "cellseq_error" in r)
+    summary = ("\ncellseq's default is at or below vpype linesort --two-opt on %d of %d files "
+               "(%d refused or failed)." % (ok, len(rows), refused))
+    print(summary)
+    lines.append(summary)
+    if args.out:
+        with open(args.out, "w") as fh:
+            fh.write("\n".join(lines) + "\n")
+    print(json.dumps({"files": len(rows), "at_or_below": ok, "refused": refused}))
+
+
+if __name__ == "__main__":
+    main()
