@@ -204,16 +204,7 @@ const NUMBERS: &[&str] = &[
 ];
 
 const UNICODE: &[&str] = &[
-    "é",
-    "\u{202e}",
-    "𝔘",
-    "\u{0}",
-    "\u{feff}",
-    "\u{fffd}",
-    "漢字",
-    "\r",
-    "\t",
-    "\u{2028}",
+    "é", "\u{202e}", "𝔘", "\u{0}", "\u{feff}", "\u{fffd}", "漢字", "\r", "\t", "\u{2028}",
 ];
 
 /// Byte ranges of the lines of `d` (each without its newline).
@@ -293,7 +284,11 @@ fn mutate_once(rng: &mut ChaCha8Rng, d: &mut Vec<u8>) -> String {
                     if (c, e) == (a, b) {
                         return "swap a line with itself".into();
                     }
-                    let (first, second) = if c < a { ((c, e), (a, b)) } else { ((a, b), (c, e)) };
+                    let (first, second) = if c < a {
+                        ((c, e), (a, b))
+                    } else {
+                        ((a, b), (c, e))
+                    };
                     let x = d[first.0..first.1].to_vec();
                     let y = d[second.0..second.1].to_vec();
                     d.splice(second.0..second.1, x);
@@ -359,7 +354,9 @@ fn cases() -> usize {
 /// Runs `cases()` mutated copies of `seeds` through `read` (given a file name with the seed's
 /// extension and the bytes); fails with every bad case listed.
 fn run(reader: &str, seeds: &[(String, Vec<u8>)], read: &dyn Fn(&str, &[u8])) {
-    let salt = reader.bytes().fold(0u64, |h, b| h.wrapping_mul(31).wrapping_add(b as u64));
+    let salt = reader
+        .bytes()
+        .fold(0u64, |h, b| h.wrapping_mul(31).wrapping_add(b as u64));
     let mut rng = ChaCha8Rng::seed_from_u64(0xC311_5E9 ^ salt);
     let mut failures = Vec::new();
     let dump = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("mutations");
@@ -455,9 +452,14 @@ fn pcglns_reader_survives_mutations() {
 
 #[test]
 fn json_instance_reader_survives_mutations() {
-    let s = seeds(&["instances/generated", "fuzz/seeds/json"], &["-20.json", ".json"]);
+    let s = seeds(
+        &["instances/generated", "fuzz/seeds/json"],
+        &["-20.json", ".json"],
+    );
     let s: Vec<_> = s.into_iter().filter(|(_, b)| b.len() <= 60_000).collect();
-    run("json-instance", &s, &|f, d| instance_case(f, d, Format::Json));
+    run("json-instance", &s, &|f, d| {
+        instance_case(f, d, Format::Json)
+    });
 }
 
 #[test]
@@ -533,5 +535,8 @@ fn mutations_are_deterministic() {
     assert_eq!(a, b);
     // and they do change the input (all but the rare no-op ones)
     let changed = a.iter().filter(|(_, d)| *d != seed).count();
-    assert!(changed >= 40, "only {changed} of 50 mutations changed the input");
+    assert!(
+        changed >= 40,
+        "only {changed} of 50 mutations changed the input"
+    );
 }

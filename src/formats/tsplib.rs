@@ -391,7 +391,9 @@ pub fn parse_pcglns(file: &str, text: &str) -> Result<Instance> {
         return Err(Error::parse(
             file,
             dim_line,
-            format!("DIMENSION {dim} is above the limit of {limit} nodes; set {MAX_NODES_ENV} to raise it"),
+            format!(
+                "DIMENSION {dim} is above the limit of {limit} nodes; set {MAX_NODES_ENV} to raise it"
+            ),
         ));
     }
     if ngroups > dim {

@@ -312,7 +312,10 @@ pub fn run(
     if !report.cost.is_finite() {
         return Err(Error::Solver {
             solver: name.to_string(),
-            msg: format!("the checker computes a cost of {} (see `cellseq validate`)", report.cost),
+            msg: format!(
+                "the checker computes a cost of {} (see `cellseq validate`)",
+                report.cost
+            ),
         });
     }
     let tol = 1e-6 * report.cost.abs().max(1.0);
