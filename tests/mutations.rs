@@ -261,7 +261,7 @@ fn mutate_once(rng: &mut ChaCha8Rng, d: &mut Vec<u8>) -> String {
             d.truncate(p);
             format!("truncate at {p}")
         }
-        2 | 3 | 4 => {
+        2..=4 => {
             let ls = lines(d);
             if ls.is_empty() {
                 return "no lines".into();
@@ -297,7 +297,7 @@ fn mutate_once(rng: &mut ChaCha8Rng, d: &mut Vec<u8>) -> String {
                 }
             }
         }
-        5 | 6 => {
+        5..=6 => {
             let ns = numbers(d);
             if ns.is_empty() {
                 return "no numbers".into();
@@ -357,7 +357,7 @@ fn run(reader: &str, seeds: &[(String, Vec<u8>)], read: &dyn Fn(&str, &[u8])) {
     let salt = reader
         .bytes()
         .fold(0u64, |h, b| h.wrapping_mul(31).wrapping_add(b as u64));
-    let mut rng = ChaCha8Rng::seed_from_u64(0xC311_5E9 ^ salt);
+    let mut rng = ChaCha8Rng::seed_from_u64(0x0C31_15E9 ^ salt);
     let mut failures = Vec::new();
     let dump = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("mutations");
     for case in 0..cases() {
