@@ -128,7 +128,8 @@ fn check_matrix_size(file: &str, ln: usize, dim: usize, tok: &Tokens) -> Result<
             file,
             tok.last_line,
             format!(
-                "EDGE_WEIGHT_SECTION holds {have} numbers, but a {dim}x{dim} matrix needs {need}"
+                "file ends early: EDGE_WEIGHT_SECTION holds {have} numbers, but a {dim}x{dim} \
+                 matrix needs {need}"
             ),
         ));
     }
