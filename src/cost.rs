@@ -8,7 +8,7 @@
 use crate::bound::closure::Closure;
 use crate::geom::Point3;
 use crate::model::{CostMatrix, Instance, Objective, Sequence};
-use crate::precedence::Dag;
+use crate::precedence::{Dag, topological_order};
 use std::sync::OnceLock;
 
 /// Up to this many cells (with precedence) [`CostModel::closure`] builds the transitive
@@ -66,6 +66,8 @@ pub struct CostModel {
     pub dag: Dag,
     /// the closure of `dag`, built on first use (see [`CostModel::closure`])
     closure: OnceLock<Option<Closure>>,
+    /// whether `dag` has a topological order (see [`CostModel::acyclic`])
+    acyclic: bool,
 }
 
 impl CostModel {
@@ -169,6 +171,7 @@ impl CostModel {
             edges.extend((0..n).filter(|&c| c != l).map(|c| (c, l)));
         }
         let dag = Dag::new(n, &edges).reduced(20_000);
+        let acyclic = topological_order(&dag).is_ok();
         let return_node = if inst.closed && inst.is_matrix() {
             inst.first.map(|f| offsets[f] as usize)
         } else {
@@ -190,6 +193,7 @@ impl CostModel {
             geo,
             dag,
             closure: OnceLock::new(),
+            acyclic,
         };
         cm.turn = (0..cm.nodes())
             .map(|nd| {
@@ -243,6 +247,14 @@ impl CostModel {
     #[inline]
     pub fn turned_or_same(&self, cell: usize, mode: usize) -> usize {
         self.turned(cell, mode).unwrap_or(mode)
+    }
+
+    /// Whether the precedence, with the fixed first and last cells, admits an order at all.
+    /// Always true for a validated instance ([`crate::validate::validate`] refuses cycles and
+    /// first or last cells that contradict the precedence); solvers that would otherwise
+    /// index past the end of a partial topological order check it first.
+    pub fn acyclic(&self) -> bool {
+        self.acyclic
     }
 
     /// The objective costs are expressed in.

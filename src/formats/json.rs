@@ -36,7 +36,11 @@ struct InstanceFile {
     precedence: Vec<(String, String)>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     as_given: Option<Vec<VisitRef>>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        deserialize_with = "matrix_rows::deserialize"
+    )]
     matrix: Option<Vec<Vec<f64>>>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     first: Option<String>,
@@ -44,6 +48,84 @@ struct InstanceFile {
     last: Option<String>,
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     closed: bool,
+}
+
+/// Reads the `matrix` field row by row and refuses an entry outside
+/// 0..=[`crate::validate::MAX_MATRIX_COST`] as it is read, so the error carries its line and
+/// column (negative entries are not TSPLIB's −1 precedence marks here: JSON instances state
+/// precedence in `precedence`).
+mod matrix_rows {
+    use serde::Deserializer;
+    use serde::de::{DeserializeSeed, Error, SeqAccess, Visitor};
+    use std::fmt;
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Option<Vec<Vec<f64>>>, D::Error> {
+        d.deserialize_option(Opt)
+    }
+
+    struct Opt;
+    impl<'de> Visitor<'de> for Opt {
+        type Value = Option<Vec<Vec<f64>>>;
+        fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+            f.write_str("a matrix (an array of rows of numbers) or null")
+        }
+        fn visit_none<E: Error>(self) -> Result<Self::Value, E> {
+            Ok(None)
+        }
+        fn visit_unit<E: Error>(self) -> Result<Self::Value, E> {
+            Ok(None)
+        }
+        fn visit_some<D: Deserializer<'de>>(self, d: D) -> Result<Self::Value, D::Error> {
+            d.deserialize_seq(Rows).map(Some)
+        }
+    }
+
+    struct Rows;
+    impl<'de> Visitor<'de> for Rows {
+        type Value = Vec<Vec<f64>>;
+        fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+            f.write_str("an array of matrix rows")
+        }
+        fn visit_seq<A: SeqAccess<'de>>(self, mut a: A) -> Result<Self::Value, A::Error> {
+            let mut rows = Vec::new();
+            while let Some(row) = a.next_element_seed(Row(rows.len()))? {
+                rows.push(row);
+            }
+            Ok(rows)
+        }
+    }
+
+    /// Row `.0` (0-based).
+    struct Row(usize);
+    impl<'de> DeserializeSeed<'de> for Row {
+        type Value = Vec<f64>;
+        fn deserialize<D: Deserializer<'de>>(self, d: D) -> Result<Self::Value, D::Error> {
+            d.deserialize_seq(self)
+        }
+    }
+    impl<'de> Visitor<'de> for Row {
+        type Value = Vec<f64>;
+        fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+            write!(f, "matrix row {} as an array of numbers", self.0 + 1)
+        }
+        fn visit_seq<A: SeqAccess<'de>>(self, mut a: A) -> Result<Self::Value, A::Error> {
+            let max = crate::validate::MAX_MATRIX_COST;
+            let mut row = Vec::new();
+            while let Some(v) = a.next_element::<f64>()? {
+                if !(0.0..=max).contains(&v) {
+                    return Err(A::Error::custom(format!(
+                        "matrix entry ({}, {}) is {}: entries must lie in 0..={max:e} \
+                         (precedence goes in \"precedence\", not as -1 entries)",
+                        self.0 + 1,
+                        row.len() + 1,
+                        crate::validate::show(v)
+                    )));
+                }
+                row.push(v);
+            }
+            Ok(row)
+        }
+    }
 }
 
 /// A solution file.

@@ -7,52 +7,95 @@ use std::collections::BTreeSet;
 /// Cost stored for arcs that precedence forbids (the files mark them −1).
 pub const FORBIDDEN_ARC: f64 = CostMatrix::FORBIDDEN;
 
-/// A whitespace token with its 1-based line number.
+/// Largest matrix dimension read by default: a matrix of n nodes takes 8·n² bytes, 3.2 GB at
+/// this limit. The environment variable [`MAX_NODES_ENV`] raises (or lowers) it.
+pub const MAX_NODES: usize = 20_000;
+/// Environment variable that overrides [`MAX_NODES`].
+pub const MAX_NODES_ENV: &str = "CELLSEQ_MAX_MATRIX_NODES";
+
+/// The matrix dimension limit in force: [`MAX_NODES_ENV`] when set to a number, else
+/// [`MAX_NODES`].
+pub fn max_nodes() -> usize {
+    std::env::var(MAX_NODES_ENV)
+        .ok()
+        .and_then(|v| v.trim().parse().ok())
+        .unwrap_or(MAX_NODES)
+}
+
+/// Whitespace tokens of numbered lines, read lazily, each with its 1-based line number.
+#[derive(Clone)]
 struct Tokens<'a> {
     file: &'a str,
-    toks: Vec<(usize, &'a str)>,
-    pos: usize,
+    lines: &'a [(usize, &'a str)],
+    /// the next line to split
+    next_line: usize,
+    current: Option<(usize, std::str::SplitWhitespace<'a>)>,
+    peeked: Option<(usize, &'a str)>,
     last_line: usize,
 }
 
 impl<'a> Tokens<'a> {
-    fn new(file: &'a str, lines: &[(usize, &'a str)]) -> Self {
-        let toks = lines
-            .iter()
-            .flat_map(|&(ln, l)| l.split_whitespace().map(move |t| (ln, t)))
-            .collect();
+    fn new(file: &'a str, lines: &'a [(usize, &'a str)]) -> Self {
         let last_line = lines.last().map(|l| l.0).unwrap_or(1);
         Tokens {
             file,
-            toks,
-            pos: 0,
+            lines,
+            next_line: 0,
+            current: None,
+            peeked: None,
             last_line,
         }
     }
-    fn peek(&self) -> Option<(usize, &'a str)> {
-        self.toks.get(self.pos).copied()
+    fn advance(&mut self) -> Option<(usize, &'a str)> {
+        if let Some(t) = self.peeked.take() {
+            return Some(t);
+        }
+        loop {
+            if let Some((ln, it)) = &mut self.current
+                && let Some(t) = it.next()
+            {
+                return Some((*ln, t));
+            }
+            let &(ln, l) = self.lines.get(self.next_line)?;
+            self.next_line += 1;
+            self.current = Some((ln, l.split_whitespace()));
+        }
     }
-    fn next_num(&mut self, what: &str) -> Result<(usize, f64)> {
-        let Some((ln, t)) = self.peek() else {
+    fn peek(&mut self) -> Option<(usize, &'a str)> {
+        if self.peeked.is_none() {
+            self.peeked = self.advance();
+        }
+        self.peeked
+    }
+    /// How many tokens are left (counted without allocating).
+    fn remaining(&self) -> usize {
+        let mut t = self.clone();
+        let mut k = 0;
+        while t.advance().is_some() {
+            k += 1;
+        }
+        k
+    }
+    fn next_num(&mut self, what: &dyn Fn() -> String) -> Result<(usize, f64)> {
+        let Some((ln, t)) = self.advance() else {
             return Err(Error::parse(
                 self.file,
                 self.last_line,
-                format!("file ends early: expected {what}"),
+                format!("file ends early: expected {}", what()),
             ));
         };
-        self.pos += 1;
         match t.parse::<f64>() {
             Ok(v) if v.is_finite() => Ok((ln, v)),
             _ => Err(Error::parse(
                 self.file,
                 ln,
-                format!("expected a number for {what}, found '{t}'"),
+                format!("expected a number for {}, found '{t}'", what()),
             )),
         }
     }
     fn next_int(&mut self, what: &str) -> Result<(usize, i64)> {
-        let (ln, v) = self.next_num(what)?;
-        if v.fract() != 0.0 {
+        let (ln, v) = self.next_num(&|| what.to_string())?;
+        if v.fract() != 0.0 || v.abs() > 9.0e15 {
             return Err(Error::parse(
                 self.file,
                 ln,
@@ -61,6 +104,70 @@ impl<'a> Tokens<'a> {
         }
         Ok((ln, v as i64))
     }
+}
+
+/// Checks a declared matrix dimension against the limit and against the numbers the
+/// section holds, before anything of that size is allocated.
+fn check_matrix_size(file: &str, ln: usize, dim: usize, tok: &Tokens) -> Result<()> {
+    let limit = max_nodes();
+    if dim > limit {
+        return Err(Error::parse(
+            file,
+            ln,
+            format!(
+                "DIMENSION {dim} is above the limit of {limit} nodes (the matrix would take \
+                 {:.1} GB); set {MAX_NODES_ENV} to raise it",
+                8.0 * (dim as f64) * (dim as f64) / 1e9
+            ),
+        ));
+    }
+    let have = tok.remaining();
+    let need = dim.saturating_mul(dim);
+    if have < need {
+        return Err(Error::parse(
+            file,
+            tok.last_line,
+            format!(
+                "file ends early: EDGE_WEIGHT_SECTION holds {have} numbers, but a {dim}x{dim} \
+                 matrix needs {need}"
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// A matrix entry: -1 marks precedence (`Ok(None)`), other numbers must lie in
+/// 0..=[`crate::validate::MAX_MATRIX_COST`].
+fn entry(file: &str, ln: usize, i: usize, j: usize, v: f64) -> Result<Option<f64>> {
+    if v == -1.0 {
+        return Ok(None);
+    }
+    if v < 0.0 {
+        return Err(Error::parse(
+            file,
+            ln,
+            format!(
+                "matrix entry ({}, {}) is negative ({}); only -1 marks precedence",
+                i + 1,
+                j + 1,
+                crate::validate::show(v)
+            ),
+        ));
+    }
+    let max = crate::validate::MAX_MATRIX_COST;
+    if v > max {
+        return Err(Error::parse(
+            file,
+            ln,
+            format!(
+                "matrix entry ({}, {}) is {}, above the limit {max:e}",
+                i + 1,
+                j + 1,
+                crate::validate::show(v)
+            ),
+        ));
+    }
+    Ok(Some(v))
 }
 
 struct Header<'a> {
@@ -204,29 +311,25 @@ pub fn parse_sop(file: &str, text: &str) -> Result<Instance> {
             format!("dimension after EDGE_WEIGHT_SECTION is {d2}, header says DIMENSION {dim}"),
         ));
     }
+    check_matrix_size(file, ln, dim, &tok)?;
     let mut costs = vec![0.0; dim * dim];
     let mut edges = Vec::new();
     for i in 0..dim {
         for j in 0..dim {
-            let (ln, v) = tok.next_num(&format!("matrix entry ({}, {})", i + 1, j + 1))?;
-            if v == -1.0 {
-                if i == j {
-                    return Err(Error::parse(
-                        file,
-                        ln,
-                        format!("node {} must precede itself", i + 1),
-                    ));
+            let (ln, v) = tok.next_num(&|| format!("matrix entry ({}, {})", i + 1, j + 1))?;
+            match entry(file, ln, i, j, v)? {
+                None => {
+                    if i == j {
+                        return Err(Error::parse(
+                            file,
+                            ln,
+                            format!("node {} must precede itself", i + 1),
+                        ));
+                    }
+                    edges.push((j, i));
+                    costs[i * dim + j] = FORBIDDEN_ARC;
                 }
-                edges.push((j, i));
-                costs[i * dim + j] = FORBIDDEN_ARC;
-            } else if v < 0.0 {
-                return Err(Error::parse(
-                    file,
-                    ln,
-                    format!("negative cost {v} (only -1 marks precedence)"),
-                ));
-            } else {
-                costs[i * dim + j] = v;
+                Some(v) => costs[i * dim + j] = v,
             }
         }
     }
@@ -282,6 +385,25 @@ pub fn parse_pcglns(file: &str, text: &str) -> Result<Instance> {
     check_explicit(file, &h)?;
     let dim = header_usize(file, &h, "DIMENSION")?;
     let ngroups = header_usize(file, &h, "GTSP_SETS")?;
+    // sizes from the header, checked before the per-node and per-group tables are allocated
+    let dim_line = h.get("DIMENSION").map_or(1, |(l, _)| l);
+    let limit = max_nodes();
+    if dim > limit {
+        return Err(Error::parse(
+            file,
+            dim_line,
+            format!(
+                "DIMENSION {dim} is above the limit of {limit} nodes; set {MAX_NODES_ENV} to raise it"
+            ),
+        ));
+    }
+    if ngroups > dim {
+        return Err(Error::parse(
+            file,
+            h.get("GTSP_SETS").map_or(1, |(l, _)| l),
+            format!("GTSP_SETS {ngroups} is more than the {dim} nodes (every group needs a node)"),
+        ));
+    }
     let section = |name: &str| -> Result<Vec<(usize, &str)>> {
         sections
             .iter()
@@ -349,31 +471,27 @@ pub fn parse_pcglns(file: &str, text: &str) -> Result<Instance> {
     }
     let lines = section("EDGE_WEIGHT_SECTION")?;
     let mut tok = Tokens::new(file, &lines);
+    check_matrix_size(file, dim_line, dim, &tok)?;
     let mut costs = vec![0.0; dim * dim];
     let mut edges: BTreeSet<(usize, usize)> = BTreeSet::new();
     for i in 0..dim {
         for j in 0..dim {
-            let (ln, v) = tok.next_num(&format!("matrix entry ({}, {})", i + 1, j + 1))?;
+            let (ln, v) = tok.next_num(&|| format!("matrix entry ({}, {})", i + 1, j + 1))?;
             let (gi, gj) = (group_of[i], group_of[j]);
             let slot = new_index[i] * dim + new_index[j];
-            if v == -1.0 {
-                if gi == gj {
-                    return Err(Error::parse(
-                        file,
-                        ln,
-                        format!("group {} must precede itself", gi + 1),
-                    ));
+            match entry(file, ln, i, j, v)? {
+                None => {
+                    if gi == gj {
+                        return Err(Error::parse(
+                            file,
+                            ln,
+                            format!("group {} must precede itself", gi + 1),
+                        ));
+                    }
+                    edges.insert((gj, gi));
+                    costs[slot] = FORBIDDEN_ARC;
                 }
-                edges.insert((gj, gi));
-                costs[slot] = FORBIDDEN_ARC;
-            } else if v < 0.0 {
-                return Err(Error::parse(
-                    file,
-                    ln,
-                    format!("negative cost {v} (only -1 marks precedence)"),
-                ));
-            } else {
-                costs[slot] = v;
+                Some(v) => costs[slot] = v,
             }
         }
     }

@@ -4,7 +4,10 @@
 //! A state is (ideal S, last node u) with the cheapest cost of a path that visits exactly the
 //! cells of S and ends in u. Only order ideals (predecessor-closed sets) are reachable, so dense
 //! precedence shrinks the state space from 2ⁿ to far less. Levels are processed by |S|; the
-//! memory in use is tracked and the solver refuses once it would pass `memory_mb`.
+//! memory in use is tracked and the solver refuses once it would pass `memory_mb`. Every state
+//! keeps the node it was reached from, so the optimal path is read back exactly; it used to be
+//! found again by recomputing costs within a tolerance, which failed ("broken DP
+//! back-pointer") once costs overflowed to infinity (∞ − ∞ is NaN).
 
 use super::{Context, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo};
 use crate::error::{Error, Result};
@@ -45,7 +48,12 @@ pub struct Exact {
     pub max_cells: usize,
 }
 
-type Level = FxHashMap<u128, Vec<(u32, f64)>>;
+/// One DP entry: the last node, the node before it (`NO_PRED` at the start) and the cost.
+type Entry = (u32, u32, f64);
+type Level = FxHashMap<u128, Vec<Entry>>;
+
+/// The predecessor of a path's first node.
+const NO_PRED: u32 = u32::MAX;
 
 const BYTES_PER_IDEAL: u64 = 80;
 const BYTES_PER_ENTRY: u64 = 16;
@@ -73,8 +81,8 @@ impl Solver for Exact {
         let mut first = Level::default();
         for v in 0..n {
             if pred_mask[v] == 0 {
-                let e: Vec<(u32, f64)> = (0..m.modes(v))
-                    .map(|md| (m.node(v, md) as u32, m.start(v, md)))
+                let e: Vec<Entry> = (0..m.modes(v))
+                    .map(|md| (m.node(v, md) as u32, NO_PRED, m.start(v, md)))
                     .collect();
                 used += BYTES_PER_IDEAL + BYTES_PER_ENTRY * e.len() as u64;
                 first.insert(1u128 << v, e);
@@ -102,24 +110,25 @@ impl Solver for Exact {
                     });
                     for mv in 0..m.modes(v) {
                         let nv = m.node(v, mv) as u32;
-                        let mut best = f64::INFINITY;
-                        for &(u, cu) in entries {
+                        // the cheapest way in, and where from (the first of equal costs)
+                        let mut best = (f64::INFINITY, NO_PRED);
+                        for &(u, _, cu) in entries {
                             let (cu_cell, cu_mode) = m.cell_mode(u as usize);
                             let c = cu + m.arc(cu_cell, cu_mode, v, mv);
-                            if c < best {
-                                best = c;
+                            if c < best.0 {
+                                best = (c, u);
                             }
                         }
                         evals += entries.len() as u64;
-                        match slot.iter_mut().find(|(x, _)| *x == nv) {
+                        match slot.iter_mut().find(|e| e.0 == nv) {
                             Some(e) => {
-                                if best < e.1 {
-                                    e.1 = best;
+                                if best.0 < e.2 {
+                                    (e.1, e.2) = (best.1, best.0);
                                 }
                             }
                             None => {
                                 used += BYTES_PER_ENTRY;
-                                slot.push((nv, best));
+                                slot.push((nv, best.1, best.0));
                             }
                         }
                     }
@@ -149,44 +158,38 @@ impl Solver for Exact {
             .iter()
             .next()
             .ok_or_else(|| err("no feasible order".into()))?;
-        let mut best = (f64::INFINITY, u32::MAX);
-        for &(u, cu) in entries {
+        let mut best = (f64::INFINITY, NO_PRED);
+        for &(u, _, cu) in entries {
             let (c, md) = m.cell_mode(u as usize);
             let total = cu + m.finish(c, md);
             if total < best.0 || (total == best.0 && u < best.1) {
                 best = (total, u);
             }
         }
-        // walk back
+        if best.1 == NO_PRED {
+            // only when every complete path costs infinity or NaN, which validation rules out
+            return Err(err("no complete order has a finite cost".into()));
+        }
+        // walk back along the stored predecessors: exact, no re-evaluation of costs
         let mut seq = Vec::with_capacity(n);
         let mut s = all;
         let mut u = best.1;
-        let mut cu = entries
-            .iter()
-            .find(|e| e.0 == u)
-            .map(|e| e.1)
-            .unwrap_or(0.0);
         for k in (0..n).rev() {
             let (c, md) = m.cell_mode(u as usize);
             seq.push(Visit::new(c, md));
+            let pred = levels[k]
+                .get(&s)
+                .and_then(|es| es.iter().find(|e| e.0 == u))
+                .map(|e| e.1)
+                .ok_or_else(|| err("internal error: DP state missing on the way back".into()))?;
             if k == 0 {
                 break;
             }
-            s &= !(1u128 << c);
-            let prev = &levels[k - 1][&s];
-            let tol = 1e-7 * cu.abs().max(1.0);
-            let mut found = None;
-            for &(p, cp) in prev {
-                let (pc, pm) = m.cell_mode(p as usize);
-                if (cp + m.arc(pc, pm, c, md) - cu).abs() <= tol {
-                    found = Some((p, cp));
-                    break;
-                }
+            if pred == NO_PRED {
+                return Err(err("internal error: DP path ends early".into()));
             }
-            let (p, cp) =
-                found.ok_or_else(|| err("internal error: broken DP back-pointer".into()))?;
-            u = p;
-            cu = cp;
+            s &= !(1u128 << c);
+            u = pred;
         }
         seq.reverse();
         let cost = m.evaluate(&seq);

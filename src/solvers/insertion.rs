@@ -61,6 +61,12 @@ pub struct Insertion {
 
 impl Solver for Insertion {
     fn solve(&self, ctx: &mut Context) -> Result<Outcome> {
+        if !ctx.model.acyclic() {
+            return Err(crate::error::Error::Solver {
+                solver: "insertion".into(),
+                msg: "the precedence has a cycle".into(),
+            });
+        }
         let seed = ctx.seed;
         let seq = sequence(ctx.model, self.k, seed, &mut |e| ctx.count(e));
         Ok(outcome_of(ctx.model, seq))

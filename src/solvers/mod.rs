@@ -294,6 +294,12 @@ pub fn run(
     let params = Params::new(name, info.params, given)?;
     let solver = (info.make)(&params);
     let model = CostModel::new(inst, objective);
+    if !model.acyclic() {
+        return Err(Error::invalid(
+            &inst.name,
+            "no order satisfies the precedence with the fixed first and last cells (see `cellseq validate`)",
+        ));
+    }
     let objective = model.objective();
     let mut ctx = Context::new(inst, &model, &params, seed, budget, observer);
     let outcome = solver.solve(&mut ctx)?;
@@ -303,6 +309,15 @@ pub fn run(
         solver: name.to_string(),
         msg: format!("returned an infeasible sequence: {v}"),
     })?;
+    if !report.cost.is_finite() {
+        return Err(Error::Solver {
+            solver: name.to_string(),
+            msg: format!(
+                "the checker computes a cost of {} (see `cellseq validate`)",
+                report.cost
+            ),
+        });
+    }
     let tol = 1e-6 * report.cost.abs().max(1.0);
     if (report.cost - outcome.cost).abs() > tol {
         return Err(Error::Solver {

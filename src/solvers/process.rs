@@ -42,6 +42,12 @@ impl Solver for Process {
         let inst = ctx.instance;
         let m = ctx.model;
         let n = inst.n();
+        if !m.acyclic() {
+            return Err(crate::error::Error::Solver {
+                solver: "process".into(),
+                msg: "the precedence has a cycle".into(),
+            });
+        }
         // level 1: cutter in process-scheme order (tool library order, then first use)
         let mut tool_order: Vec<&str> = inst.tools.iter().map(|t| t.id.as_str()).collect();
         for t in inst.used_tools() {
