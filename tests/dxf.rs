@@ -3,7 +3,8 @@
 use ::dxf::entities::{Arc, Circle, Entity, EntityType, Insert, Line, LwPolyline};
 use ::dxf::{Block, LwPolylineVertex, Point};
 use cellseq::io::dxf::{self, Post, ReadOptions};
-use cellseq::io::svg::{self, Options};
+use cellseq::io::svg;
+use cellseq::pipeline::drawing::{self as pipe, Options};
 use proptest::prelude::*;
 
 fn ent(layer: &str, t: EntityType) -> Entity {
@@ -124,7 +125,7 @@ fn gcode_post_is_verified_and_inner_first() {
         cut: true,
         ..Options::default()
     };
-    let out = svg::optimize(&d, &opts).unwrap();
+    let out = pipe::optimize(&d, &opts).unwrap();
     // the outer frame's layer comes after the inner layer
     assert_eq!(out.strokes.last().unwrap().layer, 1);
     assert_eq!(out.strokes.first().unwrap().layer, 2);

@@ -4,6 +4,7 @@ use super::gcode::{ImportArgs, OptimizeArgs};
 use anyhow::{Context as _, bail};
 use cellseq::formats::{read_text, save_instance, write_atomic};
 use cellseq::io::svg;
+use cellseq::pipeline::drawing as pipe;
 use clap::Args;
 use std::path::Path;
 
@@ -25,9 +26,15 @@ pub struct DrawingArgs {
     /// Start-vertex candidates per closed stroke when reversible.
     #[arg(long, default_value_t = 8)]
     pub max_starts: usize,
-    /// Skip unsupported elements (SVG text, images, DXF text, hatches, …) instead of refusing.
+    /// SVG: drop the elements that are not sequenced (text, images, `<use>`, metadata, …)
+    /// from the output instead of keeping them as they are; DXF: skip unsupported entities
+    /// (text, hatches, …) instead of refusing the file.
     #[arg(long)]
     pub skip_unsupported: bool,
+    /// Most points a drawing may have after flattening its curves (a cap against hostile
+    /// files; raise it for huge drawings).
+    #[arg(long, default_value_t = 10_000_000, value_name = "N")]
+    pub max_points: usize,
     /// DXF: chain loose pieces whose endpoints are closer than this (mm).
     #[arg(long, default_value_t = 0.001)]
     pub join_tol: f64,
@@ -75,7 +82,7 @@ pub fn import(a: &ImportArgs, fmt: &str) -> anyhow::Result<()> {
     if fmt == "dxf" {
         opts.cut = !a.drawing.no_inner_first;
     }
-    let inst = svg::import(&d, &opts)?;
+    let inst = pipe::import(&d, &opts)?;
     cellseq::validate::validate(&inst, &file)?;
     save_instance(&a.output, &inst)?;
     say!(
@@ -98,6 +105,7 @@ fn read_svg(path: &Path, d: &DrawingArgs) -> anyhow::Result<svg::Drawing> {
         svg::ReadOptions {
             tolerance: 1e9,
             skip_unsupported: true,
+            max_points: d.max_points,
         },
     )?;
     let tol = d.tolerance / probe.mm_per_unit;
@@ -107,6 +115,7 @@ fn read_svg(path: &Path, d: &DrawingArgs) -> anyhow::Result<svg::Drawing> {
         svg::ReadOptions {
             tolerance: tol,
             skip_unsupported: d.skip_unsupported,
+            max_points: d.max_points,
         },
     )?)
 }
@@ -118,10 +127,12 @@ fn svg_options(
     solver: &str,
     time_limit: Option<f64>,
     seed: u64,
-) -> svg::Options {
-    svg::Options {
+) -> pipe::Options {
+    pipe::Options {
         solver: solver.to_string(),
         time_limit,
+        max_evals: None,
+        params: Default::default(),
         seed,
         reversible,
         scopes: !a.no_scopes,
@@ -141,9 +152,10 @@ fn optimize_svg(a: &OptimizeArgs) -> anyhow::Result<()> {
     let solver = a
         .solver
         .clone()
-        .unwrap_or_else(|| svg::DRAWING_SOLVER.to_string());
-    let opts = svg_options(&d, &a.drawing, reversible, &solver, a.time_limit, a.seed);
-    let out = svg::optimize(&d, &opts)?;
+        .unwrap_or_else(|| pipe::DRAWING_SOLVER.to_string());
+    let mut opts = svg_options(&d, &a.drawing, reversible, &solver, a.time_limit, a.seed);
+    opts.max_evals = a.max_evals;
+    let out = pipe::optimize(&d, &opts)?;
     let text = svg::write(&d, &out.strokes);
     let segments = svg::verify(&d, "<optimized>", &text)?;
     if let Some(o) = &a.output {
@@ -239,10 +251,11 @@ fn optimize_dxf(a: &OptimizeArgs) -> anyhow::Result<()> {
     let solver = a
         .solver
         .clone()
-        .unwrap_or_else(|| svg::DRAWING_SOLVER.to_string());
+        .unwrap_or_else(|| pipe::DRAWING_SOLVER.to_string());
     let mut opts = svg_options(&d, &a.drawing, reversible, &solver, a.time_limit, a.seed);
+    opts.max_evals = a.max_evals;
     opts.cut = !a.drawing.no_inner_first;
-    let out = svg::optimize(&d, &opts)?;
+    let out = pipe::optimize(&d, &opts)?;
     let post = dxf::Post {
         safe_height: a.drawing.safe_height,
         depth: a.drawing.cut_depth,

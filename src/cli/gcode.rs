@@ -21,6 +21,10 @@ pub struct OptimizeArgs {
     /// Time limit in seconds (shared among tool blocks).
     #[arg(long, value_name = "S")]
     pub time_limit: Option<f64>,
+    /// Evaluation budget (deterministic: the same result on any machine); shared among tool
+    /// blocks or drawing scopes by size.
+    #[arg(long, value_name = "N")]
+    pub max_evals: Option<u64>,
     /// Seed.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,

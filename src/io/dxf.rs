@@ -1,13 +1,13 @@
 //! DXF drawings (2-D cutting) through the `dxf` crate: LINE, ARC, CIRCLE, ELLIPSE, LWPOLYLINE
 //! and POLYLINE (with bulges), SPLINE (flattened), INSERT (blocks, nested, with scale, rotation,
 //! arrays). Loose pieces are chained into contours per layer (endpoints within a tolerance are
-//! snapped together). The result is an [`svg::Drawing`] (one layer per DXF layer, y up), so
+//! snapped together). The result is a [`crate::io::drawing::Drawing`] (one layer per DXF layer, y up), so
 //! sequencing, the SVG preview and verification are shared with SVG; [`write_gcode`] is a
 //! simple configurable post.
 
 use crate::error::{Error, Result};
+use crate::io::drawing::{self as svg, Drawing, Layer, Stroke, Style};
 use crate::io::gcode::interp::{self, CutKind};
-use crate::io::svg::{self, Drawing, Layer, Stroke, Style};
 use dxf::entities::EntityType;
 use kurbo::Affine;
 use std::collections::HashMap;
@@ -126,6 +126,8 @@ pub fn read(file: &str, bytes: &[u8], opts: ReadOptions) -> Result<Drawing> {
         strokes: Vec::new(),
         skipped,
         flip_y: true,
+        kept: Vec::new(),
+        namespaces: Vec::new(),
     };
     for (li, _) in layers.iter().enumerate() {
         let mine: Vec<&Piece> = pieces.iter().filter(|p| p.layer == li).collect();
