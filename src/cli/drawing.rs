@@ -53,9 +53,17 @@ pub struct DrawingArgs {
     /// DXF G-code post: plunge / pierce feed (mm/min).
     #[arg(long, default_value_t = 300.0)]
     pub plunge_feed: f64,
-    /// DXF G-code post: spindle speed or laser power (M3 S…); 0 writes no spindle words.
-    #[arg(long, default_value_t = 0.0)]
+    /// DXF G-code post: spindle speed (M3 S… before the first cut, M5 at the end); 0 writes
+    /// no spindle words (the operator's spindle state is left alone).
+    #[arg(long, default_value_t = 0.0, conflicts_with = "laser_power")]
     pub spindle: f64,
+    /// DXF G-code post for a laser: power S (M4 S…, off on rapids; M5 at the end), no Z moves.
+    #[arg(long, default_value_t = 0.0, value_name = "S")]
+    pub laser_power: f64,
+    /// DXF: the drawing unit when the file does not say (`$INSUNITS`): mm, cm, m, in, ft, mil
+    /// or um (default mm, with a warning).
+    #[arg(long, value_name = "UNIT")]
+    pub units: Option<String>,
 }
 
 /// `optimize` of a drawing (`fmt` is `svg` or `dxf`).
@@ -228,10 +236,18 @@ fn optimize_svg(a: &OptimizeArgs) -> anyhow::Result<()> {
 fn read_dxf(path: &Path, d: &DrawingArgs) -> anyhow::Result<svg::Drawing> {
     let file = path.display().to_string();
     let bytes = std::fs::read(path).with_context(|| format!("reading {file}"))?;
+    let units = match &d.units {
+        Some(u) => Some(
+            cellseq::io::dxf::unit_mm(u)
+                .with_context(|| format!("--units {u}: use mm, cm, m, in, ft, mil or um"))?,
+        ),
+        None => None,
+    };
     let mut o = cellseq::io::dxf::ReadOptions {
         tolerance: d.tolerance,
         join: d.join_tol,
         skip_unsupported: d.skip_unsupported,
+        units,
     };
     let dr = cellseq::io::dxf::read(&file, &bytes, o)?;
     if dr.mm_per_unit == 1.0 {
@@ -247,6 +263,9 @@ fn optimize_dxf(a: &OptimizeArgs) -> anyhow::Result<()> {
     let file = a.input.display().to_string();
     let t0 = std::time::Instant::now();
     let d = read_dxf(&a.input, &a.drawing)?;
+    for w in &d.warnings {
+        eprintln!("warning: {file}: {w}");
+    }
     let reversible = !a.no_reversible;
     let solver = a
         .solver
@@ -262,6 +281,7 @@ fn optimize_dxf(a: &OptimizeArgs) -> anyhow::Result<()> {
         feed: a.drawing.feed,
         plunge_feed: a.drawing.plunge_feed,
         spindle: a.drawing.spindle,
+        laser_power: a.drawing.laser_power,
     };
     let preview = a
         .output
@@ -296,6 +316,8 @@ fn optimize_dxf(a: &OptimizeArgs) -> anyhow::Result<()> {
             "reversible": reversible,
             "verified_segments": segments,
             "skipped": d.skipped,
+            "warnings": d.warnings,
+            "mm_per_unit": d.mm_per_unit,
             "solve_s": out.solve_s,
             "total_s": total_s,
             "before": out.before,

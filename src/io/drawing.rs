@@ -132,6 +132,8 @@ pub struct Drawing {
     pub strokes: Vec<Stroke>,
     /// Unsupported elements skipped (with `skip_unsupported`).
     pub skipped: Vec<String>,
+    /// Warnings for the user (assumed units, …).
+    pub warnings: Vec<String>,
     /// Coordinates are y-up (DXF): the SVG writer mirrors them with `scale(1,-1)`.
     pub flip_y: bool,
     /// Elements passed through unchanged (SVG text, images, `<use>`, definitions, metadata,

@@ -136,6 +136,7 @@ pub fn read(file: &str, text: &str, opts: ReadOptions) -> Result<Drawing> {
             styles: Vec::new(),
             strokes: Vec::new(),
             skipped: Vec::new(),
+            warnings: Vec::new(),
             flip_y: false,
             kept: Vec::new(),
             namespaces,
