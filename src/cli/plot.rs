@@ -37,10 +37,12 @@ pub fn plot(a: PlotArgs) -> Result<()> {
         .and_then(|e| e.to_str())
         .unwrap_or("")
         .to_ascii_lowercase();
-    if ext != "json" && ext != "sop" && ext != "pcglns" {
-        if let Ok(fmt) = super::gcode::format_of(&a.file, None) {
-            return plot_program(&a, fmt);
-        }
+    if ext != "json"
+        && ext != "sop"
+        && ext != "pcglns"
+        && let Ok(fmt) = super::gcode::format_of(&a.file, None)
+    {
+        return plot_program(&a, fmt);
     }
     let inst = super::solve::load(&a.file)?;
     let mut caption = format!(

@@ -14,7 +14,7 @@ pub const DRAWING_SOLVER: &str = "drawing";
 
 /// Evaluations per stroke of the default budget (deterministic, linear in the drawing's size);
 /// see `notes/svg.md` for the measurements behind it.
-pub const EVALS_PER_STROKE: u64 = 2000;
+pub const EVALS_PER_STROKE: u64 = 4000;
 
 /// The smallest default budget of a scope, in evaluations.
 pub const MIN_EVALS: u64 = 1_000_000;

@@ -203,7 +203,7 @@ impl<'m> Path<'m> {
     }
 
     /// Cost of arriving at position `i` with visit `v` (from position i-1).
-    fn into_at(&self, i: usize, v: Visit) -> f64 {
+    fn arc_into(&self, i: usize, v: Visit) -> f64 {
         if i == 0 {
             self.m.start(v.cell, v.mode)
         } else {
@@ -226,8 +226,8 @@ impl<'m> Path<'m> {
     /// Saving of reversing block i..=j (costs are symmetric inside the block).
     fn reverse_gain(&self, i: usize, j: usize) -> f64 {
         let (a, b) = (self.t[i], self.t[j]);
-        self.into_at(i, a) + self.out_of(j, b)
-            - self.into_at(i, self.turned(b))
+        self.arc_into(i, a) + self.out_of(j, b)
+            - self.arc_into(i, self.turned(b))
             - self.out_of(j, self.turned(a))
     }
     fn reverse(&mut self, i: usize, j: usize) {
@@ -331,12 +331,12 @@ impl<'m> Path<'m> {
         }
         // mode change in place
         let v = self.t[p];
-        let here = self.into_at(p, v) + self.out_of(p, v);
+        let here = self.arc_into(p, v) + self.out_of(p, v);
         for md in 0..self.m.modes(c) {
             if md != v.mode {
                 evals += 1;
                 let w = Visit::new(c, md);
-                let g = here - self.into_at(p, w) - self.out_of(p, w);
+                let g = here - self.arc_into(p, w) - self.out_of(p, w);
                 if g > best.0 {
                     best = (g, 2, p, p, md);
                 }
@@ -425,7 +425,7 @@ impl<'m> Path<'m> {
         while let Some(c) = queue.pop_front() {
             self.queued[c as usize] = false;
             pops += 1;
-            if pops % 64 == 0 && ctx.exhausted() {
+            if pops.is_multiple_of(64) && ctx.exhausted() {
                 break;
             }
             touched.clear();
@@ -485,7 +485,7 @@ impl<'m> Path<'m> {
     fn window_cost(&self, a: usize, b: usize) -> f64 {
         let mut s = 0.0;
         for i in a..b {
-            s += self.into_at(i, self.t[i]);
+            s += self.arc_into(i, self.t[i]);
         }
         s + self.out_of(b - 1, self.t[b - 1])
     }

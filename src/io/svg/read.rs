@@ -431,7 +431,7 @@ fn shape(ctx: &Ctx, n: Node) -> Result<BezPath> {
     // kurbo turns circles, ellipses and rounded corners into cubics within a tolerance:
     // bound it by the shape's size, and refuse sizes no drawing has
     let sized = |extent: f64| -> Result<f64> {
-        if !(extent.abs() <= MAX_COORD) {
+        if extent.is_nan() || extent.abs() > MAX_COORD {
             return Err(Error::parse(
                 ctx.file,
                 line,
@@ -566,14 +566,13 @@ fn emit(ctx: &mut Ctx, path: &BezPath, inh: &Inherit, line: usize) -> Result<boo
         return Ok(false);
     }
     let bb = transformed.bounding_box();
-    if !(bb
+    let reach = bb
         .x0
         .abs()
         .max(bb.x1.abs())
         .max(bb.y0.abs())
-        .max(bb.y1.abs())
-        <= MAX_COORD)
-    {
+        .max(bb.y1.abs());
+    if reach.is_nan() || reach > MAX_COORD {
         return Err(Error::parse(
             ctx.file,
             line,
