@@ -14,8 +14,8 @@ pub struct OptimizeArgs {
     /// Output file (default: report only).
     #[arg(short = 'o', long)]
     pub output: Option<PathBuf>,
-    /// Solver from the registry (default: greedy for G-code; for SVG/DXF the built-in
-    /// `drawing` sequencer: grid greedy + 2-opt with reversal).
+    /// Solver from the registry (default: greedy for G-code; for SVG/DXF `drawing`: greedy,
+    /// 2-opt/Or-opt with reversal, iterated local search).
     #[arg(long)]
     pub solver: Option<String>,
     /// Time limit in seconds (shared among tool blocks).

@@ -1,11 +1,12 @@
-//! SVG drawings (pen plotters, lasers): read strokes, sequence them per scope (layer and
-//! stroke colour) with a registry solver, optionally reversing them, write the drawing back
-//! in the new order and verify that it draws exactly the same segments.
+//! SVG drawings (pen plotters, lasers): read strokes, write the drawing back in a new order and
+//! verify that it draws exactly the same segments and keeps every element it does not sequence.
+//! Sequencing is in [`crate::pipeline::drawing`]; this codec imports no solver.
 //!
 //! [`read()`] parses the file (every subpath of every shape is one [`Stroke`], curves flattened
-//! within a tolerance, transforms applied), [`optimize`] sequences, [`write()`] emits one
-//! `<path>` per stroke grouped per layer, [`verify`] compares the multisets of segments
-//! (direction-insensitive, per layer label, stroke colour and width).
+//! within a tolerance, transforms applied), [`write()`] emits one `<path>` per stroke grouped
+//! per layer (kept elements first in their layer), [`verify`] compares the multisets of
+//! segments (direction-insensitive, per layer label, stroke colour and width) and of kept
+//! elements.
 
 pub mod read;
 
