@@ -260,3 +260,263 @@ fn draw<DB: DrawingBackend>(
         .map_err(e)?;
     Ok(())
 }
+
+/// One panel of a program or drawing picture: cutting polylines and air moves in the XY
+/// plane (mm), in the file's own coordinates.
+#[derive(Debug, Clone, Default)]
+pub struct Panel {
+    /// Title above the panel.
+    pub title: String,
+    /// Pen-down / cutting polylines, in order.
+    pub cuts: Vec<Vec<(f64, f64)>>,
+    /// Air moves (pen up, rapid), in order.
+    pub air: Vec<[(f64, f64); 2]>,
+}
+
+impl Panel {
+    /// Total air length (XY).
+    pub fn air_length(&self) -> f64 {
+        self.air
+            .iter()
+            .map(|[a, b]| ((a.0 - b.0).powi(2) + (a.1 - b.1).powi(2)).sqrt())
+            .sum()
+    }
+}
+
+/// The panel of an interpreted G-code program: its cutting moves (arcs in the XY plane drawn
+/// as arcs) and an air move wherever one cut does not start where the previous one ended.
+pub fn program_panel(title: &str, prog: &crate::io::gcode::interp::Program) -> Panel {
+    use crate::io::gcode::interp::CutKind;
+    let mut p = Panel {
+        title: title.to_string(),
+        ..Panel::default()
+    };
+    let mut at: Option<(f64, f64)> = None;
+    for c in prog.lines.iter().flat_map(|l| &l.cuts) {
+        let from = (c.from[0], c.from[1]);
+        let to = (c.to[0], c.to[1]);
+        if let Some(a) = at
+            && a != from
+        {
+            p.air.push([a, from]);
+        }
+        let pts = match c.kind {
+            CutKind::Arc {
+                center,
+                cw,
+                plane: 17,
+                turns,
+            } => arc_pts(from, to, (center[0], center[1]), cw, turns),
+            _ => vec![from, to],
+        };
+        // join with the previous polyline when it continues it
+        match p.cuts.last_mut() {
+            Some(last) if at == Some(from) => last.extend(pts.into_iter().skip(1)),
+            _ => p.cuts.push(pts),
+        }
+        at = Some(to);
+    }
+    p
+}
+
+fn arc_pts(
+    from: (f64, f64),
+    to: (f64, f64),
+    c: (f64, f64),
+    cw: bool,
+    turns: u32,
+) -> Vec<(f64, f64)> {
+    let tau = std::f64::consts::TAU;
+    let r = ((from.0 - c.0).powi(2) + (from.1 - c.1).powi(2)).sqrt();
+    let a0 = (from.1 - c.1).atan2(from.0 - c.0);
+    let a1 = (to.1 - c.1).atan2(to.0 - c.0);
+    let mut sweep = if cw {
+        -(a0 - a1).rem_euclid(tau)
+    } else {
+        (a1 - a0).rem_euclid(tau)
+    };
+    if sweep == 0.0 {
+        sweep = if cw { -tau } else { tau };
+    }
+    sweep += (turns.saturating_sub(1).min(100) as f64) * sweep.signum() * tau;
+    let n = ((sweep.abs() / tau * 72.0).ceil() as usize).clamp(2, 2000);
+    let mut v: Vec<(f64, f64)> = (0..=n)
+        .map(|i| {
+            let a = a0 + sweep * i as f64 / n as f64;
+            (c.0 + r * a.cos(), c.1 + r * a.sin())
+        })
+        .collect();
+    if let Some(l) = v.last_mut() {
+        *l = to;
+    }
+    v
+}
+
+/// The panel of drawing strokes in this order (user units scaled to mm), air moves between
+/// consecutive strokes.
+pub fn drawing_panel(
+    title: &str,
+    d: &crate::io::drawing::Drawing,
+    strokes: &[crate::io::drawing::Stroke],
+) -> Panel {
+    let k = d.mm_per_unit;
+    let mut p = Panel {
+        title: title.to_string(),
+        ..Panel::default()
+    };
+    let mut at: Option<(f64, f64)> = None;
+    for s in strokes {
+        let mut pts: Vec<(f64, f64)> = s.points.iter().map(|q| (q[0] * k, q[1] * k)).collect();
+        if s.closed {
+            pts.push(pts[0]);
+        }
+        let start = pts[0];
+        if let Some(a) = at
+            && a != start
+        {
+            p.air.push([a, start]);
+        }
+        at = pts.last().copied();
+        p.cuts.push(pts);
+    }
+    p
+}
+
+/// Draws panels side by side (or, with `overlay`, the last panel's cuts with every panel's
+/// air moves in one picture). `y_down`: the file's y axis grows downwards (SVG), so the
+/// picture is drawn that way, as a browser shows the file.
+pub fn plot_panels(panels: &[Panel], y_down: bool, overlay: bool, out: &Path) -> Result<()> {
+    let fmt = PictureFormat::of(out)?;
+    register_font();
+    let file = out.display().to_string();
+    if panels.is_empty() {
+        return Err(Error::invalid(&file, "nothing to plot"));
+    }
+    let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
+    for p in panels {
+        for &(x, y) in p.cuts.iter().flatten().chain(p.air.iter().flatten()) {
+            x0 = x0.min(x);
+            x1 = x1.max(x);
+            y0 = y0.min(y);
+            y1 = y1.max(y);
+        }
+    }
+    if x0 > x1 {
+        (x0, x1, y0, y1) = (0.0, 1.0, 0.0, 1.0);
+    }
+    let pad = 0.04 * (x1 - x0).max(y1 - y0).max(1e-6);
+    let bx = (x0 - pad, x1 + pad, y0 - pad, y1 + pad);
+    let cols = if overlay { 1 } else { panels.len() as u32 };
+    let aspect = ((bx.3 - bx.2) / (bx.1 - bx.0)).clamp(0.2, 3.0);
+    let pw = if cols > 1 { 800u32 } else { 1200 };
+    let size = (pw * cols, ((pw as f64 * aspect) as u32 + 120).min(3000));
+    let err = |e: String| Error::invalid(&file, format!("drawing failed: {e}"));
+    // Drawn in memory and written once, through the safe write of `formats::write_atomic`.
+    let bytes = match fmt {
+        PictureFormat::Svg => {
+            let mut text = String::new();
+            {
+                let root = SVGBackend::with_string(&mut text, size).into_drawing_area();
+                draw_panels(&root, panels, bx, y_down, overlay).map_err(err)?;
+                root.present().map_err(|e| err(e.to_string()))?;
+            }
+            text.into_bytes()
+        }
+        PictureFormat::Png => {
+            let mut rgb = vec![0u8; size.0 as usize * size.1 as usize * 3];
+            {
+                let root = BitMapBackend::with_buffer(&mut rgb, size).into_drawing_area();
+                draw_panels(&root, panels, bx, y_down, overlay).map_err(err)?;
+                root.present().map_err(|e| err(e.to_string()))?;
+            }
+            encode_png(&rgb, size.0, size.1).map_err(err)?
+        }
+    };
+    crate::formats::write_atomic(out, &bytes)
+}
+
+fn draw_panels<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    panels: &[Panel],
+    bx: (f64, f64, f64, f64),
+    y_down: bool,
+    overlay: bool,
+) -> std::result::Result<(), String> {
+    let e = |x: DrawingAreaErrorKind<DB::ErrorType>| x.to_string();
+    root.fill(&WHITE).map_err(e)?;
+    let areas = if overlay {
+        vec![root.clone()]
+    } else {
+        root.split_evenly((1, panels.len()))
+    };
+    // y down: plot -y and label the ticks with y
+    let fy = |y: f64| if y_down { -y } else { y };
+    let (ya, yb) = if y_down { (-bx.3, -bx.2) } else { (bx.2, bx.3) };
+    let air_colours = [RGBColor(150, 150, 150), RGBColor(220, 30, 30)];
+    for (i, area) in areas.iter().enumerate() {
+        let shown: Vec<(usize, &Panel)> = if overlay {
+            panels.iter().enumerate().collect()
+        } else {
+            vec![(i, &panels[i])]
+        };
+        let main = shown.last().expect("a panel").1;
+        let caption = if overlay {
+            shown
+                .iter()
+                .map(|(_, p)| format!("{}: air {:.0} mm", p.title, p.air_length()))
+                .collect::<Vec<_>>()
+                .join("   ")
+        } else {
+            format!("{}: air {:.0} mm", main.title, main.air_length())
+        };
+        let mut chart = ChartBuilder::on(area)
+            .caption(caption, ("sans-serif", 20))
+            .margin(12)
+            .x_label_area_size(36)
+            .y_label_area_size(56)
+            .build_cartesian_2d(bx.0..bx.1, ya..yb)
+            .map_err(e)?;
+        let ylab = |v: &f64| format!("{}", if y_down { -*v } else { *v });
+        chart
+            .configure_mesh()
+            .x_desc("x (mm)")
+            .y_desc(if y_down { "y (mm, down)" } else { "y (mm)" })
+            .y_label_formatter(&ylab)
+            .light_line_style(WHITE.mix(0.0))
+            .draw()
+            .map_err(e)?;
+        chart
+            .draw_series(main.cuts.iter().map(|c| {
+                PathElement::new(
+                    c.iter().map(|&(x, y)| (x, fy(y))).collect::<Vec<_>>(),
+                    RGBColor(20, 60, 200).stroke_width(1),
+                )
+            }))
+            .map_err(e)?
+            .label("cutting / pen down")
+            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], RGBColor(20, 60, 200)));
+        for (k, (j, p)) in shown.iter().enumerate() {
+            let col = if overlay {
+                air_colours[(k + air_colours.len() - shown.len()).min(1)]
+            } else {
+                air_colours[(*j).min(1)]
+            };
+            chart
+                .draw_series(p.air.iter().map(|[a, b]| {
+                    PathElement::new(vec![(a.0, fy(a.1)), (b.0, fy(b.1))], col.stroke_width(1))
+                }))
+                .map_err(e)?
+                .label(format!("air ({})", p.title))
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], col));
+        }
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .label_font(("sans-serif", 14))
+            .position(SeriesLabelPosition::UpperRight)
+            .draw()
+            .map_err(e)?;
+    }
+    Ok(())
+}

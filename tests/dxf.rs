@@ -3,7 +3,8 @@
 use ::dxf::entities::{Arc, Circle, Entity, EntityType, Insert, Line, LwPolyline};
 use ::dxf::{Block, LwPolylineVertex, Point};
 use cellseq::io::dxf::{self, Post, ReadOptions};
-use cellseq::io::svg::{self, Options};
+use cellseq::io::svg;
+use cellseq::pipeline::drawing::{self as pipe, Options};
 use proptest::prelude::*;
 
 fn ent(layer: &str, t: EntityType) -> Entity {
@@ -124,7 +125,7 @@ fn gcode_post_is_verified_and_inner_first() {
         cut: true,
         ..Options::default()
     };
-    let out = svg::optimize(&d, &opts).unwrap();
+    let out = pipe::optimize(&d, &opts).unwrap();
     // the outer frame's layer comes after the inner layer
     assert_eq!(out.strokes.last().unwrap().layer, 1);
     assert_eq!(out.strokes.first().unwrap().layer, 2);
@@ -166,4 +167,80 @@ proptest! {
         b[i] = c;
         let _ = dxf::read("f.dxf", &b, ReadOptions::default());
     }
+}
+
+fn bytes_of(d: &::dxf::Drawing) -> Vec<u8> {
+    let mut buf = Vec::new();
+    d.save(&mut buf).unwrap();
+    buf
+}
+
+#[test]
+fn closed_polylines_without_vertices_draw_nothing_instead_of_panicking() {
+    let mut d = ::dxf::Drawing::new();
+    d.header.version = ::dxf::enums::AcadVersion::R2000;
+    let mut pl = LwPolyline::default();
+    pl.set_is_closed(true);
+    d.add_entity(ent("a", EntityType::LwPolyline(pl)));
+    let mut p = ::dxf::entities::Polyline::default();
+    p.set_is_closed(true);
+    d.add_entity(ent("a", EntityType::Polyline(p)));
+    let r = dxf::read("z.dxf", &bytes_of(&d), ReadOptions::default()).unwrap();
+    assert!(r.strokes.is_empty());
+    let out = pipe::optimize(&r, &Options::default()).unwrap();
+    assert!(out.strokes.is_empty());
+}
+
+#[test]
+fn units_come_from_insunits_else_from_the_option_with_a_warning() {
+    let mut d = ::dxf::Drawing::new();
+    d.header.version = ::dxf::enums::AcadVersion::R2000;
+    d.add_entity(ent(
+        "a",
+        EntityType::Line(Line::new(
+            Point::new(0.0, 0.0, 0.0),
+            Point::new(1.0, 0.0, 0.0),
+        )),
+    ));
+    d.header.default_drawing_units = ::dxf::enums::Units::Unitless;
+    let r = dxf::read("u.dxf", &bytes_of(&d), ReadOptions::default()).unwrap();
+    assert_eq!(r.mm_per_unit, 1.0);
+    assert!(r.warnings[0].contains("$INSUNITS"), "{:?}", r.warnings);
+    let inch = ReadOptions {
+        units: dxf::unit_mm("in"),
+        ..ReadOptions::default()
+    };
+    let r = dxf::read("u.dxf", &bytes_of(&d), inch).unwrap();
+    assert_eq!(r.mm_per_unit, 25.4);
+    assert!(r.warnings[0].contains("--units"), "{:?}", r.warnings);
+    d.header.default_drawing_units = ::dxf::enums::Units::Centimeters;
+    let r = dxf::read("u.dxf", &bytes_of(&d), inch).unwrap();
+    assert_eq!(r.mm_per_unit, 10.0);
+    // the G-code is in mm: the 1 cm line is 10 mm long
+    let g = dxf::write_gcode(&r, &r.strokes, &Post::default());
+    assert!(g.contains("X10 Y0"), "{g}");
+}
+
+#[test]
+fn spindle_and_laser_words_only_when_asked() {
+    let d = dxf::read("t.dxf", &drawing(), ReadOptions::default()).unwrap();
+    let plain = dxf::write_gcode(&d, &d.strokes, &Post::default());
+    assert!(!plain.contains("M3") && !plain.contains("M4") && !plain.contains("M5"));
+    let spindle = Post {
+        spindle: 12000.0,
+        ..Post::default()
+    };
+    let g = dxf::write_gcode(&d, &d.strokes, &spindle);
+    assert!(g.contains("M3 S12000") && g.contains("M5"));
+    dxf::verify_gcode(&d, "s.ngc", &g, &spindle).unwrap();
+    let laser = Post {
+        laser_power: 800.0,
+        ..Post::default()
+    };
+    let g = dxf::write_gcode(&d, &d.strokes, &laser);
+    assert!(
+        g.contains("M4 S800") && g.contains("M5") && !g.contains('Z'),
+        "{g}"
+    );
+    assert!(dxf::verify_gcode(&d, "l.ngc", &g, &laser).unwrap() > 20);
 }

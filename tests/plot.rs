@@ -81,3 +81,57 @@ fn cli_generate_solve_plot() {
     assert!(!o.status.success());
     assert!(String::from_utf8_lossy(&o.stderr).contains("rows"));
 }
+
+#[test]
+fn programs_and_drawings_plot_directly_right_way_up() {
+    use cellseq::io::svg;
+    use cellseq::plot::{drawing_panel, plot_panels, program_panel};
+    let dir = tempfile::tempdir().unwrap();
+    // an SVG triangle pointing down (y grows down in SVG): its apex has the largest y, and
+    // the y axis labels read as the file's y (not negated)
+    let t = "<svg xmlns=\"http://www.w3.org/2000/svg\"><polygon points=\"20,60 30,60 25,70\" stroke=\"black\"/><line x1=\"0\" y1=\"0\" x2=\"5\" y2=\"0\" stroke=\"black\"/></svg>";
+    let d = svg::read("t.svg", t, svg::ReadOptions::default()).unwrap();
+    let p = drawing_panel("before", &d, &d.strokes);
+    let k = d.mm_per_unit;
+    assert_eq!(p.cuts.len(), 2);
+    assert!((p.cuts[0].iter().map(|q| q.1).fold(0.0, f64::max) - 70.0 * k).abs() < 1e-9);
+    assert_eq!(p.air.len(), 1);
+    let out = dir.path().join("t.svg");
+    plot_panels(&[p.clone(), p], true, false, &out).unwrap();
+    let text = std::fs::read_to_string(&out).unwrap();
+    assert!(text.contains("y (mm, down)") && text.contains("before: air"));
+    assert!(
+        !text.contains(">-10<") && !text.contains(">-15<"),
+        "labels negated"
+    );
+    // a G-code program: an arc is drawn as an arc, air moves between cuts
+    let g = "G21 G90 G17\nG0 Z5\nG0 X0 Y0\nG1 Z-1 F100\nG1 X10 F500\nG2 X20 Y0 I5 J0\nG0 Z5\nG0 X0 Y20\nG1 Z-1\nG1 X10 Y20\nG0 Z5\nM2\n";
+    let prog = cellseq::io::gcode::interp::interpret(g).unwrap();
+    let p = program_panel("g", &prog);
+    assert!(p.cuts.iter().map(|c| c.len()).sum::<usize>() > 10);
+    assert!(p.air.iter().any(|[a, b]| a.1 == 0.0 && b.1 == 20.0));
+    // arc of a G2 from (10,0) to (20,0) around (15,0): clockwise, so over the top (y > 0)
+    assert!(p.cuts.iter().flatten().any(|q| q.1 > 4.9));
+    let png = dir.path().join("g.png");
+    plot_panels(&[p], false, true, &png).unwrap();
+    assert_eq!(&std::fs::read(&png).unwrap()[..4], b"\x89PNG");
+}
+
+#[test]
+fn cli_plots_svg_with_optimized_side_by_side() {
+    let exe = env!("CARGO_BIN_EXE_cellseq");
+    let dir = tempfile::tempdir().unwrap();
+    let pic = dir.path().join("s.png");
+    let o = std::process::Command::new(exe)
+        .args([
+            "plot",
+            "tests/fixtures/svg/shapes.svg",
+            "--optimized",
+            "-o",
+            pic.to_str().unwrap(),
+        ])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(&std::fs::read(&pic).unwrap()[..4], b"\x89PNG");
+}

@@ -1,6 +1,7 @@
 //! SVG reader, sequencer, writer and verifier.
 
-use cellseq::io::svg::{self, Options, ReadOptions};
+use cellseq::io::svg::{self, ReadOptions};
+use cellseq::pipeline::drawing::{self as pipe, Options};
 use proptest::prelude::*;
 
 fn fixture(name: &str) -> String {
@@ -17,13 +18,14 @@ fn reads_all_shapes_layers_and_dots() {
     assert!(d.strokes.iter().filter(|s| s.layer == 1).all(|s| s.closed));
     let dots: Vec<_> = d.strokes.iter().filter(|s| s.is_dot()).collect();
     assert_eq!(dots.len(), 1);
-    // transform of the layer and nested group applied to the dot: translate(1,2) scale(.5)
+    // transform of the layer and nested group applied to the dot (coordinates are kept at
+    // the 6 decimals the writer prints): translate(1,2) scale(.5)
     // then matrix(1 0 0 1 5 5) skewX(10) skewY(5) on (150,150)
     let t = (10f64).to_radians().tan();
     let u = (5f64).to_radians().tan();
     let (x, y) = (150.0 + t * (150.0 + u * 150.0), 150.0 + u * 150.0);
     let (x, y) = (1.0 + 0.5 * (x + 5.0), 2.0 + 0.5 * (y + 5.0));
-    assert!((dots[0].points[0][0] - x).abs() < 1e-9 && (dots[0].points[0][1] - y).abs() < 1e-9);
+    assert!((dots[0].points[0][0] - x).abs() < 1e-6 && (dots[0].points[0][1] - y).abs() < 1e-6);
     // the first line scaled: (1,2)-(6,2), red, width 0.15
     let l = d
         .strokes
@@ -47,7 +49,7 @@ fn reads_all_shapes_layers_and_dots() {
 fn optimize_writes_the_same_drawing_with_less_pen_up() {
     let text = fixture("vpype_multilayer_3layers.svg");
     let d = svg::read("m.svg", &text, ReadOptions::default()).unwrap();
-    let out = svg::optimize(&d, &Options::default()).unwrap();
+    let out = pipe::optimize(&d, &Options::default()).unwrap();
     assert_eq!(out.strokes.len(), d.strokes.len());
     assert!(out.after.pen_up_mm < 0.2 * out.before.pen_up_mm);
     let w = svg::write(&d, &out.strokes);
@@ -72,7 +74,7 @@ fn registry_solver_and_no_reversal_also_verify() {
             reversible: rev,
             ..Options::default()
         };
-        let out = svg::optimize(&d, &o).unwrap();
+        let out = pipe::optimize(&d, &o).unwrap();
         let w = svg::write(&d, &out.strokes);
         svg::verify(&d, "w.svg", &w).unwrap();
         if !rev {
@@ -86,7 +88,7 @@ fn registry_solver_and_no_reversal_also_verify() {
 #[test]
 fn tampered_output_is_rejected() {
     let d = svg::read("s.svg", &fixture("shapes.svg"), ReadOptions::default()).unwrap();
-    let out = svg::optimize(&d, &Options::default()).unwrap();
+    let out = pipe::optimize(&d, &Options::default()).unwrap();
     let mut s = out.strokes.clone();
     s.pop();
     assert!(svg::verify(&d, "w.svg", &svg::write(&d, &s)).is_err());
@@ -102,7 +104,7 @@ fn cut_mode_puts_inner_contours_first() {
         cut: true,
         ..Options::default()
     };
-    let out = svg::optimize(&d, &o).unwrap();
+    let out = pipe::optimize(&d, &o).unwrap();
     assert!(out.edges >= 3);
     let cut: Vec<_> = out.strokes.iter().filter(|s| s.layer == 1).collect();
     // the 80x80 square is last in its layer
@@ -110,23 +112,127 @@ fn cut_mode_puts_inner_contours_first() {
 }
 
 #[test]
-fn unsupported_and_malformed_input_is_refused_with_a_line() {
-    let t = "<svg xmlns=\"http://www.w3.org/2000/svg\">\n<text>hi</text>\n</svg>";
-    let e = svg::read("t.svg", t, ReadOptions::default())
-        .unwrap_err()
-        .to_string();
-    assert!(e.starts_with("t.svg:2:") && e.contains("text"), "{e}");
+fn elements_not_sequenced_are_kept_in_place_and_malformed_input_is_refused_with_a_line() {
+    let t = "<svg xmlns=\"http://www.w3.org/2000/svg\">\n<g transform=\"scale(2)\"><text>hi &amp; ho</text></g>\n<line x2=\"1\" stroke=\"red\"/></svg>";
+    let d = svg::read("t.svg", t, ReadOptions::default()).unwrap();
+    assert_eq!(d.kept.len(), 1);
+    assert_eq!(d.kept[0].line, 2);
+    assert_eq!(
+        d.kept[0].xml,
+        "<g transform=\"scale(2)\"><text>hi &amp; ho</text></g>"
+    );
+    let out = pipe::optimize(&d, &Options::default()).unwrap();
+    let w = svg::write(&d, &out.strokes);
+    assert!(w.contains("<g transform=\"scale(2)\"><text>hi &amp; ho</text></g>"));
+    svg::verify(&d, "w.svg", &w).unwrap();
+    // a kept element lost on the way is caught
+    let mut lost = d.clone();
+    lost.kept.clear();
+    let e = svg::verify(&d, "w.svg", &svg::write(&lost, &out.strokes)).unwrap_err();
+    assert!(e.to_string().contains("kept"), "{e}");
     let skip = ReadOptions {
         skip_unsupported: true,
         ..ReadOptions::default()
     };
-    assert_eq!(svg::read("t.svg", t, skip).unwrap().skipped.len(), 1);
+    let d = svg::read("t.svg", t, skip).unwrap();
+    assert_eq!((d.skipped.len(), d.kept.len()), (1, 0));
     let t = "<svg xmlns=\"http://www.w3.org/2000/svg\">\n\n<path d=\"M 0 0 L 1 x\"/>\n</svg>";
     let e = svg::read("p.svg", t, ReadOptions::default())
         .unwrap_err()
         .to_string();
     assert!(e.starts_with("p.svg:3:"), "{e}");
     assert!(svg::read("x.svg", "<svg", ReadOptions::default()).is_err());
+}
+
+#[test]
+fn doctype_is_accepted_and_entity_declarations_are_refused() {
+    let t = "<?xml version=\"1.0\"?>\n<!DOCTYPE svg PUBLIC \"-//W3C//DTD SVG 1.1//EN\" \"http://www.w3.org/Graphics/SVG/1.1/DTD/svg11.dtd\">\n<svg xmlns=\"http://www.w3.org/2000/svg\"><line x2=\"5\" stroke=\"black\"/></svg>";
+    assert_eq!(
+        svg::read("d.svg", t, ReadOptions::default())
+            .unwrap()
+            .strokes
+            .len(),
+        1
+    );
+    let t = "<?xml version=\"1.0\"?>\n<!DOCTYPE svg [\n<!ENTITY a \"x\">]>\n<svg xmlns=\"http://www.w3.org/2000/svg\"><text>&a;</text></svg>";
+    let e = svg::read("e.svg", t, ReadOptions::default())
+        .unwrap_err()
+        .to_string();
+    assert!(e.starts_with("e.svg:3:") && e.contains("entity"), "{e}");
+}
+
+#[test]
+fn invisible_zero_length_paths_are_kept_not_sequenced_and_round_caps_draw_dots() {
+    let t = "<svg xmlns=\"http://www.w3.org/2000/svg\"><path d=\"M 3,4 Z\" stroke=\"black\"/><path d=\"M 5,5 Z\" stroke=\"black\" stroke-linecap=\"round\"/><line x2=\"1\" stroke=\"black\"/></svg>";
+    let d = svg::read("z.svg", t, ReadOptions::default()).unwrap();
+    assert_eq!(d.kept.len(), 1);
+    assert_eq!(d.strokes.iter().filter(|s| s.is_dot()).count(), 1);
+    let out = pipe::optimize(&d, &Options::default()).unwrap();
+    let w = svg::write(&d, &out.strokes);
+    assert_eq!(svg::verify(&d, "w.svg", &w).unwrap(), 2);
+}
+
+fn svg_with(body: &str) -> String {
+    format!(
+        "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"100mm\" height=\"100mm\" viewBox=\"0 0 100 100\">\n{body}\n</svg>"
+    )
+}
+
+#[test]
+fn deep_nesting_huge_shapes_and_point_caps_are_bounded() {
+    // 50 000 nested groups: walked without recursion
+    let t = svg_with(&format!(
+        "{}<line x2=\"1\" stroke=\"black\"/>{}",
+        "<g>".repeat(50_000),
+        "</g>".repeat(50_000)
+    ));
+    assert_eq!(
+        svg::read("n.svg", &t, ReadOptions::default())
+            .unwrap()
+            .strokes
+            .len(),
+        1
+    );
+    // a circle of radius 1e308 is refused before kurbo builds it
+    let t = svg_with("<circle r=\"1e308\" stroke=\"black\"/>");
+    let e = svg::read("c.svg", &t, ReadOptions::default())
+        .unwrap_err()
+        .to_string();
+    assert!(e.starts_with("c.svg:2:") && e.contains("size"), "{e}");
+    // a circle of radius 1e9 is flattened with a tolerance relative to its size, and verifies
+    let t = svg_with("<circle r=\"1e9\" stroke=\"black\"/>");
+    let d = svg::read("c.svg", &t, ReadOptions::default()).unwrap();
+    let n = d.strokes[0].points.len();
+    assert!((100..20_000).contains(&n), "{n} points");
+    let out = pipe::optimize(&d, &Options::default()).unwrap();
+    assert_eq!(
+        svg::verify(&d, "w.svg", &svg::write(&d, &out.strokes)).unwrap(),
+        n
+    );
+    // the point cap
+    let capped = ReadOptions {
+        max_points: 50,
+        ..ReadOptions::default()
+    };
+    let t = svg_with("<circle r=\"40\" stroke=\"black\"/>");
+    let e = svg::read("c.svg", &t, capped).unwrap_err().to_string();
+    assert!(e.contains("--max-points"), "{e}");
+}
+
+#[test]
+fn coincident_strokes_and_a_far_point_stay_linear() {
+    // 4000 identical strokes and one dot at 1e7: the default budget is linear in the strokes
+    let mut body = String::new();
+    for _ in 0..4000 {
+        body.push_str("<line x1=\"10\" y1=\"10\" x2=\"20\" y2=\"20\" stroke=\"black\"/>\n");
+    }
+    body.push_str("<path d=\"M 1e7,1e7 Z\" stroke=\"black\" stroke-linecap=\"round\"/>");
+    let d = svg::read("c.svg", &svg_with(&body), ReadOptions::default()).unwrap();
+    assert_eq!(d.strokes.len(), 4001);
+    let out = pipe::optimize(&d, &Options::default()).unwrap();
+    // every stroke joins the previous one end to start (back and forth), then the far dot
+    assert_eq!(out.after.lifts, 2);
+    svg::verify(&d, "w.svg", &svg::write(&d, &out.strokes)).unwrap();
 }
 
 proptest! {
@@ -140,7 +246,7 @@ proptest! {
     fn reader_never_panics_on_random_path_data(d in "[MmLlHhVvCcSsQqTtAaZz0-9 ,.eE+-]{0,80}") {
         let s = format!("<svg xmlns=\"http://www.w3.org/2000/svg\"><path d=\"{d}\"/></svg>");
         if let Ok(dr) = svg::read("f.svg", &s, ReadOptions::default()) {
-            let out = svg::optimize(&dr, &Options::default()).unwrap();
+            let out = pipe::optimize(&dr, &Options::default()).unwrap();
             let w = svg::write(&dr, &out.strokes);
             prop_assert!(svg::verify(&dr, "w.svg", &w).is_ok());
         }

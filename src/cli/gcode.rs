@@ -4,7 +4,6 @@ use anyhow::{Context as _, bail};
 use cellseq::formats::write::ensure_not_input;
 use cellseq::formats::{read_text, save_instance, write_atomic};
 use cellseq::io::gcode::{self, Figures, Options};
-use cellseq::io::svg;
 use clap::Args;
 use std::path::{Path, PathBuf};
 
@@ -19,13 +18,17 @@ pub struct OptimizeArgs {
     /// Allow the output to be the input file itself (by any path or link).
     #[arg(long)]
     pub overwrite_input: bool,
-    /// Solver from the registry (default: greedy for G-code; for SVG/DXF the built-in
-    /// `drawing` sequencer: grid greedy + 2-opt with reversal).
+    /// Solver from the registry (default: greedy for G-code; for SVG/DXF `drawing`: greedy,
+    /// 2-opt/Or-opt with reversal, iterated local search).
     #[arg(long)]
     pub solver: Option<String>,
     /// Time limit in seconds (shared among tool blocks).
     #[arg(long, value_name = "S")]
     pub time_limit: Option<f64>,
+    /// Evaluation budget (deterministic: the same result on any machine); shared among tool
+    /// blocks or drawing scopes by size.
+    #[arg(long, value_name = "N")]
+    pub max_evals: Option<u64>,
     /// Seed.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
@@ -53,51 +56,7 @@ pub struct OptimizeArgs {
     #[arg(long, default_value_t = 0.5)]
     pub margin: f64,
     #[command(flatten)]
-    pub drawing: DrawingArgs,
-}
-
-/// Options of SVG and DXF input.
-#[derive(Args, Debug, Clone)]
-pub struct DrawingArgs {
-    /// Curve flattening tolerance (mm).
-    #[arg(long, default_value_t = 0.01)]
-    pub tolerance: f64,
-    /// Sequence the whole drawing at once instead of layer by layer / colour by colour.
-    #[arg(long)]
-    pub no_scopes: bool,
-    /// Cut mode: strokes inside a closed stroke are drawn/cut before it.
-    #[arg(long)]
-    pub cut: bool,
-    /// Containment tolerance of cut mode (mm).
-    #[arg(long, default_value_t = 0.01)]
-    pub contain_tol: f64,
-    /// Start-vertex candidates per closed stroke when reversible.
-    #[arg(long, default_value_t = 8)]
-    pub max_starts: usize,
-    /// Skip unsupported elements (SVG text, images, DXF text, hatches, …) instead of refusing.
-    #[arg(long)]
-    pub skip_unsupported: bool,
-    /// DXF: chain loose pieces whose endpoints are closer than this (mm).
-    #[arg(long, default_value_t = 0.001)]
-    pub join_tol: f64,
-    /// DXF: do not put inner contours first (cut mode is on by default for DXF).
-    #[arg(long)]
-    pub no_inner_first: bool,
-    /// DXF G-code post: safe height (mm).
-    #[arg(long, default_value_t = 5.0)]
-    pub safe_height: f64,
-    /// DXF G-code post: cutting depth below Z0 (mm).
-    #[arg(long, default_value_t = 1.0)]
-    pub cut_depth: f64,
-    /// DXF G-code post: cutting feed (mm/min).
-    #[arg(long, default_value_t = 1000.0)]
-    pub feed: f64,
-    /// DXF G-code post: plunge / pierce feed (mm/min).
-    #[arg(long, default_value_t = 300.0)]
-    pub plunge_feed: f64,
-    /// DXF G-code post: spindle speed or laser power (M3 S…); 0 writes no spindle words.
-    #[arg(long, default_value_t = 0.0)]
-    pub spindle: f64,
+    pub drawing: super::drawing::DrawingArgs,
 }
 
 /// Arguments of `import`.
@@ -124,7 +83,7 @@ pub struct ImportArgs {
     #[arg(long)]
     pub no_reversible: bool,
     #[command(flatten)]
-    pub drawing: DrawingArgs,
+    pub drawing: super::drawing::DrawingArgs,
 }
 
 /// Arguments of `verify-gcode`.
@@ -139,7 +98,7 @@ pub struct VerifyArgs {
     pub json: bool,
 }
 
-fn format_of(path: &Path, given: Option<&str>) -> anyhow::Result<&'static str> {
+pub(super) fn format_of(path: &Path, given: Option<&str>) -> anyhow::Result<&'static str> {
     let f = match given {
         Some(g) => g.to_ascii_lowercase(),
         None => path
@@ -197,17 +156,8 @@ pub fn optimize(a: OptimizeArgs) -> anyhow::Result<()> {
         ensure_not_input(&a.input, o, a.overwrite_input)?;
     }
     let fmt = format_of(&a.input, a.format.as_deref())?;
-    if fmt == "svg" {
-        return optimize_svg(&a);
-    }
-    if fmt == "dxf" {
-        return optimize_dxf(&a);
-    }
     if fmt != "gcode" {
-        bail!(
-            "{}: {fmt} input is not supported yet (only G-code and SVG)",
-            a.input.display()
-        );
+        return super::drawing::optimize(&a, fmt);
     }
     let file = a.input.display().to_string();
     let text = read_text(&a.input)?;
@@ -290,34 +240,8 @@ pub fn optimize(a: OptimizeArgs) -> anyhow::Result<()> {
 pub fn import(a: ImportArgs) -> anyhow::Result<()> {
     ensure_not_input(&a.input, &a.output, a.overwrite_input)?;
     let fmt = format_of(&a.input, a.format.as_deref())?;
-    if fmt == "svg" || fmt == "dxf" {
-        let file = a.input.display().to_string();
-        let d = if fmt == "svg" {
-            read_svg(&a.input, &a.drawing)?
-        } else {
-            read_dxf(&a.input, &a.drawing)?
-        };
-        let mut opts = svg_options(&d, &a.drawing, !a.no_reversible, "greedy", None, 1);
-        if fmt == "dxf" {
-            opts.cut = !a.drawing.no_inner_first;
-        }
-        let inst = svg::import(&d, &opts)?;
-        cellseq::validate::validate(&inst, &file)?;
-        save_instance(&a.output, &inst)?;
-        say!(
-            "{}: {} strokes, {} precedence edges -> {}",
-            file,
-            inst.n(),
-            inst.precedence.len(),
-            a.output.display()
-        );
-        return Ok(());
-    }
     if fmt != "gcode" {
-        bail!(
-            "{}: {fmt} input is not supported yet (only G-code)",
-            a.input.display()
-        );
+        return super::drawing::import(&a, fmt);
     }
     let file = a.input.display().to_string();
     let text = read_text(&a.input)?;
@@ -357,234 +281,6 @@ pub fn verify(a: VerifyArgs) -> anyhow::Result<()> {
             v.cuts
         );
         print_figures(&v.before, &v.after);
-    }
-    Ok(())
-}
-
-fn read_svg(path: &Path, d: &DrawingArgs) -> anyhow::Result<svg::Drawing> {
-    let file = path.display().to_string();
-    let text = read_text(path)?;
-    // the tolerance is given in mm; the reader works in user units
-    let probe = svg::read(
-        &file,
-        &text,
-        svg::ReadOptions {
-            tolerance: 1e9,
-            skip_unsupported: true,
-        },
-    )?;
-    let tol = d.tolerance / probe.mm_per_unit;
-    Ok(svg::read(
-        &file,
-        &text,
-        svg::ReadOptions {
-            tolerance: tol,
-            skip_unsupported: d.skip_unsupported,
-        },
-    )?)
-}
-
-fn svg_options(
-    d: &svg::Drawing,
-    a: &DrawingArgs,
-    reversible: bool,
-    solver: &str,
-    time_limit: Option<f64>,
-    seed: u64,
-) -> svg::Options {
-    svg::Options {
-        solver: solver.to_string(),
-        time_limit,
-        seed,
-        reversible,
-        scopes: !a.no_scopes,
-        cut: a.cut,
-        contain_tol: a.contain_tol / d.mm_per_unit,
-        max_starts: a.max_starts,
-    }
-}
-
-fn optimize_svg(a: &OptimizeArgs) -> anyhow::Result<()> {
-    let file = a.input.display().to_string();
-    let t0 = std::time::Instant::now();
-    let d = read_svg(&a.input, &a.drawing)?;
-    let read_s = t0.elapsed().as_secs_f64();
-    // reversible by default for drawings
-    let reversible = !a.no_reversible;
-    let solver = a
-        .solver
-        .clone()
-        .unwrap_or_else(|| svg::DRAWING_SOLVER.to_string());
-    let opts = svg_options(&d, &a.drawing, reversible, &solver, a.time_limit, a.seed);
-    let out = svg::optimize(&d, &opts)?;
-    let text = svg::write(&d, &out.strokes);
-    let segments = svg::verify(&d, "<optimized>", &text)?;
-    if let Some(o) = &a.output {
-        write_atomic(o, text.as_bytes()).with_context(|| format!("writing {}", o.display()))?;
-    }
-    let total_s = t0.elapsed().as_secs_f64();
-    if a.json {
-        let v = serde_json::json!({
-            "input": file,
-            "output": a.output.as_ref().map(|p| p.display().to_string()),
-            "solver": solver,
-            "strokes": d.strokes.len(),
-            "scopes": out.scopes,
-            "precedence_edges": out.edges,
-            "reversible": reversible,
-            "verified_segments": segments,
-            "skipped": d.skipped,
-            "read_s": read_s,
-            "solve_s": out.solve_s,
-            "total_s": total_s,
-            "kept_original_scopes": out.kept_original,
-            "before": out.before,
-            "after": out.after,
-        });
-        say!("{}", serde_json::to_string_pretty(&v)?);
-    } else {
-        say!(
-            "{file}: {} strokes in {} scope(s); solver {} ({:.3} s, total {:.3} s); {} segments verified identical",
-            d.strokes.len(),
-            out.scopes,
-            solver,
-            out.solve_s,
-            total_s,
-            segments
-        );
-        for s in &d.skipped {
-            say!("skipped: {s}");
-        }
-        let pct = |x: f64, y: f64| if x > 0.0 { 100.0 * (x - y) / x } else { 0.0 };
-        let (b, f) = (&out.before, &out.after);
-        say!("{:<20} {:>14} {:>14} {:>8}", "", "before", "after", "saved");
-        say!(
-            "{:<20} {:>14.1} {:>14.1} {:>7.1}%",
-            "pen-up mm (layer)",
-            b.pen_up_mm,
-            f.pen_up_mm,
-            pct(b.pen_up_mm, f.pen_up_mm)
-        );
-        say!(
-            "{:<20} {:>14.1} {:>14.1} {:>7.1}%",
-            "pen-up mm (total)",
-            b.pen_up_total_mm,
-            f.pen_up_total_mm,
-            pct(b.pen_up_total_mm, f.pen_up_total_mm)
-        );
-        say!("{:<20} {:>14} {:>14}", "pen lifts", b.lifts, f.lifts);
-        say!(
-            "{:<20} {:>14.1} {:>14.1}",
-            "pen-down mm",
-            b.draw_mm,
-            f.draw_mm
-        );
-        if let Some(o) = &a.output {
-            say!("wrote {}", o.display());
-        }
-    }
-    Ok(())
-}
-
-fn read_dxf(path: &Path, d: &DrawingArgs) -> anyhow::Result<svg::Drawing> {
-    let file = path.display().to_string();
-    let bytes = std::fs::read(path).with_context(|| format!("reading {file}"))?;
-    let mut o = cellseq::io::dxf::ReadOptions {
-        tolerance: d.tolerance,
-        join: d.join_tol,
-        skip_unsupported: d.skip_unsupported,
-    };
-    let dr = cellseq::io::dxf::read(&file, &bytes, o)?;
-    if dr.mm_per_unit == 1.0 {
-        return Ok(dr);
-    }
-    o.tolerance /= dr.mm_per_unit;
-    o.join /= dr.mm_per_unit;
-    Ok(cellseq::io::dxf::read(&file, &bytes, o)?)
-}
-
-fn optimize_dxf(a: &OptimizeArgs) -> anyhow::Result<()> {
-    use cellseq::io::dxf;
-    let file = a.input.display().to_string();
-    let t0 = std::time::Instant::now();
-    let d = read_dxf(&a.input, &a.drawing)?;
-    let reversible = !a.no_reversible;
-    let solver = a
-        .solver
-        .clone()
-        .unwrap_or_else(|| svg::DRAWING_SOLVER.to_string());
-    let mut opts = svg_options(&d, &a.drawing, reversible, &solver, a.time_limit, a.seed);
-    opts.cut = !a.drawing.no_inner_first;
-    let out = svg::optimize(&d, &opts)?;
-    let post = dxf::Post {
-        safe_height: a.drawing.safe_height,
-        depth: a.drawing.cut_depth,
-        feed: a.drawing.feed,
-        plunge_feed: a.drawing.plunge_feed,
-        spindle: a.drawing.spindle,
-    };
-    let preview = a
-        .output
-        .as_ref()
-        .and_then(|o| o.extension())
-        .is_some_and(|e| e.eq_ignore_ascii_case("svg"));
-    let (text, segments) = if preview {
-        let t = svg::write(&d, &out.strokes);
-        let n = svg::verify(&d, "<optimized>", &t)?;
-        (t, n)
-    } else {
-        let t = dxf::write_gcode(&d, &out.strokes, &post);
-        let n = dxf::verify_gcode(&d, "<optimized>", &t, &post)?;
-        (t, n)
-    };
-    if let Some(o) = &a.output {
-        write_atomic(o, text.as_bytes()).with_context(|| format!("writing {}", o.display()))?;
-    }
-    let total_s = t0.elapsed().as_secs_f64();
-    let closed = d.strokes.iter().filter(|s| s.closed).count();
-    if a.json {
-        let v = serde_json::json!({
-            "input": file,
-            "output": a.output.as_ref().map(|p| p.display().to_string()),
-            "output_kind": if preview { "svg" } else { "gcode" },
-            "solver": solver,
-            "contours": d.strokes.len(),
-            "closed_contours": closed,
-            "layers": d.layers.len() - 1,
-            "scopes": out.scopes,
-            "inner_first_edges": out.edges,
-            "reversible": reversible,
-            "verified_segments": segments,
-            "skipped": d.skipped,
-            "solve_s": out.solve_s,
-            "total_s": total_s,
-            "before": out.before,
-            "after": out.after,
-        });
-        say!("{}", serde_json::to_string_pretty(&v)?);
-    } else {
-        say!(
-            "{file}: {} contours ({closed} closed) on {} layer(s); {} inner-first edges; solver {} ({:.3} s); {} segments verified identical",
-            d.strokes.len(),
-            d.layers.len() - 1,
-            out.edges,
-            solver,
-            out.solve_s,
-            segments
-        );
-        for s in &d.skipped {
-            say!("skipped: {s}");
-        }
-        say!(
-            "travel mm (file order -> optimized): {:.1} -> {:.1}; pierces {} -> {}",
-            out.before.pen_up_total_mm,
-            out.after.pen_up_total_mm,
-            out.before.lifts,
-            out.after.lifts
-        );
-        if let Some(o) = &a.output {
-            say!("wrote {}", o.display());
-        }
     }
     Ok(())
 }

@@ -14,6 +14,7 @@ macro_rules! say {
 
 mod bound;
 mod demo;
+mod drawing;
 mod gcode;
 mod harness;
 mod plot;

@@ -1,13 +1,13 @@
 //! DXF drawings (2-D cutting) through the `dxf` crate: LINE, ARC, CIRCLE, ELLIPSE, LWPOLYLINE
 //! and POLYLINE (with bulges), SPLINE (flattened), INSERT (blocks, nested, with scale, rotation,
 //! arrays). Loose pieces are chained into contours per layer (endpoints within a tolerance are
-//! snapped together). The result is an [`svg::Drawing`] (one layer per DXF layer, y up), so
+//! snapped together). The result is a [`crate::io::drawing::Drawing`] (one layer per DXF layer, y up), so
 //! sequencing, the SVG preview and verification are shared with SVG; [`write_gcode`] is a
 //! simple configurable post.
 
 use crate::error::{Error, Result};
+use crate::io::drawing::{self as svg, Drawing, Layer, Stroke, Style};
 use crate::io::gcode::interp::{self, CutKind};
-use crate::io::svg::{self, Drawing, Layer, Stroke, Style};
 use dxf::entities::EntityType;
 use kurbo::Affine;
 use std::collections::HashMap;
@@ -22,6 +22,57 @@ pub struct ReadOptions {
     pub join: f64,
     /// Skip unsupported entities (text, hatches, dimensions, …) instead of refusing the file.
     pub skip_unsupported: bool,
+    /// Millimetres per drawing unit when the file does not say (`$INSUNITS` missing or
+    /// unitless); `None` assumes millimetres. Either way the drawing carries a warning.
+    pub units: Option<f64>,
+}
+
+/// Millimetres per unit of a unit name (`mm`, `cm`, `m`, `in`, `ft`, `mil`, `um`).
+pub fn unit_mm(name: &str) -> Option<f64> {
+    Some(match name.trim().to_ascii_lowercase().as_str() {
+        "mm" | "millimeter" | "millimeters" | "millimetre" | "millimetres" => 1.0,
+        "cm" => 10.0,
+        "m" => 1000.0,
+        "in" | "inch" | "inches" => 25.4,
+        "ft" | "foot" | "feet" => 304.8,
+        "mil" | "mils" | "thou" => 0.0254,
+        "um" | "micron" | "microns" => 0.001,
+        _ => return None,
+    })
+}
+
+/// Millimetres per unit of `$INSUNITS`; `Ok(None)` for unitless.
+fn insunits_mm(file: &str, u: dxf::enums::Units) -> Result<Option<f64>> {
+    use dxf::enums::Units as U;
+    Ok(Some(match u {
+        U::Unitless => return Ok(None),
+        U::Inches => 25.4,
+        U::Feet => 304.8,
+        U::Miles => 1_609_344.0,
+        U::Millimeters => 1.0,
+        U::Centimeters => 10.0,
+        U::Meters => 1000.0,
+        U::Kilometers => 1e6,
+        U::Microinches => 25.4e-6,
+        U::Mils => 0.0254,
+        U::Yards => 914.4,
+        U::Angstroms => 1e-7,
+        U::Nanometers => 1e-6,
+        U::Microns => 1e-3,
+        U::Decimeters => 100.0,
+        U::Decameters => 1e4,
+        U::Hectometers => 1e5,
+        U::USSurveyFeet => 1_200_000.0 / 3937.0,
+        U::USSurveyInch => 100_000.0 / 3937.0,
+        U::USSurveyYard => 3_600_000.0 / 3937.0,
+        U::USSurveyMile => 6_336_000_000.0 / 3937.0,
+        other => {
+            return Err(Error::invalid(
+                file,
+                format!("$INSUNITS {other:?} is not a unit for machining or plotting"),
+            ));
+        }
+    }))
 }
 
 impl Default for ReadOptions {
@@ -30,6 +81,7 @@ impl Default for ReadOptions {
             tolerance: 0.01,
             join: 1e-3,
             skip_unsupported: false,
+            units: None,
         }
     }
 }
@@ -81,12 +133,34 @@ pub fn read(file: &str, bytes: &[u8], opts: ReadOptions) -> Result<Drawing> {
         return Err(Error::invalid(file, "tolerances must be positive"));
     }
     let dwg = load_guarded(file, bytes)?;
-    let mm = match dwg.header.default_drawing_units {
-        dxf::enums::Units::Inches => 25.4,
-        dxf::enums::Units::Feet => 304.8,
-        dxf::enums::Units::Centimeters => 10.0,
-        dxf::enums::Units::Meters => 1000.0,
-        _ => 1.0,
+    let mut warnings = Vec::new();
+    let mm = match insunits_mm(file, dwg.header.default_drawing_units)? {
+        Some(mm) => {
+            if let Some(u) = opts.units
+                && u != mm
+            {
+                warnings.push(format!(
+                    "the file's $INSUNITS ({:?}) wins over --units",
+                    dwg.header.default_drawing_units
+                ));
+            }
+            mm
+        }
+        None => match opts.units {
+            Some(u) => {
+                warnings.push(format!(
+                    "the file does not say its units ($INSUNITS): {u} mm per unit from --units"
+                ));
+                u
+            }
+            None => {
+                warnings.push(
+                    "the file does not say its units ($INSUNITS): millimetres assumed (set them with --units)"
+                        .to_string(),
+                );
+                1.0
+            }
+        },
     };
     let mut ctx = Ctx {
         file,
@@ -125,7 +199,10 @@ pub fn read(file: &str, bytes: &[u8], opts: ReadOptions) -> Result<Drawing> {
         }],
         strokes: Vec::new(),
         skipped,
+        warnings,
         flip_y: true,
+        kept: Vec::new(),
+        namespaces: Vec::new(),
     };
     for (li, _) in layers.iter().enumerate() {
         let mine: Vec<&Piece> = pieces.iter().filter(|p| p.layer == li).collect();
@@ -154,7 +231,9 @@ fn sweep_of(s: f64, t: f64) -> f64 {
 }
 
 fn arc_points(c: [f64; 2], r: f64, a0: f64, sweep: f64, tol: f64) -> Vec<[f64; 2]> {
-    // chord error r(1 - cos(θ/2)) <= tol
+    // chord error r(1 - cos(θ/2)) <= tol, with at most ~10^4 segments per full turn of a
+    // huge arc (the tolerance grows with the radius)
+    let tol = tol.max(r.abs() * 1e-6);
     let step = if r > tol {
         2.0 * (1.0 - tol / r).acos()
     } else {
@@ -282,6 +361,10 @@ fn entity(
     let tol = ctx.opts.tolerance;
     let handle = format!("{:X}", e.common.handle.0);
     let add = |ctx: &mut Ctx, pts: Vec<[f64; 2]>, closed: bool| -> Result<()> {
+        if pts.is_empty() {
+            // a polyline without vertices draws nothing
+            return Ok(());
+        }
         ctx.points += pts.len();
         if ctx.points > MAX_POINTS {
             return Err(Error::invalid(
@@ -559,8 +642,12 @@ pub struct Post {
     pub feed: f64,
     /// Plunge feed, mm/min.
     pub plunge_feed: f64,
-    /// Spindle speed / laser power (S word with M3); 0 = no spindle words.
+    /// Spindle speed (`M3 S…` before the first cut, `M5` at the end); 0 writes no spindle
+    /// words (the operator's spindle state is left alone).
     pub spindle: f64,
+    /// Laser power: a laser post (`M4 S…`, power scaled with speed on GRBL-style controllers,
+    /// off on rapids; `M5` at the end) with no Z moves at all; 0 = not a laser post.
+    pub laser_power: f64,
 }
 
 impl Default for Post {
@@ -571,13 +658,16 @@ impl Default for Post {
             feed: 1000.0,
             plunge_feed: 300.0,
             spindle: 0.0,
+            laser_power: 0.0,
         }
     }
 }
 
 /// Writes strokes (drawing units, converted to mm) as G-code: per stroke a rapid at the safe
-/// height, a plunge, the feed moves, a retract.
+/// height, a plunge, the feed moves, a retract; with a laser power, per stroke a rapid and
+/// the feed moves (no Z words).
 pub fn write_gcode(d: &Drawing, strokes: &[Stroke], post: &Post) -> String {
+    let laser = post.laser_power > 0.0;
     let k = d.mm_per_unit;
     let f = |v: f64| svg::num(v * k);
     let mut o = String::new();
@@ -588,9 +678,13 @@ pub fn write_gcode(d: &Drawing, strokes: &[Stroke], post: &Post) -> String {
         d.file.replace(['(', ')'], "")
     );
     o.push_str("G21 G90 G17 G94\n");
-    let _ = writeln!(o, "G0 Z{}", svg::num(post.safe_height));
-    if post.spindle > 0.0 {
-        let _ = writeln!(o, "M3 S{}", svg::num(post.spindle));
+    if laser {
+        let _ = writeln!(o, "M4 S{}", svg::num(post.laser_power));
+    } else {
+        let _ = writeln!(o, "G0 Z{}", svg::num(post.safe_height));
+        if post.spindle > 0.0 {
+            let _ = writeln!(o, "M3 S{}", svg::num(post.spindle));
+        }
     }
     let mut layer = usize::MAX;
     for s in strokes {
@@ -604,12 +698,14 @@ pub fn write_gcode(d: &Drawing, strokes: &[Stroke], post: &Post) -> String {
         }
         let p0 = s.points[0];
         let _ = writeln!(o, "G0 X{} Y{}", f(p0[0]), f(p0[1]));
-        let _ = writeln!(
-            o,
-            "G1 Z{} F{}",
-            svg::num(-post.depth),
-            svg::num(post.plunge_feed)
-        );
+        if !laser {
+            let _ = writeln!(
+                o,
+                "G1 Z{} F{}",
+                svg::num(-post.depth),
+                svg::num(post.plunge_feed)
+            );
+        }
         if s.is_dot() {
             let _ = writeln!(o, "G1 X{} Y{} F{}", f(p0[0]), f(p0[1]), svg::num(post.feed));
         }
@@ -623,9 +719,11 @@ pub fn write_gcode(d: &Drawing, strokes: &[Stroke], post: &Post) -> String {
         if s.closed && s.points.len() > 1 {
             let _ = writeln!(o, "X{} Y{}", f(p0[0]), f(p0[1]));
         }
-        let _ = writeln!(o, "G0 Z{}", svg::num(post.safe_height));
+        if !laser {
+            let _ = writeln!(o, "G0 Z{}", svg::num(post.safe_height));
+        }
     }
-    if post.spindle > 0.0 {
+    if post.spindle > 0.0 || laser {
         o.push_str("M5\n");
     }
     o.push_str("M2\n");
@@ -663,7 +761,7 @@ pub fn verify_gcode(d: &Drawing, name: &str, text: &str, post: &Post) -> Result<
             if (c.from[2] - c.to[2]).abs() > 1e-9 {
                 continue; // plunge
             }
-            if (c.from[2] + post.depth).abs() > 1e-6 {
+            if post.laser_power <= 0.0 && (c.from[2] + post.depth).abs() > 1e-6 {
                 return Err(Error::invalid(
                     name,
                     format!("line {}: feed move off the cutting depth", li.line),

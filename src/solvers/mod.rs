@@ -8,6 +8,7 @@ pub mod aco;
 pub mod as_given;
 pub mod auto;
 pub mod beam;
+pub mod drawing;
 pub mod eacs;
 pub mod edge;
 pub mod exact;
@@ -241,6 +242,7 @@ pub fn registry() -> Vec<&'static SolverInfo> {
         &eacs::INFO,
         &process::INFO,
         &rules::INFO,
+        &drawing::INFO,
     ]
 }
 

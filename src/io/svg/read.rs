@@ -1,9 +1,16 @@
 //! SVG reader: XML via `roxmltree`, path data and transforms via `svgtypes`, flattening via
 //! `kurbo`. Every drawable element becomes one [`Stroke`] per subpath, in page coordinates
-//! (the root's user units, all transforms applied).
+//! (the root's user units, all transforms applied). Elements that are not sequenced (text,
+//! images, `<use>`, definitions, metadata, foreign elements) are kept as they are
+//! ([`crate::io::drawing::Kept`]). A document type declaration is accepted; entity
+//! declarations are refused (no expansion, nothing is fetched). The tree is walked without
+//! recursion, and flattening is bounded: the tolerance grows with the size of a huge shape
+//! (at most [`MAX_SEGMENTS_PER_SIZE`] segment lengths per extent) and the total number of
+//! points is capped ([`ReadOptions::max_points`]).
 
 use super::{Drawing, Layer, Stroke, Style};
 use crate::error::{Error, Result};
+use crate::io::drawing::Kept;
 use kurbo::{Affine, BezPath, PathEl, Point, Shape};
 use roxmltree::{Document, Node, ParsingOptions};
 use svgtypes::{SimplePathSegment, SimplifyingPathParser};
@@ -16,24 +23,39 @@ const INKSCAPE_NS: &str = "http://www.inkscape.org/namespaces/inkscape";
 pub struct ReadOptions {
     /// Flattening tolerance in user units of the root element.
     pub tolerance: f64,
-    /// Skip unsupported elements (`text`, `image`, `use`, …) instead of refusing the file.
+    /// Drop the elements that are not sequenced (`text`, `image`, `use`, …) from the output
+    /// instead of keeping them.
     pub skip_unsupported: bool,
+    /// Most points after flattening (a cap against hostile files).
+    pub max_points: usize,
 }
+
+/// Default of [`ReadOptions::max_points`].
+pub const MAX_POINTS: usize = 10_000_000;
+
+/// A shape's flattening tolerance is at least its extent divided by this.
+pub const MAX_SEGMENTS_PER_SIZE: f64 = 1e6;
+
+/// Coordinates (after the transforms) beyond this magnitude are refused.
+pub const MAX_COORD: f64 = 1e12;
 
 impl Default for ReadOptions {
     fn default() -> Self {
         ReadOptions {
             tolerance: 0.01,
             skip_unsupported: false,
+            max_points: MAX_POINTS,
         }
     }
 }
 
 struct Ctx<'a> {
     file: &'a str,
+    text: &'a str,
     doc: &'a Lines<'a>,
     opts: ReadOptions,
     out: Drawing,
+    points: usize,
 }
 
 /// Inherited presentation state.
@@ -43,6 +65,8 @@ struct Inherit {
     stroke: String,
     width: f64,
     layer: usize,
+    /// `stroke-linecap` is round or square: zero-length subpaths are drawn as dots.
+    caps: bool,
 }
 
 /// Parses an SVG document into strokes.
@@ -53,10 +77,18 @@ pub fn read(file: &str, text: &str, opts: ReadOptions) -> Result<Drawing> {
             "flattening tolerance must be positive",
         ));
     }
+    if let Some(i) = text.find("<!ENTITY") {
+        let line = text[..i].matches('\n').count() + 1;
+        return Err(Error::parse(
+            file,
+            line,
+            "entity declarations are not supported (entities are never expanded)",
+        ));
+    }
     let doc = Document::parse_with_options(
         text,
         ParsingOptions {
-            allow_dtd: false,
+            allow_dtd: true,
             nodes_limit: 50_000_000,
             ..ParsingOptions::default()
         },
@@ -83,8 +115,14 @@ pub fn read(file: &str, text: &str, opts: ReadOptions) -> Result<Drawing> {
         }
     }
     let mm_per_unit = mm_per_unit(root);
+    let namespaces = root
+        .namespaces()
+        .filter_map(|ns| ns.name().map(|p| (p.to_string(), ns.uri().to_string())))
+        .collect();
     let mut ctx = Ctx {
         file,
+        text,
+        points: 0,
         doc: &lines,
         opts,
         out: Drawing {
@@ -98,7 +136,10 @@ pub fn read(file: &str, text: &str, opts: ReadOptions) -> Result<Drawing> {
             styles: Vec::new(),
             strokes: Vec::new(),
             skipped: Vec::new(),
+            warnings: Vec::new(),
             flip_y: false,
+            kept: Vec::new(),
+            namespaces,
         },
     };
     let inh = Inherit {
@@ -106,11 +147,10 @@ pub fn read(file: &str, text: &str, opts: ReadOptions) -> Result<Drawing> {
         stroke: "none".into(),
         width: 1.0,
         layer: 0,
+        caps: false,
     };
     let inh = presentation(&ctx, root, &inh)?;
-    for ch in root.children().filter(|n| n.is_element()) {
-        walk(&mut ctx, ch, &inh)?;
-    }
+    walk(&mut ctx, root, inh)?;
     if let Some(s) = ctx
         .out
         .strokes
@@ -214,6 +254,9 @@ fn presentation(ctx: &Ctx, n: Node, inh: &Inherit) -> Result<Inherit> {
     {
         out.width = v;
     }
+    if let Some(c) = style_prop(n, "stroke-linecap") {
+        out.caps = matches!(c, "round" | "square");
+    }
     Ok(out)
 }
 
@@ -248,23 +291,46 @@ fn attr_num(ctx: &Ctx, n: Node, name: &str, default: Option<f64>) -> Result<f64>
     }
 }
 
-fn walk(ctx: &mut Ctx, n: Node, inh: &Inherit) -> Result<()> {
+/// Walks the children of `root` in document order with an explicit stack (no recursion, so
+/// deep nesting cannot overflow the call stack).
+fn walk<'a>(ctx: &mut Ctx, root: Node<'a, 'a>, inh: Inherit) -> Result<()> {
+    let mut stack: Vec<(Node<'a, 'a>, std::rc::Rc<Inherit>)> = Vec::new();
+    let inh = std::rc::Rc::new(inh);
+    for ch in root.children().filter(|c| c.is_element()).rev() {
+        stack.push((ch, inh.clone()));
+    }
+    while let Some((n, inh)) = stack.pop() {
+        if let Some(inner) = visit(ctx, n, &inh)? {
+            let inner = std::rc::Rc::new(inner);
+            for ch in n.children().filter(|c| c.is_element()).rev() {
+                stack.push((ch, inner.clone()));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Handles one element; returns the state its children inherit when they are to be walked.
+fn visit(ctx: &mut Ctx, n: Node, inh: &Inherit) -> Result<Option<Inherit>> {
     let ns = n.tag_name().namespace();
+    let name = n.tag_name().name();
     if ns != Some(SVG_NS) {
-        return Ok(()); // foreign elements (sodipodi:namedview, metadata contents)
+        // foreign elements (sodipodi:namedview, plotter software's own metadata)
+        keep(ctx, n, inh, &format!("foreign element <{name}>"));
+        return Ok(None);
     }
     if n.attribute("display") == Some("none") || style_prop(n, "display") == Some("none") {
-        return Ok(());
+        keep(ctx, n, inh, &format!("hidden <{name}>"));
+        return Ok(None);
     }
-    let name = n.tag_name().name();
     let line = line_of(ctx.doc, n);
     match name {
         "defs" | "title" | "desc" | "metadata" | "style" | "clipPath" | "mask" | "symbol"
-        | "marker" | "pattern" | "linearGradient" | "radialGradient" | "filter" => Ok(()),
-        "g" | "a" | "svg" if !(name == "svg" && n.parent_element().is_none()) => {
-            if name == "svg" {
-                return unsupported(ctx, n, "nested <svg> viewports are not supported");
-            }
+        | "marker" | "pattern" | "linearGradient" | "radialGradient" | "filter" | "script" => {
+            keep(ctx, n, inh, &format!("<{name}>"));
+            Ok(None)
+        }
+        "g" | "a" => {
             let mut inh = presentation(ctx, n, inh)?;
             if n.attribute((INKSCAPE_NS, "groupmode")) == Some("layer") {
                 let label = n
@@ -278,38 +344,59 @@ fn walk(ctx: &mut Ctx, n: Node, inh: &Inherit) -> Result<()> {
                 });
                 inh.layer = ctx.out.layers.len() - 1;
             }
-            for ch in n.children().filter(|c| c.is_element()) {
-                walk(ctx, ch, &inh)?;
-            }
-            Ok(())
+            Ok(Some(inh))
         }
         "line" | "polyline" | "polygon" | "rect" | "circle" | "ellipse" | "path" => {
             let inh = presentation(ctx, n, inh)?;
             let path = shape(ctx, n)?;
-            emit(ctx, &path, &inh, line);
-            Ok(())
+            if !emit(ctx, &path, &inh, line)? {
+                keep(ctx, n, &inh, "invisible zero-length path");
+            }
+            Ok(None)
         }
-        "text" | "image" | "use" | "switch" | "foreignObject" => unsupported(
-            ctx,
-            n,
-            &format!("<{name}> is not supported (convert it to paths first)"),
-        ),
-        other => unsupported(ctx, n, &format!("unknown element <{other}>")),
+        other => {
+            keep(ctx, n, inh, &format!("<{other}> (not sequenced)"));
+            Ok(None)
+        }
     }
 }
 
-fn unsupported(ctx: &mut Ctx, n: Node, why: &str) -> Result<()> {
+/// Keeps an element that is not sequenced, verbatim, with its ancestors' attributes; or,
+/// with `skip_unsupported`, drops it and says so.
+fn keep(ctx: &mut Ctx, n: Node, inh: &Inherit, what: &str) {
     let line = line_of(ctx.doc, n);
     if ctx.opts.skip_unsupported {
-        ctx.out.skipped.push(format!("line {line}: {why}"));
-        Ok(())
-    } else {
-        Err(Error::parse(
-            ctx.file,
-            line,
-            format!("{why} (--skip-unsupported skips it)"),
-        ))
+        ctx.out.skipped.push(format!("line {line}: {what}"));
+        return;
     }
+    let mut chain: Vec<Node> = n
+        .ancestors()
+        .skip(1)
+        .filter(|a| a.is_element() && a.parent_element().is_some())
+        .collect();
+    chain.reverse();
+    let mut xml = String::new();
+    for a in &chain {
+        xml.push_str("<g");
+        for at in a.attributes() {
+            let qn = &ctx.text[at.range_qname()];
+            if qn == "id" || qn.starts_with("xmlns") || at.namespace() == Some(INKSCAPE_NS) {
+                continue;
+            }
+            xml.push(' ');
+            xml.push_str(&ctx.text[at.range()]);
+        }
+        xml.push('>');
+    }
+    xml.push_str(&ctx.text[n.range()]);
+    for _ in &chain {
+        xml.push_str("</g>");
+    }
+    ctx.out.kept.push(Kept {
+        layer: inh.layer,
+        line,
+        xml,
+    });
 }
 
 fn points_attr(ctx: &Ctx, n: Node) -> Result<Vec<Point>> {
@@ -340,8 +427,22 @@ fn points_attr(ctx: &Ctx, n: Node) -> Result<Vec<Point>> {
 
 /// The element's outline as a Bézier path in its own coordinates.
 fn shape(ctx: &Ctx, n: Node) -> Result<BezPath> {
-    let tol = ctx.opts.tolerance / 4.0;
     let line = line_of(ctx.doc, n);
+    // kurbo turns circles, ellipses and rounded corners into cubics within a tolerance:
+    // bound it by the shape's size, and refuse sizes no drawing has
+    let sized = |extent: f64| -> Result<f64> {
+        if extent.is_nan() || extent.abs() > MAX_COORD {
+            return Err(Error::parse(
+                ctx.file,
+                line,
+                format!(
+                    "<{}>: size beyond {MAX_COORD:e} user units",
+                    n.tag_name().name()
+                ),
+            ));
+        }
+        Ok((ctx.opts.tolerance / 4.0).max(extent.abs() / MAX_SEGMENTS_PER_SIZE))
+    };
     let mut p = BezPath::new();
     match n.tag_name().name() {
         "line" => {
@@ -373,6 +474,7 @@ fn shape(ctx: &Ctx, n: Node) -> Result<BezPath> {
             let rx = n.attribute("rx").and_then(number);
             let ry = n.attribute("ry").and_then(number);
             let r = rx.or(ry).unwrap_or(0.0).min(w / 2.0).min(h / 2.0).max(0.0);
+            let tol = sized(w.abs().max(h.abs()))?;
             if w < 0.0 || h < 0.0 {
                 return Err(Error::parse(ctx.file, line, "<rect>: negative size"));
             }
@@ -403,6 +505,7 @@ fn shape(ctx: &Ctx, n: Node) -> Result<BezPath> {
             if r < 0.0 {
                 return Err(Error::parse(ctx.file, line, "<circle>: negative radius"));
             }
+            let tol = sized(r)?;
             p = kurbo::Circle::new((cx, cy), r).to_path(tol);
         }
         "ellipse" => {
@@ -413,6 +516,7 @@ fn shape(ctx: &Ctx, n: Node) -> Result<BezPath> {
             if rx < 0.0 || ry < 0.0 {
                 return Err(Error::parse(ctx.file, line, "<ellipse>: negative radius"));
             }
+            let tol = sized(rx.max(ry))?;
             p = kurbo::Ellipse::new((cx, cy), (rx, ry), 0.0).to_path(tol);
         }
         "path" => {
@@ -450,36 +554,45 @@ fn shape(ctx: &Ctx, n: Node) -> Result<BezPath> {
     Ok(p)
 }
 
-/// Flattens a path (after the transform) and appends one stroke per subpath.
-fn emit(ctx: &mut Ctx, path: &BezPath, inh: &Inherit, line: usize) {
+/// Flattens a path (after the transform) and appends one stroke per subpath. Zero-length
+/// subpaths are drawn only with round or square caps; returns false when the element draws
+/// nothing at all (it is then kept as it is).
+fn emit(ctx: &mut Ctx, path: &BezPath, inh: &Inherit, line: usize) -> Result<bool> {
     let tf = inh.tf;
     let scale = tf.determinant().abs().sqrt();
     let width = inh.width * if scale > 0.0 { scale } else { 1.0 };
-    let style = ctx.out.style_index(Style {
-        stroke: inh.stroke.clone(),
-        width,
-    });
-    let tol = ctx.opts.tolerance;
-    let out = &mut ctx.out;
+    let transformed = tf * path.clone();
+    if transformed.elements().is_empty() {
+        return Ok(false);
+    }
+    let bb = transformed.bounding_box();
+    let reach = bb
+        .x0
+        .abs()
+        .max(bb.x1.abs())
+        .max(bb.y0.abs())
+        .max(bb.y1.abs());
+    if reach.is_nan() || reach > MAX_COORD {
+        return Err(Error::parse(
+            ctx.file,
+            line,
+            format!("coordinates beyond ±{MAX_COORD:e} user units are not supported"),
+        ));
+    }
+    let extent = bb.width().max(bb.height());
+    let tol = ctx.opts.tolerance.max(extent / MAX_SEGMENTS_PER_SIZE);
+    let mut strokes: Vec<(Vec<[f64; 2]>, bool)> = Vec::new();
     let mut cur: Vec<[f64; 2]> = Vec::new();
     let mut after_close: Option<[f64; 2]> = None;
-    let flush = |cur: &mut Vec<[f64; 2]>, closed: bool, out: &mut Drawing| {
-        if !cur.is_empty() {
-            out.strokes.push(Stroke::new(
-                std::mem::take(cur),
-                closed,
-                inh.layer,
-                style,
-                line,
-            ));
-        }
-    };
-    let transformed = tf * path.clone();
+    let mut points = 0usize;
     kurbo::flatten(transformed.elements().iter().copied(), tol, |el| match el {
         PathEl::MoveTo(q) => {
-            flush(&mut cur, false, out);
+            if !cur.is_empty() {
+                strokes.push((std::mem::take(&mut cur), false));
+            }
             after_close = None;
             cur.push([q.x, q.y]);
+            points += 1;
         }
         PathEl::LineTo(q) => {
             if cur.is_empty()
@@ -488,14 +601,41 @@ fn emit(ctx: &mut Ctx, path: &BezPath, inh: &Inherit, line: usize) {
                 cur.push(s);
             }
             cur.push([q.x, q.y]);
+            points += 1;
         }
         PathEl::ClosePath => {
             if let Some(&f) = cur.first() {
-                flush(&mut cur, true, out);
+                strokes.push((std::mem::take(&mut cur), true));
                 after_close = Some(f);
             }
         }
         _ => {}
     });
-    flush(&mut cur, false, out);
+    if !cur.is_empty() {
+        strokes.push((cur, false));
+    }
+    ctx.points += points;
+    if ctx.points > ctx.opts.max_points {
+        return Err(Error::parse(
+            ctx.file,
+            line,
+            format!(
+                "more than {} points after flattening (raise the cap with --max-points, or use a larger --tolerance)",
+                ctx.opts.max_points
+            ),
+        ));
+    }
+    let style = ctx.out.style_index(Style {
+        stroke: inh.stroke.clone(),
+        width,
+    });
+    let before = ctx.out.strokes.len();
+    for (pts, closed) in strokes {
+        let s = Stroke::new(pts, closed, inh.layer, style, line);
+        if s.is_dot() && !inh.caps {
+            continue;
+        }
+        ctx.out.strokes.push(s);
+    }
+    Ok(ctx.out.strokes.len() > before)
 }

@@ -1,0 +1,241 @@
+//! The drawing model that the SVG and DXF readers produce and the writers consume: layers,
+//! stroke styles and strokes (pen-down polylines, closed or open, or dots) in the file's user
+//! units, with millimetres per unit, plus the pen-up figures of a stroke order.
+
+use serde::Serialize;
+
+/// An Inkscape layer (index 0 is the document root, outside any layer).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Layer {
+    /// `inkscape:label` (or id).
+    pub label: String,
+    /// Element id.
+    pub id: Option<String>,
+}
+
+/// Stroke style kept on output.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Style {
+    /// Normalized stroke colour (`#rrggbb`, or the raw value such as `none`).
+    pub stroke: String,
+    /// Stroke width in root user units (transform scale applied).
+    pub width: f64,
+}
+
+/// One pen-down polyline in root user units.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Stroke {
+    /// Vertices (a dot has one).
+    pub points: Vec<[f64; 2]>,
+    /// Closed polygon (the closing segment is implicit; the first point is not repeated).
+    pub closed: bool,
+    /// Layer index into [`Drawing::layers`].
+    pub layer: usize,
+    /// Style index into [`Drawing::styles`].
+    pub style: usize,
+    /// Source line of the element.
+    pub line: usize,
+}
+
+impl Stroke {
+    /// Normalizes: a repeated closing vertex is dropped, an open polyline ending where it
+    /// started (3+ vertices) is closed, a stroke whose points all coincide is a dot.
+    pub fn new(
+        mut points: Vec<[f64; 2]>,
+        mut closed: bool,
+        layer: usize,
+        style: usize,
+        line: usize,
+    ) -> Stroke {
+        for p in &mut points {
+            *p = [round6(p[0]), round6(p[1])];
+        }
+        points.dedup();
+        if points.len() >= 2 && points.first() == points.last() {
+            points.pop();
+            closed = points.len() >= 2;
+        }
+        if points.len() <= 1 {
+            closed = false;
+        }
+        Stroke {
+            points,
+            closed,
+            layer,
+            style,
+            line,
+        }
+    }
+    /// True for a single point.
+    pub fn is_dot(&self) -> bool {
+        self.points.len() == 1
+    }
+    /// First point drawn.
+    pub fn start(&self) -> [f64; 2] {
+        self.points[0]
+    }
+    /// Last point drawn (the start for closed strokes).
+    pub fn end(&self) -> [f64; 2] {
+        if self.closed {
+            self.points[0]
+        } else {
+            *self.points.last().expect("stroke has points")
+        }
+    }
+    /// The segments drawn (a dot is one zero-length segment).
+    pub fn segments(&self) -> Vec<([f64; 2], [f64; 2])> {
+        let p = &self.points;
+        if p.len() == 1 {
+            return vec![(p[0], p[0])];
+        }
+        let mut v: Vec<_> = p.windows(2).map(|w| (w[0], w[1])).collect();
+        if self.closed {
+            v.push((p[p.len() - 1], p[0]));
+        }
+        v
+    }
+    /// Length in user units.
+    pub fn length(&self) -> f64 {
+        self.segments().iter().map(|(a, b)| dist(*a, *b)).sum()
+    }
+    /// The same stroke drawn backwards (open) or started at vertex `k` (closed).
+    pub fn oriented(&self, reverse: bool, k: usize) -> Stroke {
+        let mut s = self.clone();
+        if self.closed {
+            s.points.rotate_left(k % self.points.len());
+        } else if reverse {
+            s.points.reverse();
+        }
+        s
+    }
+}
+
+/// Planar distance.
+pub fn dist(a: [f64; 2], b: [f64; 2]) -> f64 {
+    ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2)).sqrt()
+}
+
+/// A parsed drawing.
+#[derive(Debug, Clone)]
+pub struct Drawing {
+    /// File name for messages.
+    pub file: String,
+    /// `width`, `height`, `viewBox` of the root, copied to the output.
+    pub root_attrs: Vec<(String, String)>,
+    /// Millimetres per root user unit.
+    pub mm_per_unit: f64,
+    /// Layers (index 0: outside any layer).
+    pub layers: Vec<Layer>,
+    /// Distinct styles.
+    pub styles: Vec<Style>,
+    /// Strokes in document order.
+    pub strokes: Vec<Stroke>,
+    /// Unsupported elements skipped (with `skip_unsupported`).
+    pub skipped: Vec<String>,
+    /// Warnings for the user (assumed units, …).
+    pub warnings: Vec<String>,
+    /// Coordinates are y-up (DXF): the SVG writer mirrors them with `scale(1,-1)`.
+    pub flip_y: bool,
+    /// Elements passed through unchanged (SVG text, images, `<use>`, definitions, metadata,
+    /// foreign elements, invisible zero-length paths), in document order.
+    pub kept: Vec<Kept>,
+    /// Namespace declarations of the root (prefix, URI) that kept elements may use.
+    pub namespaces: Vec<(String, String)>,
+}
+
+/// An element that is not sequenced and is written back as it was.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Kept {
+    /// Layer index into [`Drawing::layers`].
+    pub layer: usize,
+    /// Source line of the element.
+    pub line: usize,
+    /// Its source text, wrapped in one `<g>` per ancestor below the root carrying that
+    /// ancestor's attributes (transform, style), so that it renders as before.
+    pub xml: String,
+}
+
+impl Drawing {
+    /// The index of style `s`, added when new.
+    pub fn style_index(&mut self, s: Style) -> usize {
+        match self.styles.iter().position(|x| *x == s) {
+            Some(i) => i,
+            None => {
+                self.styles.push(s);
+                self.styles.len() - 1
+            }
+        }
+    }
+}
+
+/// Pen-up figures of a stroke order (millimetres).
+#[derive(Debug, Clone, Copy, Serialize, PartialEq)]
+pub struct PenUp {
+    /// vpype's metric: sum of end→start distances between consecutive strokes of one layer.
+    pub pen_up_mm: f64,
+    /// Including travel between layers and from the origin to the first stroke.
+    pub pen_up_total_mm: f64,
+    /// Pen lifts (moves between strokes that do not start where the previous one ended).
+    pub lifts: usize,
+    /// Pen-down length.
+    pub draw_mm: f64,
+}
+
+/// Pen-up figures of strokes drawn in this order.
+pub fn pen_up(
+    strokes: &[Stroke],
+    mm_per_unit: f64,
+    layer_key: impl Fn(&Stroke) -> String,
+) -> PenUp {
+    let mut within = 0.0;
+    let mut total = 0.0;
+    let mut lifts = 0;
+    let mut draw = 0.0;
+    let mut prev: Option<&Stroke> = None;
+    for s in strokes {
+        draw += s.length();
+        match prev {
+            None => {
+                total += dist([0.0, 0.0], s.start());
+                lifts += 1;
+            }
+            Some(p) => {
+                let d = dist(p.end(), s.start());
+                total += d;
+                if layer_key(p) == layer_key(s) {
+                    within += d;
+                }
+                if d > 0.0 {
+                    lifts += 1;
+                }
+            }
+        }
+        prev = Some(s);
+    }
+    PenUp {
+        pen_up_mm: within * mm_per_unit,
+        pen_up_total_mm: total * mm_per_unit,
+        lifts,
+        draw_mm: draw * mm_per_unit,
+    }
+}
+
+/// A coordinate as the writers print it ([`num`]) and read it back, so that a drawing and
+/// its written copy hold the same numbers.
+pub fn round6(v: f64) -> f64 {
+    num(v).parse::<f64>().unwrap_or(v) + 0.0
+}
+
+/// Formats a coordinate with 6 decimals, trailing zeros trimmed.
+pub fn num(v: f64) -> String {
+    let mut s = format!("{v:.6}");
+    if s.contains('.') {
+        while s.ends_with('0') {
+            s.pop();
+        }
+        if s.ends_with('.') {
+            s.pop();
+        }
+    }
+    if s == "-0" { "0".into() } else { s }
+}

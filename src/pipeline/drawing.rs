@@ -1,0 +1,431 @@
+//! The drawing pipeline: a drawing's strokes, grouped in scopes (layer and stroke colour) in
+//! their required order, become one instance per scope; a registry solver sequences it under
+//! the caller's budget; the file's own order is kept where the solver's is not shorter; the
+//! caller then writes and verifies. Cut mode adds inner-before-outer precedence.
+
+use crate::error::{Error, Result};
+use crate::geom::Point3;
+use crate::io::drawing::{Drawing, PenUp, Stroke, dist, pen_up};
+use crate::model::{Cell, Instance, Machine, Metadata, Mode, Objective, StepKind, Tool, Visit};
+use crate::solvers::{self, Budget, NoObserver};
+
+/// The registry solver drawings get by default ([`crate::solvers::drawing`]).
+pub const DRAWING_SOLVER: &str = "drawing";
+
+/// Evaluations per stroke of the default budget (deterministic, linear in the drawing's size);
+/// see `notes/svg.md` for the measurements behind it.
+pub const EVALS_PER_STROKE: u64 = 4000;
+
+/// The smallest default budget of a scope, in evaluations.
+pub const MIN_EVALS: u64 = 1_000_000;
+
+/// Options of [`optimize`].
+#[derive(Debug, Clone)]
+pub struct Options {
+    /// Solver name.
+    pub solver: String,
+    /// Total time limit (s), shared among scopes by size.
+    pub time_limit: Option<f64>,
+    /// Total evaluation budget, shared among scopes by size. Without this and without a time
+    /// limit each scope gets [`EVALS_PER_STROKE`] evaluations per stroke (at least
+    /// [`MIN_EVALS`]).
+    pub max_evals: Option<u64>,
+    /// Solver parameters (`--param`).
+    pub params: std::collections::BTreeMap<String, String>,
+    /// Seed.
+    pub seed: u64,
+    /// Allow drawing strokes backwards / closed strokes from another vertex.
+    pub reversible: bool,
+    /// Layers and stroke colours are ordering scopes.
+    pub scopes: bool,
+    /// Cut mode: strokes inside a closed stroke come before it.
+    pub cut: bool,
+    /// Containment tolerance (user units).
+    pub contain_tol: f64,
+    /// Maximum start-vertex candidates of a closed stroke.
+    pub max_starts: usize,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        Options {
+            solver: DRAWING_SOLVER.to_string(),
+            time_limit: None,
+            max_evals: None,
+            params: Default::default(),
+            seed: 1,
+            reversible: true,
+            scopes: true,
+            cut: false,
+            contain_tol: 0.01,
+            max_starts: 8,
+        }
+    }
+}
+
+/// Scopes in drawing order: each a list of stroke indices.
+pub fn scopes(d: &Drawing, by_scope: bool) -> Vec<Vec<usize>> {
+    if !by_scope {
+        return vec![(0..d.strokes.len()).collect()];
+    }
+    let mut keys: Vec<(usize, String)> = Vec::new();
+    let mut out: Vec<Vec<usize>> = Vec::new();
+    for (i, s) in d.strokes.iter().enumerate() {
+        let k = (s.layer, d.styles[s.style].stroke.clone());
+        match keys.iter().position(|x| *x == k) {
+            Some(g) => out[g].push(i),
+            None => {
+                keys.push(k);
+                out.push(vec![i]);
+            }
+        }
+    }
+    let mut idx: Vec<usize> = (0..out.len()).collect();
+    idx.sort_by_key(|&g| (keys[g].0, out[g][0]));
+    idx.into_iter()
+        .map(|g| std::mem::take(&mut out[g]))
+        .collect()
+}
+
+/// Start-vertex candidates of a closed stroke (all when few, else evenly spaced).
+fn starts_of(s: &Stroke, max: usize) -> Vec<usize> {
+    let n = s.points.len();
+    if !s.closed {
+        return vec![0];
+    }
+    let k = n.min(max.max(1));
+    (0..k).map(|i| i * n / k).collect()
+}
+
+fn bbox(s: &Stroke) -> [f64; 4] {
+    let mut b = [
+        f64::INFINITY,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        f64::NEG_INFINITY,
+    ];
+    for p in &s.points {
+        b[0] = b[0].min(p[0]);
+        b[1] = b[1].min(p[1]);
+        b[2] = b[2].max(p[0]);
+        b[3] = b[3].max(p[1]);
+    }
+    b
+}
+
+fn seg_dist(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
+    let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
+    let l2 = dx * dx + dy * dy;
+    let t = if l2 > 0.0 {
+        (((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / l2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    dist(p, [a[0] + t * dx, a[1] + t * dy])
+}
+
+/// Point in polygon (even-odd) or within `tol` of its boundary.
+fn inside(p: [f64; 2], poly: &[[f64; 2]], tol: f64) -> bool {
+    let n = poly.len();
+    let mut c = false;
+    for i in 0..n {
+        let (a, b) = (poly[i], poly[(i + 1) % n]);
+        if seg_dist(p, a, b) <= tol {
+            return true;
+        }
+        if (a[1] > p[1]) != (b[1] > p[1]) {
+            let x = a[0] + (p[1] - a[1]) / (b[1] - a[1]) * (b[0] - a[0]);
+            if p[0] < x {
+                c = !c;
+            }
+        }
+    }
+    c
+}
+
+/// Cut-mode precedence within a scope (local indices): a stroke whose points all lie inside a
+/// closed stroke with a larger bounding box (with tolerance) comes before it.
+pub fn containment(d: &Drawing, scope: &[usize], tol: f64) -> Vec<(usize, usize)> {
+    let boxes: Vec<[f64; 4]> = scope.iter().map(|&i| bbox(&d.strokes[i])).collect();
+    let area = |b: &[f64; 4]| (b[2] - b[0]).max(0.0) * (b[3] - b[1]).max(0.0);
+    let mut outers: Vec<usize> = (0..scope.len())
+        .filter(|&k| d.strokes[scope[k]].closed && d.strokes[scope[k]].points.len() >= 3)
+        .collect();
+    outers.sort_by(|&a, &b| area(&boxes[a]).total_cmp(&area(&boxes[b])));
+    let mut edges = Vec::new();
+    for a in 0..scope.len() {
+        let ba = boxes[a];
+        let aa = area(&ba);
+        let sa = &d.strokes[scope[a]];
+        for &b in &outers {
+            let bb = boxes[b];
+            if b == a || area(&bb) <= aa + tol * tol {
+                continue;
+            }
+            if ba[0] < bb[0] - tol
+                || ba[1] < bb[1] - tol
+                || ba[2] > bb[2] + tol
+                || ba[3] > bb[3] + tol
+            {
+                continue;
+            }
+            let poly = &d.strokes[scope[b]].points;
+            if sa.points.iter().all(|&p| inside(p, poly, tol)) {
+                edges.push((a, b));
+            }
+        }
+    }
+    edges
+}
+
+/// Cut mode: reorders scopes so that a scope whose closed strokes enclose strokes of another
+/// scope comes after it (stable topological order; file order kept where containment is
+/// cyclic or absent).
+pub fn inner_scopes_first(d: &Drawing, sc: Vec<Vec<usize>>, tol: f64) -> Vec<Vec<usize>> {
+    let all: Vec<usize> = sc.iter().flatten().copied().collect();
+    let mut scope_of = vec![0usize; d.strokes.len()];
+    for (k, s) in sc.iter().enumerate() {
+        for &i in s {
+            scope_of[i] = k;
+        }
+    }
+    let m = sc.len();
+    let mut before = vec![vec![false; m]; m]; // before[a][b]: a must precede b
+    for (a, b) in containment(d, &all, tol) {
+        let (sa, sb) = (scope_of[all[a]], scope_of[all[b]]);
+        if sa != sb {
+            before[sa][sb] = true;
+        }
+    }
+    let mut placed = vec![false; m];
+    let mut order = Vec::with_capacity(m);
+    while order.len() < m {
+        // the first unplaced scope with no unplaced predecessor; file order on a cycle
+        let next = (0..m)
+            .find(|&b| !placed[b] && (0..m).all(|a| placed[a] || a == b || !before[a][b]))
+            .unwrap_or_else(|| (0..m).find(|&b| !placed[b]).expect("unplaced scope"));
+        placed[next] = true;
+        order.push(next);
+    }
+    let mut sc = sc;
+    order
+        .into_iter()
+        .map(|k| std::mem::take(&mut sc[k]))
+        .collect()
+}
+
+/// The instance of one scope, starting at `home`; also the (reverse, start vertex) of each
+/// mode of each cell.
+pub fn scope_instance(
+    d: &Drawing,
+    scope: &[usize],
+    home: [f64; 2],
+    opts: &Options,
+) -> (Instance, Vec<Vec<(bool, usize)>>) {
+    let mut orient = Vec::with_capacity(scope.len());
+    let cells: Vec<Cell> = scope
+        .iter()
+        .map(|&i| {
+            let s = &d.strokes[i];
+            let p = |q: [f64; 2]| Point3::new(q[0], q[1], 0.0);
+            let mut modes = Vec::new();
+            let mut or = Vec::new();
+            if s.closed {
+                let ks = if opts.reversible {
+                    starts_of(s, opts.max_starts)
+                } else {
+                    vec![0]
+                };
+                for k in ks {
+                    modes.push(Mode::closed(p(s.points[k])));
+                    or.push((false, k));
+                }
+            } else {
+                modes.push(Mode::new(p(s.start()), p(s.end())));
+                or.push((false, 0));
+                if opts.reversible && !s.is_dot() {
+                    modes.push(Mode::new(p(s.end()), p(s.start())));
+                    or.push((true, 0));
+                }
+            }
+            orient.push(or);
+            let mut c = Cell::new(format!("s{}", i + 1), "pen", modes);
+            c.reversible = opts.reversible && !s.closed && !s.is_dot();
+            c.step = StepKind::Engrave;
+            c.cut_length = s.length();
+            c.layer = s.layer as u32;
+            c.feature = Some(format!("line {}", s.line));
+            c
+        })
+        .collect();
+    let precedence = if opts.cut {
+        containment(d, scope, opts.contain_tol)
+    } else {
+        Vec::new()
+    };
+    let n = cells.len();
+    let inst = Instance {
+        name: d.file.clone(),
+        meta: Metadata {
+            generator: Some("svg".into()),
+            ..Metadata::default()
+        },
+        machine: Machine {
+            home: Point3::new(home[0], home[1], 0.0),
+            tool_change: Point3::new(home[0], home[1], 0.0),
+            clearance: 0.0,
+            initial_tool: Some("pen".into()),
+            ..Machine::default()
+        },
+        tools: vec![Tool {
+            id: "pen".into(),
+            diameter: 1.0,
+            name: None,
+            feed: None,
+        }],
+        cells,
+        precedence,
+        as_given: Some((0..n).map(|i| Visit::new(i, 0)).collect()),
+        ..Instance::default()
+    };
+    (inst, orient)
+}
+
+/// The whole drawing as one instance (scopes chained by precedence), for `cellseq import`.
+pub fn import(d: &Drawing, opts: &Options) -> Result<Instance> {
+    let mut sc = scopes(d, opts.scopes);
+    if opts.cut && sc.len() > 1 {
+        sc = inner_scopes_first(d, sc, opts.contain_tol);
+    }
+    let all: Vec<usize> = sc.iter().flatten().copied().collect();
+    let (mut inst, _) = scope_instance(
+        d,
+        &all,
+        [0.0, 0.0],
+        &Options {
+            cut: false,
+            ..opts.clone()
+        },
+    );
+    let mut edges = Vec::new();
+    let mut start = 0;
+    for (k, s) in sc.iter().enumerate() {
+        if opts.cut {
+            edges.extend(
+                containment(d, s, opts.contain_tol)
+                    .into_iter()
+                    .map(|(a, b)| (a + start, b + start)),
+            );
+        }
+        if k + 1 < sc.len() {
+            if edges.len() + s.len() * sc[k + 1].len() > 20_000_000 {
+                return Err(Error::invalid(
+                    &d.file,
+                    "too many scope precedence edges to export",
+                ));
+            }
+            let next = start + s.len();
+            for a in 0..s.len() {
+                for b in 0..sc[k + 1].len() {
+                    edges.push((start + a, next + b));
+                }
+            }
+        }
+        start += s.len();
+    }
+    inst.precedence = edges;
+    Ok(inst)
+}
+
+/// The result of [`optimize`].
+#[derive(Debug, Clone)]
+pub struct Optimized {
+    /// The strokes in the new order and orientation.
+    pub strokes: Vec<Stroke>,
+    /// Figures of the file's order.
+    pub before: PenUp,
+    /// Figures of the new order.
+    pub after: PenUp,
+    /// Solver seconds.
+    pub solve_s: f64,
+    /// Number of scopes.
+    pub scopes: usize,
+    /// Precedence edges (cut mode).
+    pub edges: usize,
+    /// The solver's order was worse than the file's in some scope; that scope kept its order.
+    pub kept_original: usize,
+}
+
+fn layer_label(d: &Drawing) -> impl Fn(&Stroke) -> String + '_ {
+    move |s: &Stroke| d.layers[s.layer].label.clone()
+}
+
+/// Sequences each scope with a registry solver (air-travel objective, start at the previous
+/// scope's exit, the first at the origin).
+pub fn optimize(d: &Drawing, opts: &Options) -> Result<Optimized> {
+    let mut sc = scopes(d, opts.scopes);
+    if opts.cut && sc.len() > 1 {
+        sc = inner_scopes_first(d, sc, opts.contain_tol);
+    }
+    let total = d.strokes.len().max(1);
+    let mut home = [0.0, 0.0];
+    let mut out: Vec<Stroke> = Vec::with_capacity(d.strokes.len());
+    let mut solve_s = 0.0;
+    let mut edges = 0;
+    let mut kept = 0;
+    for s in &sc {
+        let (inst, orient) = scope_instance(d, s, home, opts);
+        edges += inst.precedence.len();
+        crate::validate::validate(&inst, &d.file)?;
+        let share = s.len() as f64 / total as f64;
+        let default_evals = (opts.time_limit.is_none() && opts.max_evals.is_none())
+            .then(|| (EVALS_PER_STROKE * s.len() as u64).max(MIN_EVALS));
+        let budget = Budget {
+            time_limit: opts
+                .time_limit
+                .map(|t| std::time::Duration::from_secs_f64(t * share)),
+            max_evals: opts
+                .max_evals
+                .map(|e| ((e as f64 * share) as u64).max(1))
+                .or(default_evals),
+        };
+        let r = solvers::run(
+            &opts.solver,
+            &inst,
+            Objective::Air,
+            &opts.params,
+            opts.seed,
+            budget,
+            &mut NoObserver,
+        )?;
+        solve_s += r.elapsed_s;
+        let (seq, cost) = (r.outcome.sequence, r.report.cost);
+        let given = inst.as_given.clone().unwrap_or_default();
+        let given_cost = crate::check::check(&inst, &given, Objective::Air)
+            .map(|r| r.cost)
+            .unwrap_or(f64::INFINITY);
+        let seq: Vec<Visit> = if cost > given_cost + 1e-9 {
+            kept += 1;
+            given
+        } else {
+            seq
+        };
+        for v in &seq {
+            let (rev, k) = orient[v.cell][v.mode];
+            out.push(d.strokes[s[v.cell]].oriented(rev, k));
+        }
+        if let Some(l) = out.last() {
+            home = l.end();
+        }
+    }
+    let key = layer_label(d);
+    Ok(Optimized {
+        before: pen_up(&d.strokes, d.mm_per_unit, &key),
+        after: pen_up(&out, d.mm_per_unit, &key),
+        strokes: out,
+        solve_s,
+        scopes: sc.len(),
+        edges,
+        kept_original: kept,
+    })
+}
