@@ -34,6 +34,7 @@ pub mod harness;
 pub mod io;
 pub mod model;
 pub mod params;
+pub mod pipeline;
 pub mod plot;
 pub mod precedence;
 pub mod solvers;

@@ -27,6 +27,16 @@ pub struct GCell {
     pub end: usize,
     /// Gap lines emitted before the cell (non-motion, or motion lines to be stripped).
     pub prefix: Vec<usize>,
+    /// First line of the gap before the cell in the original (the end of the previous cell);
+    /// equal to `start` for the first cell of a block (its gap is the block's preamble).
+    pub gap_start: usize,
+    /// Run of cells that may be reordered among themselves: runs end where the program first
+    /// sets a modal element (a cell cut before that line would run with the operator's state
+    /// changed) and at pauses, coordinate-system changes, controller lines and user M codes.
+    pub run: usize,
+    /// True when the cell starts from a position the program does not know (right after
+    /// G28/G30/G53/`$H`): it keeps its place and its approach as written.
+    pub pinned: bool,
     /// Tool block index.
     pub block: usize,
     /// Tool number.
@@ -78,6 +88,24 @@ pub struct Layout {
     pub blocks: Vec<Block>,
     /// Position at the end of the header (mm), when known.
     pub start: Option<[f64; 3]>,
+    /// Per block: the height (mm) the program itself rises to between two cells of the block
+    /// (the highest rapid of those gaps); links between cells of the block retract to it.
+    /// Zero for 2-D programs.
+    pub clearance: Vec<f64>,
+}
+
+/// True for a line that cells never move across: a tool change, a coordinate-system change,
+/// a move to a machine position (G28/G30/G53, `$H`), a pause, a controller line, a user M code.
+pub fn is_boundary(p: &Program, i: usize) -> bool {
+    let li = &p.lines[i];
+    li.tool_change || li.setup || li.motion == Motion::Home || li.pause || li.dialect || li.user_m
+}
+
+/// A boundary that also ends a run (cells of different runs are never reordered, even when
+/// blocks of one tool are merged): everything but tool changes and machine-position moves.
+fn ends_run(p: &Program, i: usize) -> bool {
+    let li = &p.lines[i];
+    li.setup || li.pause || li.dialect || li.user_m
 }
 
 const EPS: f64 = 1e-6;
@@ -182,8 +210,9 @@ pub fn split(p: &Program) -> Result<Layout, (usize, String)> {
     let mut prev_end = header_end;
     for &(s, e, cycle) in &ranges {
         let gap: Vec<usize> = (prev_end..s).collect();
+        let gap_from = prev_end;
         let mut prefix = Vec::new();
-        let boundary = |g: usize| p.lines[g].tool_change || p.lines[g].setup;
+        let boundary = |g: usize| is_boundary(p, g);
         if gap.iter().any(|&g| p.lines[g].setup) {
             epoch += 1;
         }
@@ -220,10 +249,21 @@ pub fn split(p: &Program) -> Result<Layout, (usize, String)> {
                 "cutter radius compensation (G41/G42) active at the start of a cut".into(),
             ));
         }
-        let before = known(&first.pos_before).ok_or((
-            first.line,
-            "position unknown at the start of a cut (after G28/G30/G53)".to_string(),
-        ))?;
+        let pinned = known(&first.pos_before).is_none();
+        let before = match known(&first.pos_before) {
+            Some(b) => b,
+            None => {
+                // right after G28/G30/G53/$H: the axes the program has not named since are
+                // where the controller left them; the cell keeps its place and approach
+                let to = known(&first.pos_after).ok_or((
+                    first.line,
+                    "the first move after G28/G30/G53/$H does not name X, Y and Z; give all \
+                     three in an absolute move before cutting"
+                        .to_string(),
+                ))?;
+                [0, 1, 2].map(|k| first.pos_before[k].unwrap_or(to[k]))
+            }
+        };
         let exit = known(&last.pos_after).ok_or((
             last.line,
             "position unknown at the end of a cut".to_string(),
@@ -279,10 +319,16 @@ pub fn split(p: &Program) -> Result<Layout, (usize, String)> {
         let closed_xy = (pts[0][0] - exit[0]).hypot(pts[0][1] - exit[1]) < 1e-3;
         let closed = (planar && !cycle && closed_xy && pts.len() >= 4 && area(&pts).abs() > 1e-6)
             .then_some(pts);
+        let block_first = cells
+            .last()
+            .is_none_or(|c: &GCell| c.block != blocks.len() - 1);
         cells.push(GCell {
             start: s,
             end: e,
             prefix,
+            gap_start: if block_first { s } else { gap_from },
+            run: 0,
+            pinned,
             block: blocks.len() - 1,
             tool: st.tool,
             entry,
@@ -296,6 +342,8 @@ pub fn split(p: &Program) -> Result<Layout, (usize, String)> {
         });
     }
     let start = known(&p.lines[header_end].pos_before);
+    assign_runs(p, &mut cells, &blocks);
+    let clearance = clearances(p, split, &cells, &blocks);
     Ok(Layout {
         split,
         header_end,
@@ -303,7 +351,70 @@ pub fn split(p: &Program) -> Result<Layout, (usize, String)> {
         cells,
         blocks,
         start,
+        clearance,
     })
+}
+
+/// The program's elements set at the start of a cell's gap (see [`GCell::gap_start`]).
+pub fn entry_state(p: &Program, c: &GCell) -> State {
+    p.lines[c.gap_start].before
+}
+
+/// Numbers the runs (see [`GCell::run`]).
+fn assign_runs(p: &Program, cells: &mut [GCell], blocks: &[Block]) {
+    let mut run = 0;
+    for k in 1..cells.len() {
+        let (a, b) = (&cells[k - 1], &cells[k]);
+        let prev_in = entry_state(p, a).set;
+        let prev_out = p.lines[a.end - 1].after.set;
+        let this_in = entry_state(p, b).set;
+        let barrier = if b.block != a.block {
+            blocks[b.block].preamble.iter().any(|&g| ends_run(p, g))
+        } else {
+            (a.end..b.start).any(|g| ends_run(p, g))
+        };
+        if barrier || prev_in != prev_out || prev_out != this_in || a.pinned || b.pinned {
+            run += 1;
+        }
+        cells[k].run = run;
+    }
+}
+
+/// Per block, the highest rapid between two of its cells (else of its approach, else the
+/// safe height).
+fn clearances(p: &Program, split: Split, cells: &[GCell], blocks: &[Block]) -> Vec<f64> {
+    let Split::Z { safe, .. } = split else {
+        return vec![0.0; blocks.len()];
+    };
+    let rapid_top = |r: std::ops::Range<usize>| {
+        r.filter(|&g| p.lines[g].motion == Motion::Rapid)
+            .filter_map(|g| p.lines[g].pos_after[2])
+            .fold(None, |m: Option<f64>, z| Some(m.map_or(z, |m| m.max(z))))
+    };
+    let mut between: Vec<Option<f64>> = vec![None; blocks.len()];
+    for k in 1..cells.len() {
+        let (a, b) = (&cells[k - 1], &cells[k]);
+        if a.block == b.block
+            && let Some(z) = rapid_top(a.end..b.start)
+        {
+            let m = &mut between[b.block];
+            *m = Some(m.map_or(z, |m| m.max(z)));
+        }
+    }
+    blocks
+        .iter()
+        .enumerate()
+        .map(|(i, b)| {
+            between[i]
+                .or_else(|| {
+                    b.preamble
+                        .iter()
+                        .filter_map(|&g| p.lines[g].xy_rapid_z)
+                        .fold(None, |m: Option<f64>, z| Some(m.map_or(z, |m| m.max(z))))
+                })
+                .unwrap_or(safe)
+        })
+        .collect()
 }
 
 /// True when a motion line also carries words other than motion and axes (M, S, F, T…).
