@@ -323,7 +323,7 @@ fn optimize_gcode(a: &OptimizeArgs) -> anyhow::Result<()> {
                     .unwrap_or("the solver found no better order")
             ),
             Kept::Groups(g) => say!(
-                "note: the original order was kept in {g} of {} group(s) (the solver found no better order there)",
+                "note: the original order was kept in {g} of {} group(s) (the new order was not better there)",
                 out.groups
             ),
             Kept::Nothing => {}

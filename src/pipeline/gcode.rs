@@ -143,6 +143,7 @@ pub fn optimize_within(p: &Parsed, opts: &Options, allowance: &Allowance) -> Res
     let mut dropped = 0;
     let mut kept_groups = 0;
     let mut left = total;
+    let mut spans: Vec<(usize, usize)> = Vec::with_capacity(gs.len());
     for g in &gs {
         let (inst, d) = gcode::group_instance(p, g, home, opts.margin, &pl);
         dropped += d as usize;
@@ -167,10 +168,12 @@ pub fn optimize_within(p: &Parsed, opts: &Options, allowance: &Allowance) -> Res
         if r.as_ref().is_some_and(|r| r.kept_original) {
             kept_groups += 1;
         }
+        let from = order.len();
         for v in &seq {
             order.push(g[v.cell]);
             rev.push(if v.mode == 1 { pl[g[v.cell]] } else { None });
         }
+        spans.push((from, order.len()));
         if let Some(v) = seq.last() {
             home = match rev.last().copied().flatten() {
                 Some(x) => x.exit,
@@ -186,26 +189,52 @@ pub fn optimize_within(p: &Parsed, opts: &Options, allowance: &Allowance) -> Res
         Kept::Nothing
     };
     let mut note = None;
-    let t = Instant::now();
-    let written = write::write(p, &order, &rev, opts.merge);
-    timings.write_s += t.elapsed().as_secs_f64();
     let mut result = None;
-    match written {
-        Ok(text) => {
-            let t = Instant::now();
-            let check = verify_with(p, "<optimized>", &text, on)?;
-            timings.verify_s += t.elapsed().as_secs_f64();
-            // never worse than the input on air, lifts and time, each one
-            if check.after.not_worse_than(&check.before) || order == given {
-                result = Some((text, check));
-            } else {
-                note = Some(format!(
+    // the groups whose order changed, reverted one by one (at most 64 tries) while the
+    // program is worse than the input on any figure
+    let changed: Vec<usize> = (0..gs.len())
+        .filter(|&k| {
+            let (a, b) = spans[k];
+            order[a..b] != gs[k][..] || rev[a..b].iter().any(Option::is_some)
+        })
+        .collect();
+    let any_changed = !changed.is_empty();
+    let mut changed = changed.into_iter();
+    for attempt in 0..=64 {
+        let t = Instant::now();
+        let written = write::write(p, &order, &rev, opts.merge);
+        timings.write_s += t.elapsed().as_secs_f64();
+        match written {
+            Ok(text) => {
+                let t = Instant::now();
+                let check = verify_with(p, "<optimized>", &text, on)?;
+                timings.verify_s += t.elapsed().as_secs_f64();
+                // never worse than the input on air, lifts and time, each one
+                if check.after.not_worse_than(&check.before) || order == given {
+                    result = Some((text, check));
+                    break;
+                }
+                note.get_or_insert(format!(
                     "the new order was worse on {}",
                     worse_on(&check.after, &check.before)
                 ));
             }
+            Err(m) => {
+                note.get_or_insert(m);
+            }
         }
-        Err(m) => note = Some(m),
+        let Some(k) = changed.next().filter(|_| attempt < 64) else {
+            break;
+        };
+        let (a, b) = spans[k];
+        order[a..b].copy_from_slice(&gs[k]);
+        rev[a..b].iter_mut().for_each(|r| *r = None);
+        kept_groups += 1;
+        kept = Kept::Groups(kept_groups);
+    }
+    if any_changed && order == given && result.is_some() {
+        // every changed group had to be reverted: the program is the input as it is
+        kept = Kept::Whole;
     }
     let (text, check) = match result {
         Some(r) => r,

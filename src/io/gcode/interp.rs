@@ -730,9 +730,12 @@ fn step(
             return Ok(info);
         }
         Some(281) | Some(301) => {}
+        Some(530) if !axes => {
+            // G53 without axis words moves nothing (LinuxCNC accepts `G53 G0 G17`)
+        }
         Some(530) => {
-            if !axes || !matches!(st.motion, Some(0) | Some(10)) {
-                return Err("G53 needs G0 or G1 and axis words".into());
+            if !matches!(st.motion, Some(0) | Some(10)) {
+                return Err("G53 needs G0 or G1".into());
             }
             info.motion = Motion::Home;
             for (k, c) in ['X', 'Y', 'Z'].into_iter().enumerate() {
@@ -798,8 +801,10 @@ fn step(
                 *pos = t;
             }
             20 | 30 => {
-                if !axes {
-                    return Err("G2/G3 without axis words".into());
+                if !axes && !(w.has('I') || w.has('J') || w.has('K')) {
+                    return Err(
+                        "G2/G3 with neither axis words nor I/J/K (LinuxCNC refuses it too)".into(),
+                    );
                 }
                 if st.feed <= 0.0 {
                     return Err("arc with no feed rate (F)".into());

@@ -65,17 +65,17 @@ pub fn safe_height(p: &Parsed) -> Option<f64> {
 pub fn groups(p: &Parsed, merge: bool) -> Vec<Vec<usize>> {
     let l = &p.layout;
     let mut out: Vec<Vec<usize>> = Vec::new();
-    let mut keys: Vec<(usize, usize, u32)> = Vec::new();
+    let mut keys: std::collections::HashMap<(usize, usize, u32), usize> = Default::default();
     for (i, c) in l.cells.iter().enumerate() {
         let k = if merge {
             (c.run, l.blocks[c.block].epoch, c.tool)
         } else {
             (c.run, c.block, 0)
         };
-        match keys.iter().position(|&x| x == k) {
-            Some(g) => out[g].push(i),
+        match keys.get(&k) {
+            Some(&g) => out[g].push(i),
             None => {
-                keys.push(k);
+                keys.insert(k, out.len());
                 out.push(vec![i]);
             }
         }
@@ -89,9 +89,10 @@ fn p3(a: [f64; 3]) -> Point3 {
     Point3::new(a[0], a[1], a[2])
 }
 
-/// Whether reversal is on for `p` given the option (`None`: on for 2-D programs only).
+/// Whether reversal is on for `p` given the option (`None`: on for 2-D programs without Z
+/// words only).
 pub fn reversal_on(p: &Parsed, reversible: Option<bool>) -> bool {
-    reversible.unwrap_or(p.layout.split == Split::Flat)
+    reversible.unwrap_or(p.layout.split == Split::Flat && !p.program.has_z)
 }
 
 /// The reversal plan of every layout cell (`None`: one-mode), when reversal is `on`. Cells
@@ -124,7 +125,7 @@ pub fn group_instance(
     plans: &[Option<reverse::Plan>],
 ) -> (Instance, bool) {
     let l = &p.layout;
-    let (precedence, dropped) = cells::precedence(l, cells, margin);
+    let (precedence, dropped) = with_leads(l, cells, margin);
     let mut clearance = match l.split {
         Split::Z { travel, .. } => travel,
         Split::Flat => 0.0,
@@ -187,6 +188,42 @@ pub fn group_instance(
         ..Instance::default()
     };
     (inst, dropped)
+}
+
+/// [`cells::precedence`] plus the order the program's first settings impose: a leading cell
+/// (see [`cells::GCell::lead`]) before every other cell of the group, a trailing one after.
+/// When that contradicts inner-first, inner-first is dropped (reported like a contradiction
+/// with the overlap rule).
+fn with_leads(l: &Layout, cells: &[usize], margin: f64) -> (Vec<(usize, usize)>, bool) {
+    let (mut edges, mut dropped) = cells::precedence(l, cells, margin);
+    let mut extra = Vec::new();
+    for (i, &c) in cells.iter().enumerate() {
+        for j in 0..cells.len() {
+            if j != i && l.cells[c].lead {
+                extra.push((i, j));
+            }
+            if j != i && l.cells[c].trail {
+                extra.push((j, i));
+            }
+        }
+    }
+    if extra.is_empty() {
+        return (edges, dropped);
+    }
+    let mut all = edges.clone();
+    all.extend(&extra);
+    let dag = crate::precedence::Dag::new(cells.len(), &all);
+    if crate::precedence::topological_order(&dag).is_err() {
+        // keep every edge in program order (the overlap rule and the first settings agree)
+        edges = edges
+            .into_iter()
+            .map(|(a, b)| (a.min(b), a.max(b)))
+            .collect();
+        dropped = true;
+        all = edges;
+        all.extend(&extra);
+    }
+    (all, dropped)
 }
 
 /// The whole program as one instance (groups chained by precedence), for `cellseq import`;

@@ -149,7 +149,7 @@ pub fn plan(p: &Program, split: Split, c: &GCell) -> Result<Plan, &'static str> 
 }
 
 fn coord(st: &State, mm: f64) -> String {
-    num(mm / st.scale(), if st.metric { 6 } else { 7 })
+    num(mm / st.scale(), 10)
 }
 
 fn exact(v: f64) -> String {

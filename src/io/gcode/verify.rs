@@ -4,6 +4,9 @@ use super::interp::{Cut, CutKind, LineInfo, Motion, Program, Tag};
 use serde::Serialize;
 use std::hash::{Hash, Hasher};
 
+/// Straight moves shorter than this (mm) are not compared: they cut nothing.
+pub const ZERO_MOVE: f64 = 1e-6;
+
 /// Rapid rate assumed for time estimates (mm/min).
 pub const RAPID_MM_MIN: f64 = 5000.0;
 /// Time assumed per tool change (s).
@@ -256,7 +259,7 @@ pub fn same_cuts(
         for (i, li) in p.lines.iter().enumerate() {
             let t = tag(li);
             for (j, c) in li.cuts.iter().enumerate() {
-                if matches!(c.kind, CutKind::Line) && c.length() <= 1e-9 {
+                if matches!(c.kind, CutKind::Line) && c.length() <= ZERO_MOVE {
                     continue;
                 }
                 let c = cut(c);
@@ -267,16 +270,48 @@ pub fn same_cuts(
         v
     };
     let (ka, kb) = (collect(a), collect(b));
-    let ok = ka.len() == kb.len()
-        && ka.iter().zip(&kb).all(|(x, y)| {
-            let (ca, cb) = (
-                cut(&a.lines[x.1 as usize].cuts[x.2 as usize]),
-                cut(&b.lines[y.1 as usize].cuts[y.2 as usize]),
-            );
-            x.0 == y.0 && same(&ca, &cb, tol)
+    // pair equal hashes; what is left (values that fell on both sides of a grid line) is
+    // paired by the tolerance test itself
+    let (mut ua, mut ub) = (Vec::new(), Vec::new());
+    let (mut i, mut j) = (0, 0);
+    while i < ka.len() || j < kb.len() {
+        match (ka.get(i), kb.get(j)) {
+            (Some(x), Some(y)) if x.0 == y.0 => {
+                i += 1;
+                j += 1;
+            }
+            (Some(x), Some(y)) if x.0 < y.0 => {
+                ua.push(*x);
+                i += 1;
+            }
+            (Some(x), None) => {
+                ua.push(*x);
+                i += 1;
+            }
+            (_, Some(y)) => {
+                ub.push(*y);
+                j += 1;
+            }
+            (None, None) => break,
+        }
+    }
+    if ua.len() == ub.len() && ua.len() <= 10_000 {
+        let get = |p: &Program, x: &(u128, u32, u32)| {
+            let li = &p.lines[x.1 as usize];
+            (cut(&li.cuts[x.2 as usize]), tag(li))
+        };
+        let mut taken = vec![false; ub.len()];
+        let all = ua.iter().all(|x| {
+            let (ca, ta) = get(a, x);
+            let hit = ub.iter().enumerate().position(|(k, y)| {
+                let (cb, tb) = get(b, y);
+                !taken[k] && ta == tb && ca.partial == cb.partial && same(&ca, &cb, tol)
+            });
+            hit.map(|k| taken[k] = true).is_some()
         });
-    if ok {
-        return Ok(ka.len());
+        if all {
+            return Ok(ka.len());
+        }
     }
     Err(mismatch(a, b, &ka, &kb, &cut))
 }

@@ -1,7 +1,7 @@
 //! Writing the program back in a new cell order.
 
 use super::Parsed;
-use super::cells::{Block, GCell, Split, entry_state, is_boundary, is_motion_g};
+use super::cells::{Block, GCell, Split, entry_state, free_bits, is_boundary, is_motion_g};
 use super::interp::{CutKind, Motion, Program, State, el, known};
 use super::reverse::{Plan, write_reversed};
 use std::fmt::Write as _;
@@ -23,8 +23,10 @@ fn exact(v: f64) -> String {
     if s == "-0" { "0".into() } else { s }
 }
 
+/// A coordinate in the file's units, precise enough that a move the original makes from this
+/// point stays the same move (10 decimals: under 1e-9 mm off).
 fn units(st: &State, mm: f64) -> String {
-    num(mm / st.scale(), if st.metric { 4 } else { 6 })
+    num(mm / st.scale(), 10)
 }
 
 fn offset_code(o: u16) -> String {
@@ -38,9 +40,10 @@ fn offset_code(o: u16) -> String {
 /// The lines that take the machine from state `cur` to state `target`: only the elements the
 /// program itself set in `target` and that differ. An element set in `cur` but never set by the
 /// program in `target` cannot be handed back to the operator: that is an error (the grouping
-/// of cells into runs never asks for it).
-pub fn transition(cur: &State, target: &State) -> Result<Vec<String>, String> {
-    let missing = cur.set & !target.set;
+/// of cells into runs never asks for it), unless it is in `free`: the cell sets it itself
+/// before it cuts ([`free_bits`](super::cells::free_bits)).
+pub fn transition(cur: &State, target: &State, free: u32) -> Result<Vec<String>, String> {
+    let missing = cur.set & !target.set & !free;
     if missing != 0 {
         let names: Vec<&str> = (0..16)
             .filter(|b| missing & (1 << b) != 0)
@@ -124,15 +127,17 @@ pub fn transition(cur: &State, target: &State) -> Result<Vec<String>, String> {
     if want(el::SPINDLE, cur.spindle == target.spindle) {
         lines.push(format!("M{}", target.spindle));
     }
+    // coolant: only what the target has set (an element left to the cell itself stays)
+    let (tm, tf) = (target.set & el::MIST != 0, target.set & el::FLOOD != 0);
     let (mut mist, mut flood) = (cur.mist, cur.flood);
-    if (mist && !target.mist) || (flood && !target.flood) {
+    if (tm && mist && !target.mist) || (tf && flood && !target.flood) {
         lines.push("M9".into());
         (mist, flood) = (false, false);
     }
-    if target.mist && !mist {
+    if tm && target.mist && !mist {
         lines.push("M7".into());
     }
-    if target.flood && !flood {
+    if tf && target.flood && !flood {
         lines.push("M8".into());
     }
     Ok(lines)
@@ -187,6 +192,8 @@ struct Writer<'a> {
     cur: State,
     /// The output's position (mm), when known.
     pos: Option<[f64; 3]>,
+    /// The output's motion mode (×10, as in [`State::motion`]); `Some(u16::MAX)` when unknown.
+    motion: Option<u16>,
 }
 
 impl Writer<'_> {
@@ -203,14 +210,26 @@ impl Writer<'_> {
             if self.p.lines[i].motion != Motion::None {
                 self.pos = known(&self.p.lines[i].pos_after);
             }
+            if self.p.lines[i].explicit_motion {
+                self.motion = self.p.lines[i].after.motion;
+            }
         }
         if e > s {
             self.cur = self.p.lines[e - 1].after;
         }
     }
 
-    fn to_state(&mut self, target: &State) -> Result<(), String> {
-        for l in transition(&self.cur, target)? {
+    /// A gap line: as written when it does not move, else its other words only.
+    fn gap(&mut self, g: usize) {
+        gap_line(self.p, g, &mut self.out);
+        let li = &self.p.lines[g];
+        if li.motion == Motion::None && li.explicit_motion {
+            self.motion = li.after.motion;
+        }
+    }
+
+    fn to_state(&mut self, target: &State, free: u32) -> Result<(), String> {
+        for l in transition(&self.cur, target, free)? {
             self.line(&l);
         }
         let (motion, cycle, selected) = (self.cur.motion, self.cur.cycle, self.cur.selected);
@@ -228,17 +247,19 @@ impl Writer<'_> {
         let st = self.cur;
         let mut lines: Vec<String> = Vec::new();
         let mut pos = self.pos;
+        let mut zpos = pos.map(|q| q[2]);
         if let Some(h) = clear {
             let top = if cycle { h } else { h.max(entry[2]) };
-            if pos.is_none_or(|q| q[2] < top - 1e-9) {
+            if zpos.is_none_or(|z| z < top - 1e-9) {
                 lines.push(format!("G0 Z{}", units(&st, top)));
                 pos = pos.map(|q| [q[0], q[1], top]);
+                zpos = Some(top);
             }
         }
         if cycle {
             // the canned cycle moves over the hole itself, at the height it starts from
         } else {
-            let z = pos.map_or(entry[2], |q| q[2]);
+            let z = zpos.unwrap_or(entry[2]);
             if pos.is_none_or(|q| (q[0] - entry[0]).abs() > 1e-9 || (q[1] - entry[1]).abs() > 1e-9)
             {
                 lines.push(format!(
@@ -266,6 +287,7 @@ impl Writer<'_> {
             self.line("G91");
         }
         self.pos = pos;
+        self.motion = Some(0);
     }
 
     /// The block's preamble when the output enters the block at another cell than its first:
@@ -283,7 +305,7 @@ impl Writer<'_> {
             if g <= last {
                 self.verbatim(g, g + 1);
             } else {
-                gap_line(p, g, &mut self.out);
+                self.gap(g);
             }
         }
         self.cur = p.lines[first_start].before;
@@ -313,6 +335,7 @@ pub fn write(
         ),
         cur: p.lines[l.header_end].before,
         pos: known(&p.lines[l.header_end].pos_before),
+        motion: p.lines[l.header_end].before.motion,
     };
     for t in &p.text[..l.header_end] {
         w.out.push_str(t);
@@ -346,11 +369,11 @@ pub fn write(
                 .unwrap_or(ci);
             if enter && first == ci && plan.is_none() {
                 // the block's own approach to its first cell, as written
-                w.to_state(&p.lines[b.gap_start].before)?;
+                w.to_state(&p.lines[b.gap_start].before, 0)?;
                 w.verbatim(b.gap_start, c.start);
             } else {
                 if enter {
-                    w.to_state(&p.lines[b.gap_start].before)?;
+                    w.to_state(&p.lines[b.gap_start].before, 0)?;
                     w.preamble(b, l.cells[first].start);
                 }
                 if c.pinned {
@@ -359,26 +382,49 @@ pub fn write(
                         p.lines[c.start].line
                     ));
                 }
-                w.to_state(&entry_state(p, c))?;
-                let mut clear = z.then(|| l.clearance[c.block]);
-                if let Some(h) = clear.as_mut() {
-                    *h = h.max(l.clearance[block]);
-                }
-                w.link(entry, clear, c.cycle);
+                w.to_state(&entry_state(p, c), free_bits(p, c))?;
+                // the gap's words first (as in the original, the approach then runs in the
+                // cell's own state: length offset, units, offset), then the link
                 for &g in &c.prefix {
-                    gap_line(p, g, &mut w.out);
+                    w.gap(g);
                 }
                 w.cur = p.lines[c.start].before;
+                let clear = if z {
+                    Some(l.clearance[c.block].max(l.clearance[block]))
+                } else {
+                    // a 2-D split of a program with Z (cuts at the travel height): the link
+                    // goes over at the higher of here and the entry, then to the entry's Z
+                    p.has_z.then_some(f64::NEG_INFINITY)
+                };
+                if c.cycle {
+                    // a canned cycle moves over its hole by itself, at the height it starts
+                    // from: at least the height the original started it from
+                    let h = p.lines[c.start].pos_before[2].unwrap_or(entry[2]);
+                    w.link(entry, z.then_some(h), true);
+                } else {
+                    w.link(entry, clear, false);
+                }
             }
         }
         block = c.block;
-        if c.cycle {
+        let before = &p.lines[c.start].before;
+        let motion_ok = w.motion == before.motion && w.cur.cycle == before.cycle;
+        if c.cycle && !motion_ok {
             cycle_line(p, c, &mut w.out);
             w.pos = known(&p.lines[c.start].pos_after);
+            w.motion = None;
+        } else if c.cycle {
+            w.verbatim(c.start, c.end);
         } else {
             match plan {
-                Some(pl) => write_reversed(p, z, c, &pl, &mut w.out),
-                None => body(p, c.start, c.end, &mut w.out),
+                Some(pl) => {
+                    write_reversed(p, z, c, &pl, &mut w.out);
+                    w.motion = Some(u16::MAX);
+                }
+                None => {
+                    body(p, c.start, c.end, !motion_ok, &mut w.out);
+                    w.motion = p.lines[c.end - 1].after.motion;
+                }
             }
             w.pos = Some(plan.map(|pl| pl.exit).unwrap_or(c.exit));
         }
@@ -389,7 +435,13 @@ pub fn write(
     if l.footer_start < n {
         let last = l.cells.len() - 1;
         if prev != Some((last, false)) {
-            w.to_state(&p.lines[l.footer_start].before)?;
+            // the footer runs with the tool (and its length offset) the last cell left: with
+            // merged tool blocks that is not always the original's last tool
+            let mut target = p.lines[l.footer_start].before;
+            target.tool = w.cur.tool;
+            target.tlc = w.cur.tlc;
+            target.set = (target.set & !(el::TOOL | el::TLC)) | (w.cur.set & (el::TOOL | el::TLC));
+            w.to_state(&target, 0)?;
             if z {
                 let h = l.clearance[block];
                 if w.pos.is_none_or(|q| q[2] < h - 1e-9) {
@@ -443,10 +495,10 @@ fn cycle_line(p: &Program, c: &GCell, out: &mut String) {
     out.push_str("G80\n");
 }
 
-/// Copies lines `[s, e)`, giving the first motion line its modal motion code explicitly
-/// (a link before it may have changed the motion mode).
-fn body(p: &Program, s: usize, e: usize, out: &mut String) {
-    let mut fixed = false;
+/// Copies lines `[s, e)`; with `fix`, the first motion line gets its modal motion code
+/// explicitly (a link before it changed the motion mode).
+fn body(p: &Program, s: usize, e: usize, fix: bool, out: &mut String) {
+    let mut fixed = !fix;
     for i in s..e {
         let li = &p.lines[i];
         if !fixed && li.motion != Motion::None {
