@@ -50,7 +50,7 @@ fn laser_reversal_reduces_air_and_verifies() {
 fn all_reversed(p: &gcode::Parsed) -> String {
     let plans = gcode::plans(p, true);
     let order: Vec<usize> = (0..p.layout.cells.len()).collect();
-    gcode::write::write(p, &order, &plans, false).unwrap()
+    gcode::write::write_checked(&p.program, &p.layout, &order, &plans, false).unwrap()
 }
 
 fn arcs(prog: &gcode::interp::Program) -> (usize, usize) {

@@ -202,7 +202,7 @@ pub fn optimize_within(p: &Parsed, opts: &Options, allowance: &Allowance) -> Res
     let mut changed = changed.into_iter();
     for attempt in 0..=64 {
         let t = Instant::now();
-        let written = write::write(p, &order, &rev, opts.merge);
+        let written = write::write_checked(&p.program, &p.layout, &order, &rev, opts.merge);
         timings.write_s += t.elapsed().as_secs_f64();
         match written {
             Ok(text) => {
@@ -242,7 +242,7 @@ pub fn optimize_within(p: &Parsed, opts: &Options, allowance: &Allowance) -> Res
             // the input's own order: every cell next to its original neighbours, so the
             // program is written as it is
             let t = Instant::now();
-            let text = write::write(p, &given, &[], false)
+            let text = write::write_checked(&p.program, &p.layout, &given, &[], false)
                 .map_err(|m| crate::Error::invalid(&p.file, m))?;
             timings.write_s += t.elapsed().as_secs_f64();
             let t = Instant::now();

@@ -801,7 +801,7 @@ fn step(
                 *pos = t;
             }
             20 | 30 => {
-                if !axes && !(w.has('I') || w.has('J') || w.has('K')) {
+                if !(axes || w.has('I') || w.has('J') || w.has('K')) {
                     return Err(
                         "G2/G3 with neither axis words nor I/J/K (LinuxCNC refuses it too)".into(),
                     );

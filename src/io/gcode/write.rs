@@ -1,7 +1,6 @@
 //! Writing the program back in a new cell order.
 
-use super::Parsed;
-use super::cells::{Block, GCell, Split, entry_state, free_bits, is_boundary, is_motion_g};
+use super::cells::{Block, GCell, Layout, Split, entry_state, free_bits, is_boundary, is_motion_g};
 use super::interp::{CutKind, Motion, Program, State, el, known};
 use super::reverse::{Plan, write_reversed};
 use std::fmt::Write as _;
@@ -102,17 +101,17 @@ pub fn transition(cur: &State, target: &State, free: u32) -> Result<Vec<String>,
             None => "G49".into(),
         });
     }
-    if want(el::PATH, cur.path == target.path) {
-        if let Some((c, p, q)) = target.path {
-            let mut w = format!("G{}", offset_code(c));
-            if let Some(p) = p {
-                let _ = write!(w, " P{}", exact(p));
-            }
-            if let Some(q) = q {
-                let _ = write!(w, " Q{}", exact(q));
-            }
-            g.push(w);
+    if want(el::PATH, cur.path == target.path)
+        && let Some((c, p, q)) = target.path
+    {
+        let mut w = format!("G{}", offset_code(c));
+        if let Some(p) = p {
+            let _ = write!(w, " P{}", exact(p));
         }
+        if let Some(q) = q {
+            let _ = write!(w, " Q{}", exact(q));
+        }
+        g.push(w);
     }
     if want(el::FEED, cur.feed == target.feed) {
         g.push(format!("F{}", exact(target.feed)));
@@ -228,7 +227,7 @@ impl Writer<'_> {
         }
     }
 
-    fn to_state(&mut self, target: &State, free: u32) -> Result<(), String> {
+    fn reach(&mut self, target: &State, free: u32) -> Result<(), String> {
         for l in transition(&self.cur, target, free)? {
             self.line(&l);
         }
@@ -321,13 +320,13 @@ impl Writer<'_> {
 /// original has at the start of this cell's gap ([`transition`]: only what the program set and
 /// what the new order changed), a link of rapids (retract to the block's own clearance, over,
 /// down to the cell's entry), the gap's non-motion words, and the cell as written.
-pub fn write(
-    parsed: &Parsed,
+pub fn write_checked(
+    p: &Program,
+    l: &Layout,
     order: &[usize],
     rev: &[Option<Plan>],
     merge: bool,
 ) -> Result<String, String> {
-    let (p, l) = (&parsed.program, &parsed.layout);
     let mut w = Writer {
         p,
         out: String::with_capacity(
@@ -369,11 +368,11 @@ pub fn write(
                 .unwrap_or(ci);
             if enter && first == ci && plan.is_none() {
                 // the block's own approach to its first cell, as written
-                w.to_state(&p.lines[b.gap_start].before, 0)?;
+                w.reach(&p.lines[b.gap_start].before, 0)?;
                 w.verbatim(b.gap_start, c.start);
             } else {
                 if enter {
-                    w.to_state(&p.lines[b.gap_start].before, 0)?;
+                    w.reach(&p.lines[b.gap_start].before, 0)?;
                     w.preamble(b, l.cells[first].start);
                 }
                 if c.pinned {
@@ -382,7 +381,7 @@ pub fn write(
                         p.lines[c.start].line
                     ));
                 }
-                w.to_state(&entry_state(p, c), free_bits(p, c))?;
+                w.reach(&entry_state(p, c), free_bits(p, c))?;
                 // the gap's words first (as in the original, the approach then runs in the
                 // cell's own state: length offset, units, offset), then the link
                 for &g in &c.prefix {
@@ -441,7 +440,7 @@ pub fn write(
             target.tool = w.cur.tool;
             target.tlc = w.cur.tlc;
             target.set = (target.set & !(el::TOOL | el::TLC)) | (w.cur.set & (el::TOOL | el::TLC));
-            w.to_state(&target, 0)?;
+            w.reach(&target, 0)?;
             if z {
                 let h = l.clearance[block];
                 if w.pos.is_none_or(|q| q[2] < h - 1e-9) {
@@ -458,6 +457,21 @@ pub fn write(
         w.verbatim(l.footer_start, n);
     }
     Ok(w.out)
+}
+
+/// [`write_checked`] for callers that need text: where the order cannot be written (it would
+/// hand a modal element back to the operator, see [`transition`]), the program as it is.
+pub fn write(
+    p: &Program,
+    l: &Layout,
+    order: &[usize],
+    rev: &[Option<Plan>],
+    merge: bool,
+) -> String {
+    write_checked(p, l, order, rev, merge).unwrap_or_else(|_| {
+        let identity: Vec<usize> = (0..l.cells.len()).collect();
+        write_checked(p, l, &identity, &[], false).unwrap_or_else(|_| p.text.join("\n") + "\n")
+    })
 }
 
 /// A canned-cycle hole written with every word it uses, then G80.
