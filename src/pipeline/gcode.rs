@@ -232,7 +232,7 @@ pub fn optimize_within(p: &Parsed, opts: &Options, allowance: &Allowance) -> Res
         kept_groups += 1;
         kept = Kept::Groups(kept_groups);
     }
-    if any_changed && order == given && result.is_some() {
+    if any_changed && order == given && rev.iter().all(Option::is_none) && result.is_some() {
         // every changed group had to be reverted: the program is the input as it is
         kept = Kept::Whole;
     }
