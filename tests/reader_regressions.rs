@@ -3,10 +3,6 @@
 //! 4 GB of address space and 30 s of CPU, and expects a clean refusal (exit 2) or a result (exit
 //! 0), never a panic, an abort or a signal. Children are limited so that a regression cannot
 //! take the machine down with it.
-//!
-//! Tests marked `#[ignore]` still fail at the time of writing; their readers (`src/io/svg`,
-//! `src/io/dxf.rs`) are being fixed separately. Run them with
-//! `cargo test --release --test reader_regressions -- --ignored`.
 
 use std::path::Path;
 use std::process::Command;
@@ -41,7 +37,6 @@ fn limited(input: &Path, output: &Path) -> std::process::Output {
 const SVG_HEAD: &str = r#"<svg xmlns="http://www.w3.org/2000/svg" viewBox="0 0 100 100">"#;
 
 #[test]
-#[ignore = "SVG reader (src/io/svg, not this branch's): flattening a circle of radius 1e308 allocates 7.5 GB"]
 fn svg_circle_of_radius_1e308_is_refused_within_memory() {
     let t = format!(r#"{SVG_HEAD}<circle cx="70" cy="30" r="1e308"/></svg>"#);
     optimize_is_clean("circle.svg", &t, "svg");
@@ -50,7 +45,6 @@ fn svg_circle_of_radius_1e308_is_refused_within_memory() {
 /// Found by `svg_reader_survives_mutations` at 3000 cases (case 1456: `rx` of
 /// `tests/fixtures/svg/shapes.svg`'s rotated ellipse set to 2^64).
 #[test]
-#[ignore = "SVG reader (src/io/svg, not this branch's): a rotated ellipse of radius 2^64 allocates 4-8 GB"]
 fn svg_rotated_ellipse_of_radius_2_pow_64_is_refused_within_memory() {
     let t = format!(
         r#"{SVG_HEAD}<ellipse cx="70" cy="30" rx="18446744073709551616" ry="3" transform="rotate(30 70 30)"/></svg>"#
@@ -59,7 +53,6 @@ fn svg_rotated_ellipse_of_radius_2_pow_64_is_refused_within_memory() {
 }
 
 #[test]
-#[ignore = "SVG reader (src/io/svg, not this branch's): 50,000 nested <g> overflow the stack"]
 fn svg_50000_nested_groups_do_not_overflow_the_stack() {
     let t = format!(
         r#"{SVG_HEAD}{}<line x1="0" y1="0" x2="1" y2="1"/>{}</svg>"#,
@@ -74,14 +67,12 @@ fn dxf(entities: &str) -> String {
 }
 
 #[test]
-#[ignore = "DXF reader (src/io/dxf.rs and src/io/svg/mod.rs, not this branch's): panics at io/svg/mod.rs:87"]
 fn dxf_closed_lwpolyline_without_vertices_is_refused_not_a_panic() {
     let t = dxf("  0\nLWPOLYLINE\n  8\n0\n 90\n0\n 70\n1\n");
     optimize_is_clean("empty-lw.dxf", &t, "svg");
 }
 
 #[test]
-#[ignore = "DXF reader (src/io/dxf.rs and src/io/svg/mod.rs, not this branch's): panics at io/svg/mod.rs:87"]
 fn dxf_closed_polyline_without_vertices_is_refused_not_a_panic() {
     let t = dxf("  0\nPOLYLINE\n  8\n0\n 66\n1\n 70\n1\n  0\nSEQEND\n");
     optimize_is_clean("empty-poly.dxf", &t, "svg");

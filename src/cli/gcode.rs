@@ -3,7 +3,9 @@
 use anyhow::{Context as _, bail};
 use cellseq::formats::write::ensure_not_input;
 use cellseq::formats::{read_text, save_instance, write_atomic};
-use cellseq::io::gcode::{self, Figures, Options};
+use cellseq::io::gcode::{self, Figures};
+use cellseq::pipeline::Allowance;
+use cellseq::pipeline::gcode::{self as gcode_pipeline, Kept, Options};
 use clap::Args;
 use std::path::{Path, PathBuf};
 
@@ -18,15 +20,16 @@ pub struct OptimizeArgs {
     /// Allow the output to be the input file itself (by any path or link).
     #[arg(long)]
     pub overwrite_input: bool,
-    /// Solver from the registry (default: greedy for G-code; for SVG/DXF `drawing`: greedy,
-    /// 2-opt/Or-opt with reversal, iterated local search).
+    /// Solver from the registry (default for G-code: `auto`, the registry's default portfolio;
+    /// for SVG/DXF `drawing`: greedy, 2-opt/Or-opt with reversal, iterated local search).
     #[arg(long)]
     pub solver: Option<String>,
-    /// Time limit in seconds (shared among tool blocks).
+    /// Time limit in seconds for the whole command (reading, solving, checking, writing);
+    /// the solver's part is shared among groups of cells by size.
     #[arg(long, value_name = "S")]
     pub time_limit: Option<f64>,
-    /// Evaluation budget (deterministic: the same result on any machine); shared among tool
-    /// blocks or drawing scopes by size.
+    /// Evaluation budget of the solver, shared among groups by size (deterministic results);
+    /// without this or a time limit, each group gets 20 000 evaluations per cell.
     #[arg(long, value_name = "N")]
     pub max_evals: Option<u64>,
     /// Seed.
@@ -159,9 +162,44 @@ pub fn optimize(a: OptimizeArgs) -> anyhow::Result<()> {
     if fmt != "gcode" {
         return super::drawing::optimize(&a, fmt);
     }
+    optimize_gcode(&a)
+}
+
+/// Output extensions that are not G-code: an optimized program is never written into them.
+fn refuse_non_gcode_output(o: &Path) -> anyhow::Result<()> {
+    let ext = o
+        .extension()
+        .and_then(|e| e.to_str())
+        .unwrap_or("")
+        .to_ascii_lowercase();
+    if matches!(
+        ext.as_str(),
+        "svg" | "dxf" | "png" | "pdf" | "json" | "csv" | "toml"
+    ) {
+        bail!(
+            "{}: an optimized G-code program is not written into a .{ext} file; give a G-code \
+             name (.ngc, .nc, .gcode, …), or draw it with `cellseq plot`",
+            o.display()
+        );
+    }
+    Ok(())
+}
+
+fn optimize_gcode(a: &OptimizeArgs) -> anyhow::Result<()> {
+    let allowance = Allowance::new(a.time_limit, a.max_evals);
+    if let Some(o) = &a.output {
+        refuse_non_gcode_output(o)?;
+    }
+    if let Some(t) = a.time_limit
+        && !(t.is_finite() && t > 0.0)
+    {
+        bail!("--time-limit must be a positive number of seconds (got {t})");
+    }
     let file = a.input.display().to_string();
+    let t0 = std::time::Instant::now();
     let text = read_text(&a.input)?;
     let parsed = gcode::parse(&file, &text)?;
+    let parse_s = t0.elapsed().as_secs_f64();
     let solver = a
         .solver
         .clone()
@@ -169,6 +207,7 @@ pub fn optimize(a: OptimizeArgs) -> anyhow::Result<()> {
     let opts = Options {
         solver: solver.clone(),
         time_limit: a.time_limit,
+        max_evals: a.max_evals,
         seed: a.seed,
         merge: a.merge_tool_blocks,
         margin: a.margin,
@@ -180,10 +219,14 @@ pub fn optimize(a: OptimizeArgs) -> anyhow::Result<()> {
             None
         },
     };
-    let out = gcode::optimize(&parsed, &opts)?;
+    let mut out = gcode_pipeline::optimize_within(&parsed, &opts, &allowance)?;
+    out.timings.parse_s = parse_s;
     if let Some(o) = &a.output {
+        let t = std::time::Instant::now();
         write_atomic(o, out.text.as_bytes()).with_context(|| format!("writing {}", o.display()))?;
+        out.timings.write_s += t.elapsed().as_secs_f64();
     }
+    let reversed = out.reversed.iter().filter(|&&r| r).count();
     if a.json {
         let v = serde_json::json!({
             "input": file,
@@ -191,36 +234,55 @@ pub fn optimize(a: OptimizeArgs) -> anyhow::Result<()> {
             "solver": solver,
             "cells": parsed.layout.cells.len(),
             "tool_blocks": parsed.layout.blocks.len(),
+            "groups": out.groups,
             "verified_cutting_moves": out.cuts,
+            "verified_events": out.events,
             "inner_first_dropped_groups": out.inner_first_dropped,
-            "solve_s": out.solve_s,
-            "kept_original_order": out.kept_original,
+            "kept_original_order": out.kept_original(),
+            "kept": out.kept,
+            "kept_note": out.note,
+            "reversal": out.reversal_on,
             "reversible_cells": out.reversible_cells,
-            "reversed_cells": out.reversed.iter().filter(|&&r| r).count(),
+            "reversed_cells": reversed,
+            "timings": out.timings,
+            "solve_s": out.timings.solve_s,
+            "total_s": allowance.started.elapsed().as_secs_f64(),
             "before": out.before,
             "after": out.after,
         });
         say!("{}", serde_json::to_string_pretty(&v)?);
     } else {
         say!(
-            "{file}: {} cells in {} tool blocks; solver {} ({:.3} s); {} cutting moves verified identical",
+            "{file}: {} cells in {} tool blocks, {} groups; solver {}; {} cutting moves and {} events verified in the same machine state",
             parsed.layout.cells.len(),
             parsed.layout.blocks.len(),
+            out.groups,
             solver,
-            out.solve_s,
-            out.cuts
+            out.cuts,
+            out.events
         );
-        if out.reversible_cells > 0 {
-            say!(
-                "reversal: {} of {} reversible cells cut backwards",
-                out.reversed.iter().filter(|&&r| r).count(),
-                out.reversible_cells
-            );
+        if out.reversal_on {
+            if out.reversible_cells == 0 {
+                say!("reversal: on, but no cell could be reversed");
+            } else {
+                say!(
+                    "reversal: {reversed} of {} reversible cells cut backwards",
+                    out.reversible_cells
+                );
+            }
         }
-        if out.kept_original {
-            say!(
-                "note: the solver's order had more air travel than the original order; original order kept"
-            );
+        match out.kept {
+            Kept::Whole => say!(
+                "note: the program is kept in its original order ({})",
+                out.note
+                    .as_deref()
+                    .unwrap_or("the solver found no better order")
+            ),
+            Kept::Groups(g) => say!(
+                "note: the original order was kept in {g} of {} group(s) (the new order was not better there)",
+                out.groups
+            ),
+            Kept::Nothing => {}
         }
         if out.inner_first_dropped > 0 {
             say!(
@@ -229,6 +291,14 @@ pub fn optimize(a: OptimizeArgs) -> anyhow::Result<()> {
             );
         }
         print_figures(&out.before, &out.after);
+        let t = &out.timings;
+        say!(
+            "time: parse {:.3} s, solve {:.3} s, verify {:.3} s, write {:.3} s",
+            t.parse_s,
+            t.solve_s,
+            t.verify_s,
+            t.write_s
+        );
         if let Some(o) = &a.output {
             say!("wrote {}", o.display());
         }
@@ -277,8 +347,9 @@ pub fn verify(a: VerifyArgs) -> anyhow::Result<()> {
         say!("{}", serde_json::to_string_pretty(&v)?);
     } else {
         say!(
-            "equivalent: {} cutting moves match (per tool, feed, speed, offset; in either direction)",
-            v.cuts
+            "equivalent: {} cutting moves and {} events match, each in the same machine state (in either direction); no new motion",
+            v.cuts,
+            v.events
         );
         print_figures(&v.before, &v.after);
     }

@@ -1,7 +1,7 @@
 //! Splitting an interpreted program into cells, tool blocks, header and footer; default
 //! precedence (overlap keeps order, inner closed contours first).
 
-use super::interp::{CutKind, Motion, Program, State, known};
+use super::interp::{CutKind, Motion, Program, State, el, known};
 
 /// How cells are delimited.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -27,6 +27,22 @@ pub struct GCell {
     pub end: usize,
     /// Gap lines emitted before the cell (non-motion, or motion lines to be stripped).
     pub prefix: Vec<usize>,
+    /// First line of the gap before the cell in the original (the end of the previous cell);
+    /// equal to `start` for the first cell of a block (its gap is the block's preamble).
+    pub gap_start: usize,
+    /// Run of cells that may be reordered among themselves: runs end where the program first
+    /// sets a modal element (a cell cut before that line would run with the operator's state
+    /// changed) and at pauses, coordinate-system changes, controller lines and user M codes.
+    pub run: usize,
+    /// True when the cell itself sets an element for the first time and opens its run: it must
+    /// come first in its group (the cells after it rely on what it sets).
+    pub lead: bool,
+    /// True when the cell itself sets an element for the first time and closes its run: it
+    /// must come last in its group (the cells before it run without what it sets).
+    pub trail: bool,
+    /// True when the cell starts from a position the program does not know (right after
+    /// G28/G30/G53/`$H`): it keeps its place and its approach as written.
+    pub pinned: bool,
     /// Tool block index.
     pub block: usize,
     /// Tool number.
@@ -78,13 +94,43 @@ pub struct Layout {
     pub blocks: Vec<Block>,
     /// Position at the end of the header (mm), when known.
     pub start: Option<[f64; 3]>,
+    /// Per block: the height (mm) the program itself rises to between two cells of the block
+    /// (the highest rapid of those gaps); links between cells of the block retract to it.
+    /// Zero for 2-D programs.
+    pub clearance: Vec<f64>,
+}
+
+/// True for a line that cells never move across: a tool change, a coordinate-system change,
+/// a move to a machine position (G28/G30/G53, `$H`), a pause, a controller line, a user M code.
+pub fn is_boundary(p: &Program, i: usize) -> bool {
+    let li = &p.lines[i];
+    li.tool_change || li.setup || li.motion == Motion::Home || li.pause || li.dialect || li.user_m
+}
+
+/// A boundary that also ends a run (cells of different runs are never reordered, even when
+/// blocks of one tool are merged): everything but tool changes and machine-position moves.
+fn ends_run(p: &Program, i: usize) -> bool {
+    let li = &p.lines[i];
+    li.setup || li.pause || li.dialect || li.user_m
 }
 
 const EPS: f64 = 1e-6;
 
 /// Splits a program. Errors: `(line, message)`.
 pub fn split(p: &Program) -> Result<Layout, (usize, String)> {
-    let split = if p.has_z { find_safe(p)? } else { Split::Flat };
+    // no rapid across at a known height (a single helix, a wave): nothing to lift between, the
+    // program is split like a 2-D one
+    let z_split = if p.has_z {
+        find_safe(p).unwrap_or(Split::Flat)
+    } else {
+        Split::Flat
+    };
+    let split = match z_split {
+        // every cut at or above the travel height (a pen or a silkscreen pass at Z0 with
+        // rapids at Z0): the Z rule would make each move a cell; cells are runs of feed moves
+        Split::Z { safe, .. } if !cuts_below(p, safe) => Split::Flat,
+        s => s,
+    };
     let safe = match split {
         Split::Z { safe, .. } => safe,
         Split::Flat => f64::INFINITY,
@@ -136,11 +182,11 @@ pub fn split(p: &Program) -> Result<Layout, (usize, String)> {
                     ranges.push((i, i + 1, true));
                     continue;
                 }
-                li.motion == Motion::Feed
+                (li.motion == Motion::Feed && cuts_something(li))
                     || (li.motion == Motion::Rapid
                         && matches!((li.pos_before[2], zafter), (Some(a), Some(b)) if b < safe - EPS && b < a - EPS))
             }
-            Split::Flat => li.motion == Motion::Feed,
+            Split::Flat => li.motion == Motion::Feed && cuts_something(li),
         };
         if starts {
             open = Some(i);
@@ -182,8 +228,9 @@ pub fn split(p: &Program) -> Result<Layout, (usize, String)> {
     let mut prev_end = header_end;
     for &(s, e, cycle) in &ranges {
         let gap: Vec<usize> = (prev_end..s).collect();
+        let gap_from = prev_end;
         let mut prefix = Vec::new();
-        let boundary = |g: usize| p.lines[g].tool_change || p.lines[g].setup;
+        let boundary = |g: usize| is_boundary(p, g);
         if gap.iter().any(|&g| p.lines[g].setup) {
             epoch += 1;
         }
@@ -220,10 +267,21 @@ pub fn split(p: &Program) -> Result<Layout, (usize, String)> {
                 "cutter radius compensation (G41/G42) active at the start of a cut".into(),
             ));
         }
-        let before = known(&first.pos_before).ok_or((
-            first.line,
-            "position unknown at the start of a cut (after G28/G30/G53)".to_string(),
-        ))?;
+        let pinned = known(&first.pos_before).is_none();
+        let before = match known(&first.pos_before) {
+            Some(b) => b,
+            None => {
+                // right after G28/G30/G53/$H: the axes the program has not named since are
+                // where the controller left them; the cell keeps its place and approach
+                let to = known(&first.pos_after).ok_or((
+                    first.line,
+                    "the first move after G28/G30/G53/$H does not name X, Y and Z; give all \
+                     three in an absolute move before cutting"
+                        .to_string(),
+                ))?;
+                [0, 1, 2].map(|k| first.pos_before[k].unwrap_or(to[k]))
+            }
+        };
         let exit = known(&last.pos_after).ok_or((
             last.line,
             "position unknown at the end of a cut".to_string(),
@@ -279,10 +337,18 @@ pub fn split(p: &Program) -> Result<Layout, (usize, String)> {
         let closed_xy = (pts[0][0] - exit[0]).hypot(pts[0][1] - exit[1]) < 1e-3;
         let closed = (planar && !cycle && closed_xy && pts.len() >= 4 && area(&pts).abs() > 1e-6)
             .then_some(pts);
+        let block_first = cells
+            .last()
+            .is_none_or(|c: &GCell| c.block != blocks.len() - 1);
         cells.push(GCell {
             start: s,
             end: e,
             prefix,
+            gap_start: if block_first { s } else { gap_from },
+            run: 0,
+            lead: false,
+            trail: false,
+            pinned,
             block: blocks.len() - 1,
             tool: st.tool,
             entry,
@@ -296,6 +362,8 @@ pub fn split(p: &Program) -> Result<Layout, (usize, String)> {
         });
     }
     let start = known(&p.lines[header_end].pos_before);
+    assign_runs(p, &mut cells, &blocks);
+    let clearance = clearances(p, split, &cells, &blocks);
     Ok(Layout {
         split,
         header_end,
@@ -303,7 +371,143 @@ pub fn split(p: &Program) -> Result<Layout, (usize, String)> {
         cells,
         blocks,
         start,
+        clearance,
     })
+}
+
+/// The program's elements set at the start of a cell's gap (see [`GCell::gap_start`]).
+pub fn entry_state(p: &Program, c: &GCell) -> State {
+    p.lines[c.gap_start].before
+}
+
+/// Elements whose value does not change where a link's rapids go (feed, speed, spindle,
+/// coolant, path and retract modes, plane, arc distance, cutter compensation, G94).
+const LINK_NEUTRAL: u32 = el::FEED
+    | el::SPEED
+    | el::SPINDLE
+    | el::MIST
+    | el::FLOOD
+    | el::PATH
+    | el::RETRACT
+    | el::PLANE
+    | el::ARC_DIST
+    | el::CUTTER
+    | el::FEED_MODE;
+
+/// Elements unset at the start of the cell's gap that the cell sets itself before anything it
+/// cuts or does (so a cell before it may leave them set): those set by the gap's lines (written
+/// before the link), and link-neutral ones set by the body before its first cut.
+pub fn free_bits(p: &Program, c: &GCell) -> u32 {
+    let a = entry_state(p, c).set;
+    let tagged = |i: usize| {
+        let li = &p.lines[i];
+        li.cuts.iter().any(|x| {
+            !matches!(x.kind, super::interp::CutKind::Line) || x.length() > super::verify::ZERO_MOVE
+        }) || li.tool_change
+            || li.pause
+            || li.dwell
+            || li.user_m
+            || li.setup
+            || li.dialect
+    };
+    let g = (c.gap_start..c.end)
+        .find(|&i| tagged(i))
+        .unwrap_or(c.end - 1);
+    let t = p.lines[g].after.set;
+    if g < c.start {
+        return t & !a;
+    }
+    let body = p.lines[c.start].before.set;
+    (body & !a) | (t & !body & LINK_NEUTRAL)
+}
+
+/// Numbers the runs (see [`GCell::run`]) and marks the cells that set an element for the
+/// first time: a run's first cell may be such a cell (it then leads: the rest of the run
+/// relies on it), any other such cell closes the run (it trails).
+fn assign_runs(p: &Program, cells: &mut [GCell], blocks: &[Block]) {
+    let entry = |c: &GCell| entry_state(p, c).set | free_bits(p, c);
+    let setter = |c: &GCell| entry(c) != p.lines[c.end - 1].after.set;
+    let mut run = 0;
+    let mut start = 0;
+    for k in 1..cells.len() {
+        let (a, b) = (&cells[k - 1], &cells[k]);
+        let prev_out = p.lines[a.end - 1].after.set;
+        let this_in = entry(b);
+        let barrier = if b.block != a.block {
+            blocks[b.block].preamble.iter().any(|&g| ends_run(p, g))
+        } else {
+            (a.end..b.start).any(|g| ends_run(p, g))
+        };
+        let closes = setter(a) && start != k - 1;
+        if barrier || closes || prev_out != this_in || a.pinned || b.pinned {
+            run += 1;
+            start = k;
+        }
+        cells[k].run = run;
+    }
+    let n = cells.len();
+    for k in 0..n {
+        if setter(&cells[k]) {
+            let first = k == 0 || cells[k - 1].run != cells[k].run;
+            let last = k + 1 == n || cells[k + 1].run != cells[k].run;
+            cells[k].lead = first && !last;
+            cells[k].trail = !first;
+        }
+    }
+}
+
+/// Per block, the highest rapid between two of its cells (else of its approach, else the
+/// safe height).
+fn clearances(p: &Program, split: Split, cells: &[GCell], blocks: &[Block]) -> Vec<f64> {
+    let Split::Z { safe, .. } = split else {
+        return vec![0.0; blocks.len()];
+    };
+    let rapid_top = |r: std::ops::Range<usize>| {
+        r.filter(|&g| p.lines[g].motion == Motion::Rapid)
+            .filter_map(|g| p.lines[g].pos_after[2])
+            .fold(None, |m: Option<f64>, z| Some(m.map_or(z, |m| m.max(z))))
+    };
+    let mut between: Vec<Option<f64>> = vec![None; blocks.len()];
+    for k in 1..cells.len() {
+        let (a, b) = (&cells[k - 1], &cells[k]);
+        if a.block == b.block
+            && let Some(z) = rapid_top(a.end..b.start)
+        {
+            let m = &mut between[b.block];
+            *m = Some(m.map_or(z, |m| m.max(z)));
+        }
+    }
+    blocks
+        .iter()
+        .enumerate()
+        .map(|(i, b)| {
+            between[i]
+                .or_else(|| {
+                    b.preamble
+                        .iter()
+                        .filter_map(|&g| p.lines[g].xy_rapid_z)
+                        .fold(None, |m: Option<f64>, z| Some(m.map_or(z, |m| m.max(z))))
+                })
+                .unwrap_or(safe)
+        })
+        .collect()
+}
+
+/// True when a line cuts anything: a feed line that does not move (`G01 F100`, a move to
+/// where the tool already is) starts no cell, so no link is ever written before it (a header's
+/// `G01 F200` before the first tool change stays in the header).
+fn cuts_something(li: &super::interp::LineInfo) -> bool {
+    li.cuts
+        .iter()
+        .any(|c| !matches!(c.kind, CutKind::Line) || c.length() > super::verify::ZERO_MOVE)
+}
+
+/// True when some cut runs below `safe`.
+fn cuts_below(p: &Program, safe: f64) -> bool {
+    p.lines
+        .iter()
+        .flat_map(|l| l.cuts.iter())
+        .any(|c| c.from[2].min(c.to[2]) < safe - EPS)
 }
 
 /// True when a motion line also carries words other than motion and axes (M, S, F, T…).

@@ -43,6 +43,67 @@ pub struct State {
     pub path: Option<(u16, Option<f64>, Option<f64>)>,
     /// Cutter radius compensation on (G41/G42).
     pub cutter_comp: bool,
+    /// Feed mode set by G94 (the only one supported).
+    pub feed_mode: bool,
+    /// Elements the program has set so far ([`el`] bits); the others belong to the operator.
+    pub set: u32,
+    /// Coordinate-system changes (G10, G52, G92…) executed so far.
+    pub epoch: u32,
+}
+
+/// Bits of [`State::set`]: the modal elements a program can establish.
+pub mod el {
+    /// G20/G21.
+    pub const UNITS: u32 = 1;
+    /// G90/G91.
+    pub const DIST: u32 = 1 << 1;
+    /// G90.1/G91.1.
+    pub const ARC_DIST: u32 = 1 << 2;
+    /// G17/G18/G19.
+    pub const PLANE: u32 = 1 << 3;
+    /// G54 … G59.3.
+    pub const OFFSET: u32 = 1 << 4;
+    /// F.
+    pub const FEED: u32 = 1 << 5;
+    /// S.
+    pub const SPEED: u32 = 1 << 6;
+    /// M3/M4/M5.
+    pub const SPINDLE: u32 = 1 << 7;
+    /// M7 (or M9).
+    pub const MIST: u32 = 1 << 8;
+    /// M8 (or M9).
+    pub const FLOOD: u32 = 1 << 9;
+    /// G43/G49.
+    pub const TLC: u32 = 1 << 10;
+    /// G61/G61.1/G64.
+    pub const PATH: u32 = 1 << 11;
+    /// G40/G41/G42.
+    pub const CUTTER: u32 = 1 << 12;
+    /// G98/G99.
+    pub const RETRACT: u32 = 1 << 13;
+    /// The tool in the spindle (M6, or T in programs without M6).
+    pub const TOOL: u32 = 1 << 14;
+    /// G94.
+    pub const FEED_MODE: u32 = 1 << 15;
+    /// Names of the bits, for messages.
+    pub const NAMES: [&str; 16] = [
+        "units (G20/G21)",
+        "distance mode (G90/G91)",
+        "arc distance mode (G90.1/G91.1)",
+        "plane (G17/G18/G19)",
+        "work offset (G54-G59.3)",
+        "feed (F)",
+        "spindle speed (S)",
+        "spindle (M3/M4/M5)",
+        "mist (M7/M9)",
+        "flood (M8/M9)",
+        "tool length offset (G43/G49)",
+        "path mode (G61/G64)",
+        "cutter compensation (G40-G42)",
+        "canned-cycle retract (G98/G99)",
+        "tool (M6)",
+        "feed mode (G94)",
+    ];
 }
 
 impl Default for State {
@@ -66,6 +127,9 @@ impl Default for State {
             selected: 0,
             path: None,
             cutter_comp: false,
+            feed_mode: false,
+            set: 0,
+            epoch: 0,
         }
     }
 }
@@ -75,6 +139,66 @@ impl State {
     pub fn scale(&self) -> f64 {
         if self.metric { 1.0 } else { 25.4 }
     }
+
+    /// The machine state that matters at a cutting move or an event, with what the program set:
+    /// everything but the motion mode, canned-cycle words and the selected (not loaded) tool.
+    /// Two moves run in the same state exactly when their tags are equal.
+    pub fn tag(&self) -> Tag {
+        let q = |v: f64| (v * 1e6).round() as i64;
+        let (pc, pp, pq) = match self.path {
+            Some((c, p, q2)) => (c as i64, p.map(q), q2.map(q)),
+            None => (-1, None, None),
+        };
+        Tag {
+            flags: [
+                self.metric,
+                self.absolute,
+                self.arc_absolute,
+                self.mist,
+                self.flood,
+                self.cutter_comp,
+                self.retract_old_z,
+                self.feed_mode,
+            ],
+            plane: self.plane,
+            offset: self.offset,
+            spindle: self.spindle,
+            tool: self.tool,
+            feed: q(self.feed * self.scale()),
+            speed: q(self.speed),
+            tlc: self.tlc.map(q),
+            path: (pc, pp, pq),
+            set: self.set,
+            epoch: self.epoch,
+        }
+    }
+}
+
+/// The comparable machine state of [`State::tag`] (values quantized to 1e-6).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub struct Tag {
+    /// metric, absolute, arc absolute, mist, flood, cutter compensation, G98, G94.
+    pub flags: [bool; 8],
+    /// Plane.
+    pub plane: u8,
+    /// Work offset ×10.
+    pub offset: u16,
+    /// 3, 4, 5.
+    pub spindle: u8,
+    /// Tool in the spindle.
+    pub tool: u32,
+    /// Feed in mm/min ×1e6.
+    pub feed: i64,
+    /// Speed ×1e6.
+    pub speed: i64,
+    /// Tool length offset H ×1e6.
+    pub tlc: Option<i64>,
+    /// Path mode code, P, Q.
+    pub path: (i64, Option<i64>, Option<i64>),
+    /// [`el`] bits set by the program.
+    pub set: u32,
+    /// Coordinate-system changes so far.
+    pub epoch: u32,
 }
 
 /// What a cutting move is.
@@ -125,6 +249,9 @@ pub struct Cut {
     pub speed: f64,
     /// Work offset ×10.
     pub offset: u16,
+    /// True when the move started from a position the program does not know on some axis
+    /// (after G28/G30/G53): the unknown start coordinates are taken from the end point.
+    pub partial: bool,
 }
 
 impl Cut {
@@ -261,6 +388,13 @@ pub struct LineInfo {
     pub end: bool,
     /// G10/G92/G52: changes coordinate systems.
     pub setup: bool,
+    /// G4 dwell.
+    pub dwell: bool,
+    /// An M code with effects cellseq does not model (M48–M53 overrides, M62–M68 outputs,
+    /// M100–M199 user codes): kept in place.
+    pub user_m: bool,
+    /// A controller system line (GRBL `$H`, `$X`, …): carried through unchanged, in place.
+    pub dialect: bool,
     /// The cutting moves of the line.
     pub cuts: Vec<Cut>,
     /// Rapid length (mm) when both ends are known.
@@ -284,7 +418,15 @@ pub struct Program {
 
 /// Interprets a program. Errors: `(line, message)`.
 pub fn interpret(src: &str) -> Result<Program, (usize, String)> {
-    let text: Vec<String> = src.lines().map(|l| l.to_string()).collect();
+    let text: Vec<String> = src
+        .lines()
+        .enumerate()
+        .map(|(i, l)| {
+            super::lex::normalize(l)
+                .map(|c| c.into_owned())
+                .map_err(|e| (i + 1, e))
+        })
+        .collect::<Result<_, _>>()?;
     let mut words = Vec::with_capacity(text.len());
     let mut has_m6 = false;
     let mut has_z = false;
@@ -336,10 +478,20 @@ fn step(
         spindle_off: false,
         end: false,
         setup: false,
+        dwell: false,
+        user_m: false,
+        dialect: w.dialect,
         cuts: Vec::new(),
         rapid_len: 0.0,
         xy_rapid_z: None,
     };
+    if w.dialect {
+        if w.homing {
+            info.motion = Motion::Home;
+            *pos = [None; 3];
+        }
+        return Ok(finish(info, w, st, pos));
+    }
     for &(c, _) in &w.words {
         if !matches!(
             c,
@@ -416,18 +568,21 @@ fn step(
     // feed, speed, tool
     if let Some(f) = w.get('F') {
         st.feed = f;
+        st.set |= el::FEED;
     }
     if let Some(s) = w.get('S') {
         st.speed = s;
+        st.set |= el::SPEED;
     }
     if let Some(t) = w.get('T') {
         if t < 0.0 || !close(t, t.round()) {
             return Err(format!("bad tool number T{t}"));
         }
         st.selected = t as u32;
-        if !has_m6 && st.tool != st.selected {
+        if !has_m6 && (st.tool != st.selected || st.set & el::TOOL == 0) {
+            info.tool_change = st.tool != st.selected;
             st.tool = st.selected;
-            info.tool_change = true;
+            st.set |= el::TOOL;
         }
     }
     for m in w.all('M') {
@@ -438,49 +593,100 @@ fn step(
         match code {
             6 => {
                 st.tool = st.selected;
+                st.set |= el::TOOL;
                 info.tool_change = true;
             }
-            3 | 4 => st.spindle = code as u8,
+            3 | 4 => {
+                st.spindle = code as u8;
+                st.set |= el::SPINDLE;
+            }
             5 => {
                 st.spindle = 5;
+                st.set |= el::SPINDLE;
                 info.spindle_off = true;
             }
-            7 => st.mist = true,
-            8 => st.flood = true,
+            7 => {
+                st.mist = true;
+                st.set |= el::MIST;
+            }
+            8 => {
+                st.flood = true;
+                st.set |= el::FLOOD;
+            }
             9 => {
                 st.mist = false;
                 st.flood = false;
+                st.set |= el::MIST | el::FLOOD;
             }
             0 | 1 | 60 => info.pause = true,
             2 | 30 => info.end = true,
-            48..=53 | 62..=68 | 100..=199 => {}
+            48..=53 | 62..=68 | 100..=199 => info.user_m = true,
             _ => return Err(format!("M{code} is not supported")),
         }
     }
     // modal G codes in execution order
     for g in w.all('G') {
         let code = (g * 10.0).round() as u16;
-        match code {
-            170 => st.plane = 17,
-            180 => st.plane = 18,
-            190 => st.plane = 19,
-            200 => st.metric = false,
-            210 => st.metric = true,
-            400 => st.cutter_comp = false,
-            410 | 420 => st.cutter_comp = true,
-            430 => st.tlc = Some(w.get('H').unwrap_or(st.tool as f64)),
-            490 => st.tlc = None,
-            540..=593 => st.offset = code,
-            610 | 611 => st.path = Some((code, None, None)),
-            640 => st.path = Some((640, w.get('P'), w.get('Q'))),
-            900 => st.absolute = true,
-            910 => st.absolute = false,
-            901 => st.arc_absolute = true,
-            911 => st.arc_absolute = false,
-            980 => st.retract_old_z = true,
-            990 => st.retract_old_z = false,
-            _ => {}
-        }
+        let bit = match code {
+            170 | 180 | 190 => {
+                st.plane = (code / 10) as u8;
+                el::PLANE
+            }
+            200 | 210 => {
+                st.metric = code == 210;
+                el::UNITS
+            }
+            400 => {
+                st.cutter_comp = false;
+                el::CUTTER
+            }
+            410 | 420 => {
+                st.cutter_comp = true;
+                el::CUTTER
+            }
+            430 => {
+                st.tlc = Some(w.get('H').unwrap_or(st.tool as f64));
+                el::TLC
+            }
+            490 => {
+                st.tlc = None;
+                el::TLC
+            }
+            540..=593 => {
+                st.offset = code;
+                el::OFFSET
+            }
+            610 | 611 => {
+                st.path = Some((code, None, None));
+                el::PATH
+            }
+            640 => {
+                st.path = Some((640, w.get('P'), w.get('Q')));
+                el::PATH
+            }
+            900 | 910 => {
+                st.absolute = code == 900;
+                el::DIST
+            }
+            901 | 911 => {
+                st.arc_absolute = code == 901;
+                el::ARC_DIST
+            }
+            940 => {
+                st.feed_mode = true;
+                el::FEED_MODE
+            }
+            980 | 990 => {
+                st.retract_old_z = code == 980;
+                el::RETRACT
+            }
+            40 => {
+                info.dwell = true;
+                0
+            }
+            _ => 0,
+        };
+        st.set |= bit;
     }
     if let Some(m) = motion_g {
         info.explicit_motion = true;
@@ -505,6 +711,7 @@ fn step(
         Some(40) => {}
         Some(100) | Some(920) | Some(921) | Some(922) | Some(923) | Some(520) => {
             info.setup = true;
+            st.epoch += 1;
             if matches!(nonmodal, Some(920) | Some(520)) {
                 // the program position becomes what the words say
                 *pos = target(pos, true)?;
@@ -523,9 +730,12 @@ fn step(
             return Ok(info);
         }
         Some(281) | Some(301) => {}
+        Some(530) if !axes => {
+            // G53 without axis words moves nothing (LinuxCNC accepts `G53 G0 G17`)
+        }
         Some(530) => {
-            if !axes || !matches!(st.motion, Some(0) | Some(10)) {
-                return Err("G53 needs G0 or G1 and axis words".into());
+            if !matches!(st.motion, Some(0) | Some(10)) {
+                return Err("G53 needs G0 or G1".into());
             }
             info.motion = Motion::Home;
             for (k, c) in ['X', 'Y', 'Z'].into_iter().enumerate() {
@@ -554,6 +764,7 @@ fn step(
             feed: st.feed * st.scale(),
             speed: if st.spindle == 5 { 0.0 } else { st.speed },
             offset: st.offset,
+            partial: false,
         };
         match mode {
             0 | 10 => {
@@ -571,22 +782,29 @@ fn step(
                     }
                 } else {
                     info.motion = Motion::Feed;
-                    let from =
-                        known(pos).ok_or("feed move from an unknown position (after G28/G53)")?;
-                    let to = known(&t).ok_or("feed move to an unknown position")?;
+                    let to = known(&t).ok_or(
+                        "feed move to a position the program does not know (after G28/G30/G53: \
+                         give X, Y and Z in an absolute move first)",
+                    )?;
+                    // after G28/G30/G53 an axis the move does not name is where the controller
+                    // left it: the move is kept in place and compared with that axis unknown
+                    let from = [0, 1, 2].map(|k| pos[k].unwrap_or(to[k]));
                     if st.feed <= 0.0 {
                         return Err("feed move with no feed rate (F)".into());
                     }
                     let mut c = cut_base(st);
                     c.from = from;
                     c.to = to;
+                    c.partial = known(pos).is_none();
                     info.cuts.push(c);
                 }
                 *pos = t;
             }
             20 | 30 => {
-                if !axes {
-                    return Err("G2/G3 without axis words".into());
+                if !(axes || w.has('I') || w.has('J') || w.has('K')) {
+                    return Err(
+                        "G2/G3 with neither axis words nor I/J/K (LinuxCNC refuses it too)".into(),
+                    );
                 }
                 if st.feed <= 0.0 {
                     return Err("arc with no feed rate (F)".into());
@@ -629,7 +847,11 @@ fn step(
                     }
                     let r1 = (from[a] - center[a]).hypot(from[b] - center[b]);
                     let r2 = (to[a] - center[a]).hypot(to[b] - center[b]);
-                    if (r1 - r2).abs() > 0.002 * scale.max(1.0) && (r1 - r2).abs() > 1e-3 * r1 {
+                    // LinuxCNC's rule, measured with its `rs274` on arcs of radius 1 to 1000:
+                    // refused when the radii differ by more than 0.1 % of the start radius and
+                    // by more than 0.028 mm (G21) or 0.002 inch (G20)
+                    let abs_tol = if st.metric { 0.028 } else { 0.002 * 25.4 };
+                    if (r1 - r2).abs() > abs_tol && (r1 - r2).abs() > 1e-3 * r1 {
                         return Err(format!(
                             "arc radius to end point differs from radius to start point ({r1:.4} vs {r2:.4} mm)"
                         ));

@@ -9,6 +9,10 @@ pub struct Words {
     pub n: Option<f64>,
     /// True when the line held a comment.
     pub has_comment: bool,
+    /// True for a controller system line (GRBL `$X`, `$H`, `$$`…), carried through as is.
+    pub dialect: bool,
+    /// True for GRBL's homing cycle `$H` (the position is unknown afterwards).
+    pub homing: bool,
 }
 
 impl Words {
@@ -38,6 +42,41 @@ impl Words {
     }
 }
 
+/// The line with every whitespace character outside comments made an ASCII space (LinuxCNC
+/// refuses U+00A0, U+0085, U+2028, a carriage return inside a line … with "Bad character"), and
+/// an error for any other non-ASCII or control character outside comments. Comments (`( … )`,
+/// `;` to the end) are kept as they are: LinuxCNC accepts any character there.
+pub fn normalize(line: &str) -> Result<std::borrow::Cow<'_, str>, String> {
+    let odd = |c: char| !c.is_ascii() || (c.is_ascii_control() && c != '\t');
+    if !line.chars().any(odd) {
+        return Ok(std::borrow::Cow::Borrowed(line));
+    }
+    let mut out = String::with_capacity(line.len());
+    let mut depth = 0usize;
+    let mut rest_comment = false;
+    for c in line.chars() {
+        let in_comment = rest_comment || depth > 0 || c == ')';
+        match c {
+            '(' if !rest_comment => depth += 1,
+            ')' if depth > 0 => depth -= 1,
+            ';' if depth == 0 => rest_comment = true,
+            _ => {}
+        }
+        if in_comment || c == '(' || c == ';' || !odd(c) {
+            out.push(c);
+        } else if c.is_whitespace() {
+            out.push(' ');
+        } else {
+            return Err(format!(
+                "character {c:?} (U+{:04X}) outside a comment: controllers refuse it (\"Bad \
+                 character\"); remove it or put it in a comment",
+                c as u32
+            ));
+        }
+    }
+    Ok(std::borrow::Cow::Owned(out))
+}
+
 /// Tokenizes a line. Errors name the problem (the caller adds file and line).
 ///
 /// Handles `( … )` and `;` comments, `%` lines, spaces inside words, lower case. Refuses `#`
@@ -47,6 +86,19 @@ pub fn tokenize(line: &str) -> Result<Words, String> {
     let mut out = Words::default();
     let trimmed = line.trim();
     if trimmed == "%" || trimmed.is_empty() {
+        return Ok(out);
+    }
+    if let Some(rest) = trimmed.strip_prefix('$') {
+        let rest = rest.trim_start().to_ascii_uppercase();
+        if rest.starts_with('J') {
+            return Err(
+                "GRBL jog line '$J=' moves the machine in a way cellseq does not follow; \
+                        remove it or run it by hand"
+                    .into(),
+            );
+        }
+        out.dialect = true;
+        out.homing = rest.starts_with('H');
         return Ok(out);
     }
     // strip comments
@@ -128,5 +180,20 @@ mod tests {
         assert!(tokenize("o100 sub").is_err());
         assert!(tokenize("G1 X(").is_err());
         assert!(tokenize("G1 X").is_err());
+        assert!(tokenize("$H").unwrap().homing);
+        assert!(tokenize("$X").unwrap().dialect);
+        assert!(tokenize("$J=G91 X1 F100").is_err());
+    }
+
+    #[test]
+    fn unicode_whitespace_is_made_ascii_outside_comments() {
+        assert_eq!(
+            normalize("G1\u{a0}X1 (caf\u{e9}\u{a0})").unwrap(),
+            "G1 X1 (caf\u{e9}\u{a0})"
+        );
+        assert_eq!(normalize("G\r1 X\u{2028}2\u{85}").unwrap(), "G 1 X 2 ");
+        assert_eq!(normalize("G1 X1 ; \u{e9}").unwrap(), "G1 X1 ; \u{e9}");
+        assert!(normalize("G1 X\u{e9}1").is_err());
+        assert!(normalize("G1 X1\0").is_err());
     }
 }

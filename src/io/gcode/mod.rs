@@ -1,10 +1,13 @@
 //! G-code (RS-274: LinuxCNC, Fanuc-style, GRBL): read a program, split it into cells, build
-//! an [`Instance`], write the program back in a solved order, and verify equivalence.
+//! an [`Instance`], write the program back in a given order, and verify equivalence. This
+//! codec runs no solver: [`crate::pipeline::gcode`] does.
 //!
-//! Pipeline: [`lex`] tokenizes lines, [`interp`] executes them with full modal state and lists
-//! every cutting move, [`cells`] splits the program (header, tool blocks, cells, footer) and
-//! derives the default precedence, [`write`](mod@write) re-emits it, [`verify`] compares the cutting moves
-//! of two programs as multisets and measures air travel.
+//! [`lex`] tokenizes lines (whitespace made ASCII outside comments), [`interp`] executes them
+//! with full modal state (and which elements the program set at all) and lists every cutting
+//! move, [`cells`] splits the program (header, tool blocks, runs, cells, footer) and derives
+//! the default precedence, [`write`](mod@write) re-emits it with only the state changes the
+//! new order needs, [`verify`] compares two programs: cutting moves and events with their
+//! machine state, as multisets, and no new motion; and measures air travel, lifts and time.
 
 pub mod cells;
 pub mod interp;
@@ -15,8 +18,7 @@ pub mod write;
 
 use crate::error::{Error, Result};
 use crate::geom::Point3;
-use crate::model::{Cell, Instance, Machine, Metadata, Mode, Objective, StepKind, Tool, Visit};
-use crate::solvers::{self, Budget, NoObserver};
+use crate::model::{Cell, Instance, Machine, Metadata, Mode, StepKind, Tool, Visit};
 use cells::{Layout, Split};
 use interp::Program;
 pub use verify::Figures;
@@ -57,21 +59,23 @@ pub fn safe_height(p: &Parsed) -> Option<f64> {
     }
 }
 
-/// Groups of cells sequenced independently, in their fixed order: tool blocks, or (with
-/// `merge`) all cells of a tool, tools in first-use order.
-pub fn groups(l: &Layout, merge: bool) -> Vec<Vec<usize>> {
+/// Groups of cells sequenced independently, in their fixed order: the runs of a tool block
+/// (see [`cells::GCell::run`]), or (with `merge`) all cells of a tool within a run, tools in
+/// first-use order.
+pub fn groups(p: &Parsed, merge: bool) -> Vec<Vec<usize>> {
+    let l = &p.layout;
     let mut out: Vec<Vec<usize>> = Vec::new();
-    let mut keys: Vec<u64> = Vec::new();
+    let mut keys: std::collections::HashMap<(usize, usize, u32), usize> = Default::default();
     for (i, c) in l.cells.iter().enumerate() {
         let k = if merge {
-            ((l.blocks[c.block].epoch as u64) << 32) | c.tool as u64
+            (c.run, l.blocks[c.block].epoch, c.tool)
         } else {
-            c.block as u64
+            (c.run, c.block, 0)
         };
-        match keys.iter().position(|&x| x == k) {
-            Some(g) => out[g].push(i),
+        match keys.get(&k) {
+            Some(&g) => out[g].push(i),
             None => {
-                keys.push(k);
+                keys.insert(k, out.len());
                 out.push(vec![i]);
             }
         }
@@ -79,45 +83,16 @@ pub fn groups(l: &Layout, merge: bool) -> Vec<Vec<usize>> {
     out
 }
 
-/// Options of [`optimize`].
-#[derive(Debug, Clone)]
-pub struct Options {
-    /// Solver name from the registry.
-    pub solver: String,
-    /// Total time limit (s), shared among groups by size.
-    pub time_limit: Option<f64>,
-    /// Seed.
-    pub seed: u64,
-    /// Merge blocks of the same tool.
-    pub merge: bool,
-    /// XY margin (mm) added to footprints for the overlap rule.
-    pub margin: f64,
-    /// Allow cutting reversible cells backwards: `Some(true)` (`--reversible`), `Some(false)`
-    /// (`--no-reversible`), or `None`: on for 2-D programs (laser, plasma, plotter), off for
-    /// programs with Z (milling, where reversal swaps climb and conventional milling).
-    pub reversible: Option<bool>,
-}
-
-impl Default for Options {
-    fn default() -> Self {
-        Options {
-            solver: solvers::DEFAULT_SOLVER.to_string(),
-            time_limit: None,
-            seed: 1,
-            merge: false,
-            margin: 0.5,
-            reversible: None,
-        }
-    }
-}
+pub use crate::pipeline::gcode::{Optimized, Options, optimize};
 
 fn p3(a: [f64; 3]) -> Point3 {
     Point3::new(a[0], a[1], a[2])
 }
 
-/// Whether reversal is on for `p` given the option (`None`: on for 2-D programs only).
+/// Whether reversal is on for `p` given the option (`None`: on for 2-D programs without Z
+/// words only).
 pub fn reversal_on(p: &Parsed, reversible: Option<bool>) -> bool {
-    reversible.unwrap_or(p.layout.split == Split::Flat)
+    reversible.unwrap_or(p.layout.split == Split::Flat && !p.program.has_z)
 }
 
 /// The reversal plan of every layout cell (`None`: one-mode), when reversal is `on`. Cells
@@ -150,7 +125,7 @@ pub fn group_instance(
     plans: &[Option<reverse::Plan>],
 ) -> (Instance, bool) {
     let l = &p.layout;
-    let (precedence, dropped) = cells::precedence(l, cells, margin);
+    let (precedence, dropped) = with_leads(l, cells, margin);
     let mut clearance = match l.split {
         Split::Z { travel, .. } => travel,
         Split::Flat => 0.0,
@@ -215,10 +190,46 @@ pub fn group_instance(
     (inst, dropped)
 }
 
+/// [`cells::precedence`] plus the order the program's first settings impose: a leading cell
+/// (see [`cells::GCell::lead`]) before every other cell of the group, a trailing one after.
+/// When that contradicts inner-first, inner-first is dropped (reported like a contradiction
+/// with the overlap rule).
+fn with_leads(l: &Layout, cells: &[usize], margin: f64) -> (Vec<(usize, usize)>, bool) {
+    let (mut edges, mut dropped) = cells::precedence(l, cells, margin);
+    let mut extra = Vec::new();
+    for (i, &c) in cells.iter().enumerate() {
+        for j in 0..cells.len() {
+            if j != i && l.cells[c].lead {
+                extra.push((i, j));
+            }
+            if j != i && l.cells[c].trail {
+                extra.push((j, i));
+            }
+        }
+    }
+    if extra.is_empty() {
+        return (edges, dropped);
+    }
+    let mut all = edges.clone();
+    all.extend(&extra);
+    let dag = crate::precedence::Dag::new(cells.len(), &all);
+    if crate::precedence::topological_order(&dag).is_err() {
+        // keep every edge in program order (the overlap rule and the first settings agree)
+        edges = edges
+            .into_iter()
+            .map(|(a, b)| (a.min(b), a.max(b)))
+            .collect();
+        dropped = true;
+        all = edges;
+        all.extend(&extra);
+    }
+    (all, dropped)
+}
+
 /// The whole program as one instance (groups chained by precedence), for `cellseq import`;
 /// `reversible` as in [`Options::reversible`].
 pub fn import(p: &Parsed, merge: bool, margin: f64, reversible: Option<bool>) -> Result<Instance> {
-    let gs = groups(&p.layout, merge);
+    let gs = groups(p, merge);
     let all: Vec<usize> = gs.iter().flatten().copied().collect();
     let home = p.layout.start.unwrap_or(p.layout.cells[0].entry);
     let pl = plans(p, reversal_on(p, reversible));
@@ -254,133 +265,16 @@ pub fn import(p: &Parsed, merge: bool, margin: f64, reversible: Option<bool>) ->
     Ok(inst)
 }
 
-/// The result of [`optimize`].
-#[derive(Debug, Clone)]
-pub struct Optimized {
-    /// The new order (indices into the layout's cells).
-    pub order: Vec<usize>,
-    /// Parallel to `order`: true where the cell is cut backwards.
-    pub reversed: Vec<bool>,
-    /// Cells that could have been reversed (reversal on and the cell qualifies).
-    pub reversible_cells: usize,
-    /// The new program text.
-    pub text: String,
-    /// Figures of the original.
-    pub before: Figures,
-    /// Figures of the new program.
-    pub after: Figures,
-    /// Cutting moves compared.
-    pub cuts: usize,
-    /// Groups where the inner-first rule was dropped.
-    pub inner_first_dropped: usize,
-    /// Solver seconds.
-    pub solve_s: f64,
-    /// True when the solver's order was worse than the original order, which was kept.
-    pub kept_original: bool,
-}
-
 /// Tolerance (mm) of the cutting-move comparison.
 pub const TOLERANCE: f64 = 1e-3;
-
-/// Sequences the cells group by group with a registry solver, writes the program and
-/// verifies it against the original (an error if any cutting move differs).
-pub fn optimize(p: &Parsed, opts: &Options) -> Result<Optimized> {
-    let l = &p.layout;
-    let on = reversal_on(p, opts.reversible);
-    let pl = plans(p, on);
-    let gs = groups(l, opts.merge);
-    let total: usize = l.cells.len();
-    let mut order = Vec::with_capacity(total);
-    let mut rev: Vec<Option<reverse::Plan>> = Vec::with_capacity(total);
-    let mut home = l.start.unwrap_or(l.cells[0].entry);
-    let mut dropped = 0;
-    let mut solve_s = 0.0;
-    for g in &gs {
-        let (inst, d) = group_instance(p, g, home, opts.margin, &pl);
-        dropped += d as usize;
-        crate::validate::validate(&inst, &p.file)?;
-        let budget = Budget {
-            time_limit: opts
-                .time_limit
-                .map(|t| std::time::Duration::from_secs_f64(t * g.len() as f64 / total as f64)),
-            // without a time limit: an evaluation budget, so the output is deterministic
-            max_evals: opts
-                .time_limit
-                .is_none()
-                .then(|| (g.len() as u64 * 20_000).clamp(100_000, 10_000_000)),
-        };
-        let r = solvers::run(
-            &opts.solver,
-            &inst,
-            Objective::Air,
-            &Default::default(),
-            opts.seed,
-            budget,
-            &mut NoObserver,
-        )?;
-        solve_s += r.elapsed_s;
-        for v in &r.outcome.sequence {
-            order.push(g[v.cell]);
-            rev.push(if v.mode == 1 { pl[g[v.cell]] } else { None });
-        }
-        if let Some(v) = r.outcome.sequence.last() {
-            home = match rev.last().copied().flatten() {
-                Some(x) => x.exit,
-                None => l.cells[g[v.cell]].exit,
-            };
-        }
-    }
-    let mut text = write::write(&p.program, l, &order, &rev, opts.merge);
-    let mut check = verify_with(
-        &p.file,
-        &p.program,
-        "<optimized>",
-        &text,
-        safe_height(p),
-        on,
-    )?;
-    // never worse than the program's own order (regenerated the same way)
-    let given: Vec<usize> = gs.iter().flatten().copied().collect();
-    let mut kept_original = false;
-    if given != order {
-        let t2 = write::write(&p.program, l, &given, &[], opts.merge);
-        let c2 = verify_with(
-            &p.file,
-            &p.program,
-            "<optimized>",
-            &t2,
-            safe_height(p),
-            false,
-        )?;
-        if c2.after.air_length < check.after.air_length - 1e-9 {
-            text = t2;
-            check = c2;
-            order = given;
-            rev.clear();
-            kept_original = true;
-        }
-    }
-    let mut reversed: Vec<bool> = rev.iter().map(Option::is_some).collect();
-    reversed.resize(order.len(), false);
-    Ok(Optimized {
-        kept_original,
-        reversible_cells: pl.iter().filter(|x| x.is_some()).count(),
-        reversed,
-        order,
-        text,
-        before: check.before,
-        after: check.after,
-        cuts: check.cuts,
-        inner_first_dropped: dropped,
-        solve_s,
-    })
-}
 
 /// What [`verify_texts`] found.
 #[derive(Debug, Clone, Copy, Serialize)]
 pub struct Verification {
-    /// Cutting moves matched.
+    /// Cutting moves matched (each in the same machine state).
     pub cuts: usize,
+    /// Events matched (dwells, pauses, tool changes, …; each in the same machine state).
+    pub events: usize,
     /// Original figures.
     pub before: Figures,
     /// New figures.
@@ -389,35 +283,30 @@ pub struct Verification {
 
 use serde::Serialize;
 
-/// Interprets `new_text` and checks its cutting moves against the original's, in either
-/// direction (a move cut backwards, arc direction swapped around the same centre, counts as
-/// the same move): what `verify-gcode` does, since an optimized program may reverse cells.
-pub fn verify_texts(
-    orig_file: &str,
-    orig: &Program,
-    new_file: &str,
-    new_text: &str,
-    safe: Option<f64>,
-) -> Result<Verification> {
-    verify_with(orig_file, orig, new_file, new_text, safe, true)
+/// Interprets `new_text` and checks it against the original with [`verify::equivalent`]:
+/// cutting moves and events with their machine state, in either direction (a move cut
+/// backwards, arc direction swapped around the same centre, counts as the same move), and no
+/// new motion. What `verify-gcode` does, since an optimized program may reverse cells.
+pub fn verify_texts(orig: &Parsed, new_file: &str, new_text: &str) -> Result<Verification> {
+    verify_with(orig, new_file, new_text, true)
 }
 
 /// [`verify_texts`] with the direction rule chosen: `undirected` false demands every move in
 /// its original direction (what `optimize` checks when reversal is off).
 pub fn verify_with(
-    orig_file: &str,
-    orig: &Program,
+    orig: &Parsed,
     new_file: &str,
     new_text: &str,
-    safe: Option<f64>,
     undirected: bool,
 ) -> Result<Verification> {
     let np = interp::interpret(new_text).map_err(|(l, m)| Error::parse(new_file, l, m))?;
-    let cuts = verify::same_cuts(orig, &np, TOLERANCE, undirected)
-        .map_err(|m| Error::invalid(new_file, format!("not equivalent to {orig_file}: {m}")))?;
+    let eq = verify::equivalent(&orig.program, &np, TOLERANCE, undirected)
+        .map_err(|m| Error::invalid(new_file, format!("not equivalent to {}: {m}", orig.file)))?;
+    let safe = safe_height(orig);
     Ok(Verification {
-        cuts,
-        before: verify::figures(orig, safe),
+        cuts: eq.cuts,
+        events: eq.events,
+        before: verify::figures(&orig.program, safe),
         after: verify::figures(&np, safe),
     })
 }
@@ -430,5 +319,5 @@ pub fn verify_files(
     new_text: &str,
 ) -> Result<Verification> {
     let p = parse(orig_file, orig_text)?;
-    verify_texts(orig_file, &p.program, new_file, new_text, safe_height(&p))
+    verify_texts(&p, new_file, new_text)
 }

@@ -15,7 +15,7 @@
 //! F and S in force after the original feed moves are restored afterwards.
 
 use super::cells::{GCell, Split};
-use super::interp::{CutKind, Motion, Program, State, known, plane_axes};
+use super::interp::{CutKind, Motion, Program, State, el, known, plane_axes};
 use super::write::num;
 use std::fmt::Write as _;
 
@@ -41,6 +41,7 @@ fn masked(s: &State) -> State {
         feed: 0.0,
         speed: 0.0,
         motion: None,
+        set: 0,
         ..*s
     }
 }
@@ -73,6 +74,11 @@ pub fn plan(p: &Program, split: Split, c: &GCell) -> Result<Plan, &'static str> 
         .rev()
         .find(|&i| p.lines[i].motion == Motion::Feed)
         .ok_or("no feed moves")?;
+    if !p.lines[first].before.absolute {
+        // the reversed moves are written in absolute coordinates: the machine state at the
+        // cuts (distance mode) would differ from the original's
+        return Err("incremental distance mode (G91)");
+    }
     for i in (c.start..first).chain(last + 1..c.end) {
         let li = &p.lines[i];
         match li.motion {
@@ -143,7 +149,7 @@ pub fn plan(p: &Program, split: Split, c: &GCell) -> Result<Plan, &'static str> 
 }
 
 fn coord(st: &State, mm: f64) -> String {
-    num(mm / st.scale(), if st.metric { 6 } else { 7 })
+    num(mm / st.scale(), 10)
 }
 
 fn exact(v: f64) -> String {
@@ -162,7 +168,11 @@ pub fn write_reversed(p: &Program, has_z: bool, c: &GCell, plan: &Plan, out: &mu
             out.push('\n');
         }
     }
-    let _ = writeln!(out, "G{} G90 G91.1", st0.plane);
+    // the reversed moves are absolute with centre offsets in the arc mode in force; only a
+    // distance mode the program itself set to incremental is switched (and restored below)
+    if !st0.absolute {
+        out.push_str("G90\n");
+    }
     if has_z && (plan.entry[2] - plan.z).abs() > EPS {
         let _ = writeln!(out, "G0 Z{}", coord(&st0, plan.z));
     }
@@ -202,12 +212,12 @@ pub fn write_reversed(p: &Program, has_z: bool, c: &GCell, plan: &Plan, out: &mu
             {
                 let (a, b, _) = plane_axes(plane);
                 for ax in [a, b] {
-                    let _ = write!(
-                        s,
-                        " {}{}",
-                        ['I', 'J', 'K'][ax],
-                        coord(st, center[ax] - cut.to[ax])
-                    );
+                    let v = if st.arc_absolute {
+                        center[ax]
+                    } else {
+                        center[ax] - cut.to[ax]
+                    };
+                    let _ = write!(s, " {}{}", ['I', 'J', 'K'][ax], coord(st, v));
                 }
                 if turns > 1 {
                     let _ = write!(s, " P{turns}");
@@ -228,19 +238,20 @@ pub fn write_reversed(p: &Program, has_z: bool, c: &GCell, plan: &Plan, out: &mu
     if has_z && (plan.exit[2] - plan.z).abs() > EPS {
         let _ = writeln!(out, "G0 Z{}", coord(&st1, plan.exit[2]));
     }
-    let mut s = format!(
-        "G{} G{}",
-        if st1.absolute { 90 } else { 91 },
-        if st1.arc_absolute { "90.1" } else { "91.1" }
-    );
-    if feed != Some(st1.feed) && st1.feed > 0.0 {
+    let mut s = String::new();
+    if !st1.absolute {
+        s.push_str(" G91");
+    }
+    if feed != Some(st1.feed) && st1.set & el::FEED != 0 {
         let _ = write!(s, " F{}", exact(st1.feed));
     }
     if speed != st1.speed {
         let _ = write!(s, " S{}", exact(st1.speed));
     }
-    out.push_str(&s);
-    out.push('\n');
+    if !s.is_empty() {
+        out.push_str(s.trim_start());
+        out.push('\n');
+    }
     // non-motion lines after the feed moves, in order (the Z-only rapids became one move)
     for i in plan.last + 1..c.end {
         if p.lines[i].motion == Motion::None {

@@ -1,7 +1,7 @@
 //! Writing the program back in a new cell order.
 
-use super::cells::{Layout, Split, is_motion_g};
-use super::interp::{CutKind, Motion, Program, State};
+use super::cells::{Block, GCell, Layout, Split, entry_state, free_bits, is_boundary, is_motion_g};
+use super::interp::{CutKind, Motion, Program, State, el, known};
 use super::reverse::{Plan, write_reversed};
 use std::fmt::Write as _;
 
@@ -22,25 +22,10 @@ fn exact(v: f64) -> String {
     if s == "-0" { "0".into() } else { s }
 }
 
+/// A coordinate in the file's units, precise enough that a move the original makes from this
+/// point stays the same move (10 decimals: under 1e-9 mm off).
 fn units(st: &State, mm: f64) -> String {
-    num(mm / st.scale(), if st.metric { 4 } else { 6 })
-}
-
-/// Units, plane, offset, tool length compensation and absolute mode.
-fn part_a(st: &State) -> String {
-    let mut s = format!(
-        "G{} G{} G{} G90",
-        st.plane,
-        if st.metric { 21 } else { 20 },
-        offset_code(st.offset)
-    );
-    match st.tlc {
-        Some(h) => {
-            let _ = write!(s, " G43 H{}", exact(h));
-        }
-        None => s.push_str(" G49"),
-    }
-    s
+    num(mm / st.scale(), 10)
 }
 
 fn offset_code(o: u16) -> String {
@@ -51,34 +36,110 @@ fn offset_code(o: u16) -> String {
     }
 }
 
-/// Distance modes, path mode, retract mode, feed, speed, spindle, coolant.
-fn part_b(st: &State) -> String {
-    let mut s = format!(
-        "G{} G{} G{}",
-        if st.absolute { 90 } else { 91 },
-        if st.arc_absolute { "90.1" } else { "91.1" },
-        if st.retract_old_z { 98 } else { 99 }
-    );
-    if let Some((c, p, q)) = st.path {
-        let _ = write!(s, " G{}", offset_code(c));
+/// The lines that take the machine from state `cur` to state `target`: only the elements the
+/// program itself set in `target` and that differ. An element set in `cur` but never set by the
+/// program in `target` cannot be handed back to the operator: that is an error (the grouping
+/// of cells into runs never asks for it), unless it is in `free`: the cell sets it itself
+/// before it cuts ([`free_bits`](super::cells::free_bits)).
+pub fn transition(cur: &State, target: &State, free: u32) -> Result<Vec<String>, String> {
+    let missing = cur.set & !target.set & !free;
+    if missing != 0 {
+        let names: Vec<&str> = (0..16)
+            .filter(|b| missing & (1 << b) != 0)
+            .map(|b| el::NAMES[b])
+            .collect();
+        return Err(format!(
+            "a cell would run with {} set although the original leaves it to the operator there",
+            names.join(", ")
+        ));
+    }
+    let want = |bit: u32, same: bool| target.set & bit != 0 && (cur.set & bit == 0 || !same);
+    if want(el::TOOL, cur.tool == target.tool) && cur.set & el::TOOL != 0 {
+        return Err(format!(
+            "a cell of tool {} would run with tool {}",
+            target.tool, cur.tool
+        ));
+    }
+    if want(el::CUTTER, cur.cutter_comp == target.cutter_comp) && target.cutter_comp {
+        return Err("a cell would need cutter compensation turned on between cells".into());
+    }
+    let mut g: Vec<String> = Vec::new();
+    if want(el::UNITS, cur.metric == target.metric) {
+        g.push(if target.metric { "G21" } else { "G20" }.into());
+    }
+    if want(el::PLANE, cur.plane == target.plane) {
+        g.push(format!("G{}", target.plane));
+    }
+    if want(el::DIST, cur.absolute == target.absolute) {
+        g.push(if target.absolute { "G90" } else { "G91" }.into());
+    }
+    if want(el::ARC_DIST, cur.arc_absolute == target.arc_absolute) {
+        g.push(
+            if target.arc_absolute {
+                "G90.1"
+            } else {
+                "G91.1"
+            }
+            .into(),
+        );
+    }
+    if want(el::OFFSET, cur.offset == target.offset) {
+        g.push(format!("G{}", offset_code(target.offset)));
+    }
+    if want(el::CUTTER, cur.cutter_comp == target.cutter_comp) {
+        g.push("G40".into());
+    }
+    if want(el::RETRACT, cur.retract_old_z == target.retract_old_z) {
+        g.push(if target.retract_old_z { "G98" } else { "G99" }.into());
+    }
+    if want(el::FEED_MODE, cur.feed_mode == target.feed_mode) {
+        g.push("G94".into());
+    }
+    if want(el::TLC, cur.tlc == target.tlc) {
+        g.push(match target.tlc {
+            Some(h) => format!("G43 H{}", exact(h)),
+            None => "G49".into(),
+        });
+    }
+    if want(el::PATH, cur.path == target.path)
+        && let Some((c, p, q)) = target.path
+    {
+        let mut w = format!("G{}", offset_code(c));
         if let Some(p) = p {
-            let _ = write!(s, " P{}", exact(p));
+            let _ = write!(w, " P{}", exact(p));
         }
         if let Some(q) = q {
-            let _ = write!(s, " Q{}", exact(q));
+            let _ = write!(w, " Q{}", exact(q));
         }
+        g.push(w);
     }
-    if st.feed > 0.0 {
-        let _ = write!(s, " F{}", exact(st.feed));
+    if want(el::FEED, cur.feed == target.feed) {
+        g.push(format!("F{}", exact(target.feed)));
     }
-    let _ = write!(s, " S{} M{}", exact(st.speed), st.spindle);
-    match (st.mist, st.flood) {
-        (false, false) => s.push_str(" M9"),
-        (true, false) => s.push_str(" M7"),
-        (false, true) => s.push_str(" M8"),
-        (true, true) => s.push_str("\nM7 M8"),
+    if want(el::SPEED, cur.speed == target.speed) {
+        g.push(format!("S{}", exact(target.speed)));
     }
-    s
+    let mut lines = Vec::new();
+    if !g.is_empty() {
+        lines.push(g.join(" "));
+    }
+    if want(el::SPINDLE, cur.spindle == target.spindle) {
+        lines.push(format!("M{}", target.spindle));
+    }
+    // coolant: only what the target has set (an element left to the cell itself stays)
+    let (tm, tf) = (target.set & el::MIST != 0, target.set & el::FLOOD != 0);
+    let (mut mist, mut flood) = (cur.mist, cur.flood);
+    if (tm && mist && !target.mist) || (tf && flood && !target.flood) {
+        lines.push("M9".into());
+        (mist, flood) = (false, false);
+    }
+    if tm && target.mist && !mist {
+        lines.push("M7".into());
+    }
+    if tf && target.flood && !flood {
+        lines.push("M8".into());
+    }
+    Ok(lines)
 }
 
 fn motion_code(m: u16) -> String {
@@ -123,8 +184,283 @@ fn gap_line(p: &Program, i: usize, out: &mut String) {
     }
 }
 
+struct Writer<'a> {
+    p: &'a Program,
+    out: String,
+    /// The output's machine state.
+    cur: State,
+    /// The output's position (mm), when known.
+    pos: Option<[f64; 3]>,
+    /// The output's motion mode (×10, as in [`State::motion`]); `Some(u16::MAX)` when unknown.
+    motion: Option<u16>,
+}
+
+impl Writer<'_> {
+    fn line(&mut self, s: &str) {
+        self.out.push_str(s);
+        self.out.push('\n');
+    }
+
+    /// Lines `[s, e)` of the original, unchanged.
+    fn verbatim(&mut self, s: usize, e: usize) {
+        for i in s..e {
+            self.out.push_str(&self.p.text[i]);
+            self.out.push('\n');
+            if self.p.lines[i].motion != Motion::None {
+                self.pos = known(&self.p.lines[i].pos_after);
+            }
+            if self.p.lines[i].explicit_motion {
+                self.motion = self.p.lines[i].after.motion;
+            }
+        }
+        if e > s {
+            self.cur = self.p.lines[e - 1].after;
+        }
+    }
+
+    /// A gap line: as written when it does not move, else its other words only.
+    fn gap(&mut self, g: usize) {
+        gap_line(self.p, g, &mut self.out);
+        let li = &self.p.lines[g];
+        if li.motion == Motion::None && li.explicit_motion {
+            self.motion = li.after.motion;
+        }
+    }
+
+    fn reach(&mut self, target: &State, free: u32) -> Result<(), String> {
+        for l in transition(&self.cur, target, free)? {
+            self.line(&l);
+        }
+        let (motion, cycle, selected) = (self.cur.motion, self.cur.cycle, self.cur.selected);
+        self.cur = State {
+            motion,
+            cycle,
+            selected,
+            ..*target
+        };
+        Ok(())
+    }
+
+    /// Retract to `clear`, rapid over, plunge to `entry` (rapids only, in the state in force).
+    fn link(&mut self, entry: [f64; 3], clear: Option<f64>, cycle: bool) {
+        let st = self.cur;
+        let mut lines: Vec<String> = Vec::new();
+        let mut pos = self.pos;
+        let mut zpos = pos.map(|q| q[2]);
+        if let Some(h) = clear {
+            let top = if cycle { h } else { h.max(entry[2]) };
+            if zpos.is_none_or(|z| z < top - 1e-9) {
+                lines.push(format!("G0 Z{}", units(&st, top)));
+                pos = pos.map(|q| [q[0], q[1], top]);
+                zpos = Some(top);
+            }
+        }
+        if cycle {
+            // the canned cycle moves over the hole itself, at the height it starts from
+        } else {
+            let z = zpos.unwrap_or(entry[2]);
+            if pos.is_none_or(|q| (q[0] - entry[0]).abs() > 1e-9 || (q[1] - entry[1]).abs() > 1e-9)
+            {
+                lines.push(format!(
+                    "G0 X{} Y{}",
+                    units(&st, entry[0]),
+                    units(&st, entry[1])
+                ));
+            }
+            if clear.is_some() && (z - entry[2]).abs() > 1e-9 {
+                lines.push(format!("G0 Z{}", units(&st, entry[2])));
+            }
+            pos = Some(entry);
+        }
+        if lines.is_empty() {
+            return;
+        }
+        let incremental = !st.absolute;
+        if incremental {
+            self.line("G90");
+        }
+        for l in &lines {
+            self.line(l);
+        }
+        if incremental {
+            self.line("G91");
+        }
+        self.pos = pos;
+        self.motion = Some(0);
+    }
+
+    /// The block's preamble when the output enters the block at another cell than its first:
+    /// the lines up to its last boundary as written, then its other words without their motion.
+    fn preamble(&mut self, b: &Block, first_start: usize) {
+        let p = self.p;
+        let last = b
+            .preamble
+            .iter()
+            .rev()
+            .find(|&&g| is_boundary(p, g))
+            .copied()
+            .unwrap_or(0);
+        for &g in &b.preamble {
+            if g <= last {
+                self.verbatim(g, g + 1);
+            } else {
+                self.gap(g);
+            }
+        }
+        self.cur = p.lines[first_start].before;
+    }
+}
+
 /// Writes the program with cells in `order` (indices into `layout.cells`); `rev[k]` holds the
 /// reversal plan when `order[k]` is cut backwards (or is empty: nothing reversed).
+///
+/// The header and footer are copied as they are. Two cells that follow each other in the
+/// original keep the lines between them as written. Elsewhere a cell gets: the modal words
+/// that take the machine from the state the previous output cell leaves to the state the
+/// original has at the start of this cell's gap ([`transition`]: only what the program set and
+/// what the new order changed), a link of rapids (retract to the block's own clearance, over,
+/// down to the cell's entry), the gap's non-motion words, and the cell as written.
+pub fn write_checked(
+    p: &Program,
+    l: &Layout,
+    order: &[usize],
+    rev: &[Option<Plan>],
+    merge: bool,
+) -> Result<String, String> {
+    let mut w = Writer {
+        p,
+        out: String::with_capacity(
+            p.text.iter().map(|t| t.len() + 1).sum::<usize>() + order.len() * 40,
+        ),
+        cur: p.lines[l.header_end].before,
+        pos: known(&p.lines[l.header_end].pos_before),
+        motion: p.lines[l.header_end].before.motion,
+    };
+    for t in &p.text[..l.header_end] {
+        w.out.push_str(t);
+        w.out.push('\n');
+    }
+    let z = matches!(l.split, Split::Z { .. });
+    let mut block = l.cells[0].block;
+    let mut prev: Option<(usize, bool)> = None;
+    for (k, &ci) in order.iter().enumerate() {
+        let c = &l.cells[ci];
+        let plan = rev.get(k).copied().flatten();
+        let entry = plan.map(|pl| pl.entry).unwrap_or(c.entry);
+        let adjacent = plan.is_none()
+            && match prev {
+                None => ci == 0,
+                Some((pc, r)) => !r && pc + 1 == ci,
+            };
+        if adjacent {
+            let from = prev.map_or(l.header_end, |(pc, _)| l.cells[pc].end);
+            w.verbatim(from, c.start);
+        } else {
+            let enter = c.block != block
+                && (!merge
+                    || c.tool != l.blocks[block].tool
+                    || l.blocks[c.block].epoch != l.blocks[block].epoch);
+            let b = &l.blocks[c.block];
+            let first = l
+                .cells
+                .iter()
+                .position(|x| x.block == c.block)
+                .unwrap_or(ci);
+            if enter && first == ci && plan.is_none() {
+                // the block's own approach to its first cell, as written
+                w.reach(&p.lines[b.gap_start].before, 0)?;
+                w.verbatim(b.gap_start, c.start);
+            } else {
+                if enter {
+                    w.reach(&p.lines[b.gap_start].before, 0)?;
+                    w.preamble(b, l.cells[first].start);
+                }
+                if c.pinned {
+                    return Err(format!(
+                        "line {}: a cut that starts where G28/G30/G53 left the tool cannot move",
+                        p.lines[c.start].line
+                    ));
+                }
+                w.reach(&entry_state(p, c), free_bits(p, c))?;
+                // the gap's words first (as in the original, the approach then runs in the
+                // cell's own state: length offset, units, offset), then the link
+                for &g in &c.prefix {
+                    w.gap(g);
+                }
+                w.cur = p.lines[c.start].before;
+                let clear = if z {
+                    Some(l.clearance[c.block].max(l.clearance[block]))
+                } else {
+                    // a 2-D split of a program with Z (cuts at the travel height): the link
+                    // goes over at the higher of here and the entry, then to the entry's Z
+                    p.has_z.then_some(f64::NEG_INFINITY)
+                };
+                if c.cycle {
+                    // a canned cycle moves over its hole by itself, at the height it starts
+                    // from: at least the height the original started it from
+                    let h = p.lines[c.start].pos_before[2].unwrap_or(entry[2]);
+                    w.link(entry, z.then_some(h), true);
+                } else {
+                    w.link(entry, clear, false);
+                }
+            }
+        }
+        block = c.block;
+        let before = &p.lines[c.start].before;
+        let motion_ok = w.motion == before.motion && w.cur.cycle == before.cycle;
+        if c.cycle && !motion_ok {
+            cycle_line(p, c, &mut w.out);
+            w.pos = known(&p.lines[c.start].pos_after);
+            w.motion = None;
+        } else if c.cycle {
+            w.verbatim(c.start, c.end);
+        } else {
+            match plan {
+                Some(pl) => {
+                    write_reversed(p, z, c, &pl, &mut w.out);
+                    w.motion = Some(u16::MAX);
+                }
+                None => {
+                    body(p, c.start, c.end, !motion_ok, &mut w.out);
+                    w.motion = p.lines[c.end - 1].after.motion;
+                }
+            }
+            w.pos = Some(plan.map(|pl| pl.exit).unwrap_or(c.exit));
+        }
+        w.cur = p.lines[c.end - 1].after;
+        prev = Some((ci, plan.is_some()));
+    }
+    let n = p.lines.len();
+    if l.footer_start < n {
+        let last = l.cells.len() - 1;
+        if prev != Some((last, false)) {
+            // the footer runs with the tool (and its length offset) the last cell left: with
+            // merged tool blocks that is not always the original's last tool
+            let mut target = p.lines[l.footer_start].before;
+            target.tool = w.cur.tool;
+            target.tlc = w.cur.tlc;
+            target.set = (target.set & !(el::TOOL | el::TLC)) | (w.cur.set & (el::TOOL | el::TLC));
+            w.reach(&target, 0)?;
+            if z {
+                let h = l.clearance[block];
+                if w.pos.is_none_or(|q| q[2] < h - 1e-9) {
+                    let s = format!("G0 Z{}", units(&w.cur, h));
+                    if w.cur.absolute {
+                        w.line(&s);
+                    } else {
+                        w.line(&format!("G90 {s}"));
+                        w.line("G91");
+                    }
+                }
+            }
+        }
+        w.verbatim(l.footer_start, n);
+    }
+    Ok(w.out)
+}
+
+/// [`write_checked`] for callers that need text: where the order cannot be written (it would
+/// hand a modal element back to the operator, see [`transition`]), the program as it is.
 pub fn write(
     p: &Program,
     l: &Layout,
@@ -132,148 +468,58 @@ pub fn write(
     rev: &[Option<Plan>],
     merge: bool,
 ) -> String {
-    let mut out =
-        String::with_capacity(p.text.iter().map(|t| t.len() + 1).sum::<usize>() + order.len() * 80);
-    for t in &p.text[..l.header_end] {
-        out.push_str(t);
-        out.push('\n');
-    }
-    let travel = match l.split {
-        Split::Z { travel, .. } => Some(travel),
-        Split::Flat => None,
-    };
-    let mut block = l
-        .cells
-        .get(order.first().copied().unwrap_or(0))
-        .map(|c| c.block)
-        .unwrap_or(0);
-    for (k, &ci) in order.iter().enumerate() {
-        let c = &l.cells[ci];
-        let plan = rev.get(k).copied().flatten();
-        let entry = plan.map(|pl| pl.entry).unwrap_or(c.entry);
-        let st = &c.state;
-        if c.block != block
-            && (!merge
-                || c.tool != l.blocks[block].tool
-                || l.blocks[c.block].epoch != l.blocks[block].epoch)
-        {
-            // entering another tool block: retract, then the original tool-change lines
-            let b = &l.blocks[c.block];
-            let gst = &p.lines[b.gap_start.min(p.lines.len() - 1)].before;
-            out.push_str(&part_a(gst));
-            out.push('\n');
-            if let Some(h) = travel {
-                let _ = writeln!(out, "G0 Z{}", units(gst, h));
-            }
-            out.push_str(&part_b(gst));
-            out.push('\n');
-            let last_change = b
-                .preamble
-                .iter()
-                .rev()
-                .find(|&&g| p.lines[g].tool_change || p.lines[g].setup)
-                .copied()
-                .unwrap_or(0);
-            for &g in &b.preamble {
-                if g <= last_change {
-                    out.push_str(&p.text[g]);
-                    out.push('\n');
-                } else {
-                    gap_line(p, g, &mut out);
-                }
-            }
-        }
-        block = c.block;
-        let _ = writeln!(
-            out,
-            "(cellseq: cell {} from line {}{})",
-            ci + 1,
-            p.lines[c.start].line,
-            if plan.is_some() { ", reversed" } else { "" }
-        );
-        out.push_str(&part_a(st));
-        out.push('\n');
-        let (x, y) = (units(st, entry[0]), units(st, entry[1]));
-        match travel {
-            Some(h) => {
-                let top = h.max(entry[2]);
-                let _ = writeln!(out, "G0 Z{}", units(st, top));
-                let _ = writeln!(out, "G0 X{x} Y{y}");
-                if !c.cycle && (top - entry[2]).abs() > 1e-9 {
-                    let _ = writeln!(out, "G0 Z{}", units(st, entry[2]));
-                }
-            }
-            None => {
-                let _ = writeln!(out, "G0 X{x} Y{y}");
-            }
-        }
-        for &g in &c.prefix {
-            gap_line(p, g, &mut out);
-        }
-        out.push_str(&part_b(st));
-        out.push('\n');
-        if c.cycle {
-            let li = &p.lines[c.start];
-            let cut = li.cuts[0];
-            if let CutKind::Cycle { code, l: reps, .. } = cut.kind {
-                let s = li.after.scale();
-                let mut line = format!(
-                    "G{} X{} Y{} Z{} R{}",
-                    motion_code(code),
-                    num(cut.to[0] / s, 9),
-                    num(cut.to[1] / s, 9),
-                    exact(li.after.cycle[1].unwrap_or(0.0)),
-                    exact(li.after.cycle[0].unwrap_or(0.0)),
-                );
-                if let Some(pv) = li.after.cycle[2] {
-                    let _ = write!(line, " P{}", exact(pv));
-                }
-                if let Some(q) = li.after.cycle[3] {
-                    let _ = write!(line, " Q{}", exact(q));
-                }
-                if reps > 1 {
-                    let _ = write!(line, " L{reps}");
-                }
-                for &(ch, v) in &li.words.words {
-                    if !matches!(ch, 'G' | 'X' | 'Y' | 'Z' | 'R' | 'P' | 'Q' | 'L') {
-                        let _ = write!(line, " {ch}{}", exact(v));
-                    }
-                }
-                out.push_str(&line);
-                out.push('\n');
-            }
-            out.push_str("G80\n");
-            continue;
-        }
-        match plan {
-            Some(pl) => write_reversed(p, travel.is_some(), c, &pl, &mut out),
-            None => body(p, c.start, c.end, &mut out),
-        }
-    }
-    if l.footer_start < p.lines.len() {
-        let fst = &p.lines[l.footer_start].before;
-        out.push_str(&part_a(fst));
-        out.push('\n');
-        if let Some(h) = travel {
-            let _ = writeln!(out, "G0 Z{}", units(fst, h));
-        }
-        out.push_str(&part_b(fst));
-        out.push('\n');
-        body(p, l.footer_start, p.lines.len(), &mut out);
-    }
-    out
+    write_checked(p, l, order, rev, merge).unwrap_or_else(|_| {
+        let identity: Vec<usize> = (0..l.cells.len()).collect();
+        write_checked(p, l, &identity, &[], false).unwrap_or_else(|_| p.text.join("\n") + "\n")
+    })
 }
 
-/// Copies lines `[s, e)`, giving the first motion line its modal motion code explicitly
-/// (the regenerated rapids before it changed the motion mode to G0).
-fn body(p: &Program, s: usize, e: usize, out: &mut String) {
-    let mut fixed = false;
+/// A canned-cycle hole written with every word it uses, then G80.
+fn cycle_line(p: &Program, c: &GCell, out: &mut String) {
+    let li = &p.lines[c.start];
+    let cut = li.cuts[0];
+    if let CutKind::Cycle { code, l: reps, .. } = cut.kind {
+        let s = li.after.scale();
+        let mut line = format!(
+            "G{} X{} Y{} Z{} R{}",
+            motion_code(code),
+            num(cut.to[0] / s, 9),
+            num(cut.to[1] / s, 9),
+            exact(li.after.cycle[1].unwrap_or(0.0)),
+            exact(li.after.cycle[0].unwrap_or(0.0)),
+        );
+        if let Some(pv) = li.after.cycle[2] {
+            let _ = write!(line, " P{}", exact(pv));
+        }
+        if let Some(q) = li.after.cycle[3] {
+            let _ = write!(line, " Q{}", exact(q));
+        }
+        if reps > 1 {
+            let _ = write!(line, " L{reps}");
+        }
+        for &(ch, v) in &li.words.words {
+            let motion = ch == 'G' && is_motion_g(v);
+            if !motion && !matches!(ch, 'X' | 'Y' | 'Z' | 'R' | 'P' | 'Q' | 'L') {
+                let _ = write!(line, " {ch}{}", exact(v));
+            }
+        }
+        out.push_str(&line);
+        out.push('\n');
+    }
+    out.push_str("G80\n");
+}
+
+/// Copies lines `[s, e)`; with `fix`, the first motion line gets its modal motion code
+/// explicitly (a link before it changed the motion mode).
+fn body(p: &Program, s: usize, e: usize, fix: bool, out: &mut String) {
+    let mut fixed = !fix;
     for i in s..e {
         let li = &p.lines[i];
         if !fixed && li.motion != Motion::None {
             fixed = true;
-            let mode = li.before.motion.unwrap_or(0);
-            if !li.explicit_motion && mode != 0 {
+            if !li.explicit_motion
+                && let Some(mode) = li.before.motion
+            {
                 let _ = writeln!(out, "G{} {}", motion_code(mode), strip_n(&p.text[i]));
                 continue;
             }
