@@ -40,7 +40,7 @@ fn offset_code(o: u16) -> String {
 /// program itself set in `target` and that differ. An element set in `cur` but never set by the
 /// program in `target` cannot be handed back to the operator: that is an error (the grouping
 /// of cells into runs never asks for it), unless it is in `free`: the cell sets it itself
-/// before it cuts ([`free_bits`](super::cells::free_bits)).
+/// before it cuts ([`free_bits`]).
 pub fn transition(cur: &State, target: &State, free: u32) -> Result<Vec<String>, String> {
     let missing = cur.set & !target.set & !free;
     if missing != 0 {
