@@ -70,6 +70,7 @@ const SOLVERS: &[&str] = &[
     "beam",
     "reopt",
     "two-opt",
+    "drawing",
     "local-search",
     "sa",
     "tabu",

@@ -199,8 +199,15 @@ fn deep_nesting_huge_shapes_and_point_caps_are_bounded() {
         .unwrap_err()
         .to_string();
     assert!(e.starts_with("c.svg:2:") && e.contains("size"), "{e}");
-    // a circle of radius 1e9 is flattened with a tolerance relative to its size, and verifies
+    // a circle of radius 1e9 reaches past the coordinate limit of validation: a clean refusal
     let t = svg_with("<circle r=\"1e9\" stroke=\"black\"/>");
+    let d = svg::read("c.svg", &t, ReadOptions::default()).unwrap();
+    let e = pipe::optimize(&d, &Options::default())
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("beyond"), "{e}");
+    // a circle of radius 1e8 is flattened with a tolerance relative to its size, and verifies
+    let t = svg_with("<circle r=\"1e8\" stroke=\"black\"/>");
     let d = svg::read("c.svg", &t, ReadOptions::default()).unwrap();
     let n = d.strokes[0].points.len();
     assert!((100..20_000).contains(&n), "{n} points");

@@ -207,17 +207,25 @@ pub fn optimize_within(p: &Parsed, opts: &Options, allowance: &Allowance) -> Res
         match written {
             Ok(text) => {
                 let t = Instant::now();
-                let check = verify_with(p, "<optimized>", &text, on)?;
+                let verified = verify_with(p, "<optimized>", &text, on);
                 timings.verify_s += t.elapsed().as_secs_f64();
-                // never worse than the input on air, lifts and time, each one
-                if check.after.not_worse_than(&check.before) || order == given {
-                    result = Some((text, check));
-                    break;
+                match verified {
+                    // never worse than the input on air, lifts and time, each one
+                    Ok(check) if check.after.not_worse_than(&check.before) || order == given => {
+                        result = Some((text, check));
+                        break;
+                    }
+                    Ok(check) => {
+                        note.get_or_insert(format!(
+                            "the new order was worse on {}",
+                            worse_on(&check.after, &check.before)
+                        ));
+                    }
+                    // when in doubt, keep the original: a failed check reverts groups too
+                    Err(e) => {
+                        note.get_or_insert(format!("the new order failed the built-in check: {e}"));
+                    }
                 }
-                note.get_or_insert(format!(
-                    "the new order was worse on {}",
-                    worse_on(&check.after, &check.before)
-                ));
             }
             Err(m) => {
                 note.get_or_insert(m);

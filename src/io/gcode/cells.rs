@@ -152,11 +152,11 @@ pub fn split(p: &Program) -> Result<Layout, (usize, String)> {
                     if li.motion == Motion::Home {
                         return Err((
                             li.line,
-                            "G28/G30/G53 move while cutting (below the safe height)".into(),
+                            "G28/G30/G53 move while cutting (below the safe height); retract above the safe height before it and try again".into(),
                         ));
                     }
                     if li.tool_change {
-                        return Err((li.line, "tool change while below the safe height".into()));
+                        return Err((li.line, "tool change while below the safe height; retract above the safe height before the tool change and try again".into()));
                     }
                     if li.motion != Motion::None && zafter.is_some_and(|z| z >= safe - EPS) {
                         ranges.push((s, i + 1, false));
@@ -214,7 +214,7 @@ pub fn split(p: &Program) -> Result<Layout, (usize, String)> {
     let footer_start = ranges[ranges.len() - 1].1;
     for li in &p.lines[header_end..footer_start] {
         if li.end {
-            return Err((li.line, "program end (M2/M30) before the last cut".into()));
+            return Err((li.line, "program end (M2/M30) before the last cut; move M2/M30 to the end of the program or remove the cuts after it".into()));
         }
     }
     let mut cells = Vec::with_capacity(ranges.len());
@@ -264,7 +264,7 @@ pub fn split(p: &Program) -> Result<Layout, (usize, String)> {
         if st.cutter_comp {
             return Err((
                 first.line,
-                "cutter radius compensation (G41/G42) active at the start of a cut".into(),
+                "cutter radius compensation (G41/G42) active at the start of a cut: cells cannot be reordered under it; turn it off (G40) before each retract, or use tool-centre paths instead".into(),
             ));
         }
         let pinned = known(&first.pos_before).is_none();

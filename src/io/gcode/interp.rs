@@ -513,7 +513,7 @@ fn step(
                 | 'D'
         ) {
             return Err(format!(
-                "word '{c}' is not supported (axes A/B/C/U/V/W, E are refused)"
+                "word '{c}' is not supported (axes A/B/C/U/V/W, E are refused); remove it or use a 3-axis program"
             ));
         }
     }
@@ -560,9 +560,13 @@ fn step(
             | 580 | 590 | 591 | 592 | 593 | 610 | 611 | 640 | 900 | 910 | 901 | 911 | 940 | 980
             | 990 => {}
             930 | 950 => {
-                return Err("inverse-time / per-revolution feed (G93/G95) is not supported".into());
+                return Err("inverse-time / per-revolution feed (G93/G95) is not supported; use units-per-minute feed (G94) instead".into());
             }
-            _ => return Err(format!("G{g} is not supported")),
+            _ => {
+                return Err(format!(
+                    "G{g} is not supported; remove it or replace it with plain moves and try again"
+                ));
+            }
         }
     }
     // feed, speed, tool
@@ -588,7 +592,9 @@ fn step(
     for m in w.all('M') {
         let code = m.round() as i64;
         if !close(code as f64, m) {
-            return Err(format!("M{m} is not supported"));
+            return Err(format!(
+                "M{m} is not supported; remove it or replace it with a standard M code and try again"
+            ));
         }
         match code {
             6 => {
@@ -621,7 +627,11 @@ fn step(
             0 | 1 | 60 => info.pause = true,
             2 | 30 => info.end = true,
             48..=53 | 62..=68 | 100..=199 => info.user_m = true,
-            _ => return Err(format!("M{code} is not supported")),
+            _ => {
+                return Err(format!(
+                    "M{code} is not supported; remove it or replace it with a standard M code and try again"
+                ));
+            }
         }
     }
     // modal G codes in execution order
@@ -790,7 +800,7 @@ fn step(
                     // left it: the move is kept in place and compared with that axis unknown
                     let from = [0, 1, 2].map(|k| pos[k].unwrap_or(to[k]));
                     if st.feed <= 0.0 {
-                        return Err("feed move with no feed rate (F)".into());
+                        return Err("feed move with no feed rate (F); add an F word before the first feed move and try again (LinuxCNC refuses it too)".into());
                     }
                     let mut c = cut_base(st);
                     c.from = from;
@@ -803,11 +813,11 @@ fn step(
             20 | 30 => {
                 if !(axes || w.has('I') || w.has('J') || w.has('K')) {
                     return Err(
-                        "G2/G3 with neither axis words nor I/J/K (LinuxCNC refuses it too)".into(),
+                        "G2/G3 with neither axis words nor I/J/K (LinuxCNC refuses it too); remove the line or give the arc its end point and centre".into(),
                     );
                 }
                 if st.feed <= 0.0 {
-                    return Err("arc with no feed rate (F)".into());
+                    return Err("arc with no feed rate (F); add an F word before the first feed move and try again (LinuxCNC refuses it too)".into());
                 }
                 let from = known(pos).ok_or("arc from an unknown position (after G28/G53)")?;
                 let t = target(pos, st.absolute)?;
@@ -853,7 +863,8 @@ fn step(
                     let abs_tol = if st.metric { 0.028 } else { 0.002 * 25.4 };
                     if (r1 - r2).abs() > abs_tol && (r1 - r2).abs() > 1e-3 * r1 {
                         return Err(format!(
-                            "arc radius to end point differs from radius to start point ({r1:.4} vs {r2:.4} mm)"
+                            "arc radius to end point differs from radius to start point ({r1:.4} vs {r2:.4} mm; \
+                             LinuxCNC refuses it too): correct the arc's end point or centre and try again"
                         ));
                     }
                 }
@@ -897,7 +908,7 @@ fn step(
                 let r = st.cycle[0].ok_or("canned cycle without R")? * scale;
                 let z = st.cycle[1].ok_or("canned cycle without Z")? * scale;
                 if st.feed <= 0.0 {
-                    return Err("canned cycle with no feed rate (F)".into());
+                    return Err("canned cycle with no feed rate (F); add an F word before the first feed move and try again (LinuxCNC refuses it too)".into());
                 }
                 let l = match w.get('L') {
                     Some(l) if l >= 1.0 && close(l, l.round()) => l as u32,

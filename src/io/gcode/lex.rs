@@ -133,8 +133,8 @@ pub fn tokenize(line: &str) -> Result<Words, String> {
         match c {
             '#' => return Err("'#' parameters are not supported (expand them first)".into()),
             '[' | ']' => return Err("expressions '[...]' are not supported".into()),
-            'O' => return Err("O-words (subroutines, program numbers) are not supported".into()),
-            '/' => return Err("block delete '/' is not supported".into()),
+            'O' => return Err("O-words (subroutines, program numbers) are not supported (expand them first)".into()),
+            '/' => return Err("block delete '/' is not supported; remove the '/' lines or the '/' marks and try again".into()),
             'A'..='Z' => {}
             _ => return Err(format!("unexpected character '{}'", chars[i])),
         }
