@@ -10,7 +10,9 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 fn git(dir: &Path, args: &[&str]) -> Option<String> {
+    // --no-optional-locks: `git status` must not refresh the index, which is watched below
     let out = Command::new("git")
+        .arg("--no-optional-locks")
         .arg("-C")
         .arg(dir)
         .args(args)
@@ -48,13 +50,20 @@ fn main() {
                 println!("cargo:rerun-if-changed={}", root.join(p).display());
             }
         }
+        // Only the ref HEAD points at: watching all of `refs/` would rebuild this worktree
+        // whenever any other branch or worktree of the repository commits.
         if let Some(common) = git(&root, &["rev-parse", "--git-common-dir"]) {
             let common = root.join(common);
-            println!("cargo:rerun-if-changed={}", common.join("refs").display());
-            println!(
-                "cargo:rerun-if-changed={}",
-                common.join("packed-refs").display()
-            );
+            // Cargo treats a missing path as changed on every build, so only existing files
+            // are named: the loose ref, or packed-refs when the ref is packed.
+            let loose = git(&root, &["symbolic-ref", "-q", "HEAD"]).map(|r| common.join(r));
+            let packed = common.join("packed-refs");
+            for p in [loose, Some(packed)].into_iter().flatten() {
+                if p.is_file() {
+                    println!("cargo:rerun-if-changed={}", p.display());
+                    break;
+                }
+            }
         }
     }
     let (commit, dirty) = match (env_commit, head) {
