@@ -37,11 +37,14 @@ seed svg "tests/fixtures fuzz/seeds" '\.svg$'
 seed dxf "tests/fixtures fuzz/seeds" '\.dxf$'
 seed plan "experiments fuzz/seeds" '\.toml$'
 
-if [ ${#targets[@]} -eq ${#all[@]} ]; then
-  nice cargo +nightly fuzz build -O
-else
-  for t in "${targets[@]}"; do nice cargo +nightly fuzz build -O "$t"; done
-fi
+# Build through `fuzz run` itself: `fuzz build` passes other profile settings than `fuzz run`,
+# so building with it first made every run recompile the crate.
+empty=$(mktemp -d)
+for t in "${targets[@]}"; do
+  nice cargo +nightly fuzz run -O "$t" "$empty" -- -runs=0 >/dev/null 2>&1 ||
+    nice cargo +nightly fuzz run -O "$t" "$empty" -- -runs=0
+done
+rmdir "$empty"
 
 mkdir -p fuzz/logs
 run_one() {
