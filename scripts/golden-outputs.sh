@@ -134,4 +134,7 @@ if [ -n "$REF" ]; then SRC="$REF/raw-demo"; fi
 mkdir -p "$TMP/refdemo"
 cp "$SRC/"{results.csv,traces.csv,manifest.json} "$TMP/refdemo/"
 "$B" report "$TMP/refdemo" --out "$OUT/refreport" >/dev/null
+# PDF figures: same pages, but svg2pdf writes their resource dictionaries in hash-map order
+(cd "$OUT/refreport/plots" && ls) >"$OUT/refreport/plots.txt"
+rm -f "$OUT"/refreport/plots/*.pdf
 echo "recorded in $OUT"
