@@ -781,7 +781,8 @@ fn plots_section(o: &mut Out, d: &Data, traces: &[TraceRow]) -> Result<()> {
     })?;
     let _ = writeln!(
         o.md,
-        "## Plots\n\nEach figure is written as PNG (shown) and SVG (text kept as text, for papers).\n"
+        "## Plots\n\nEach figure is written as PNG (shown), SVG (text kept as text) and PDF (text in \
+         DejaVu Sans, the font embedded: for papers).\n"
     );
     for p in plots_written
         .iter()
@@ -789,7 +790,11 @@ fn plots_section(o: &mut Out, d: &Data, traces: &[TraceRow]) -> Result<()> {
     {
         let name = p.file_name().and_then(|s| s.to_str()).unwrap_or("");
         let svg = name.replace(".png", ".svg");
-        let _ = writeln!(o.md, "![{name}](plots/{name})  \n[SVG](plots/{svg})\n");
+        let pdf = name.replace(".png", ".pdf");
+        let _ = writeln!(
+            o.md,
+            "![{name}](plots/{name})  \n[SVG](plots/{svg}) · [PDF](plots/{pdf})\n"
+        );
     }
     o.files.extend(plots_written);
     Ok(())
