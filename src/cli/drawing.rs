@@ -1,8 +1,9 @@
 //! `optimize` and `import` of drawings (SVG, DXF): read, sequence, verify, write.
 
 use super::gcode::{ImportArgs, OptimizeArgs};
+use super::rows::{Table, say_wrote, write_output};
 use anyhow::{Context as _, bail};
-use cellseq::formats::{read_text, save_instance, write_atomic};
+use cellseq::formats::{read_text, save_instance};
 use cellseq::io::svg;
 use cellseq::pipeline::drawing as pipe;
 use clap::Args;
@@ -150,25 +151,36 @@ fn svg_options(
     }
 }
 
-fn optimize_svg(a: &OptimizeArgs) -> anyhow::Result<()> {
-    let file = a.input.display().to_string();
-    let t0 = std::time::Instant::now();
-    let d = read_svg(&a.input, &a.drawing)?;
-    let read_s = t0.elapsed().as_secs_f64();
-    // reversible by default for drawings
+/// The solver (default `drawing`), whether strokes may be reversed (by default yes) and the
+/// pipeline options of `optimize` on drawing `d`.
+fn optimize_options(a: &OptimizeArgs, d: &svg::Drawing) -> (String, bool, pipe::Options) {
     let reversible = !a.no_reversible;
     let solver = a
         .solver
         .clone()
         .unwrap_or_else(|| pipe::DRAWING_SOLVER.to_string());
-    let mut opts = svg_options(&d, &a.drawing, reversible, &solver, a.time_limit, a.seed);
+    let mut opts = svg_options(d, &a.drawing, reversible, &solver, a.time_limit, a.seed);
     opts.max_evals = a.max_evals;
+    (solver, reversible, opts)
+}
+
+/// The elements the reader skipped, one line each.
+fn say_skipped(d: &svg::Drawing) {
+    for s in &d.skipped {
+        say!("skipped: {s}");
+    }
+}
+
+fn optimize_svg(a: &OptimizeArgs) -> anyhow::Result<()> {
+    let file = a.input.display().to_string();
+    let t0 = std::time::Instant::now();
+    let d = read_svg(&a.input, &a.drawing)?;
+    let read_s = t0.elapsed().as_secs_f64();
+    let (solver, reversible, opts) = optimize_options(a, &d);
     let out = pipe::optimize(&d, &opts)?;
     let text = svg::write(&d, &out.strokes);
     let segments = svg::verify(&d, "<optimized>", &text)?;
-    if let Some(o) = &a.output {
-        write_atomic(o, text.as_bytes()).with_context(|| format!("writing {}", o.display()))?;
-    }
+    write_output(a.output.as_deref(), &text)?;
     let total_s = t0.elapsed().as_secs_f64();
     if a.json {
         let v = serde_json::json!({
@@ -199,36 +211,14 @@ fn optimize_svg(a: &OptimizeArgs) -> anyhow::Result<()> {
             total_s,
             segments
         );
-        for s in &d.skipped {
-            say!("skipped: {s}");
-        }
-        let pct = |x: f64, y: f64| if x > 0.0 { 100.0 * (x - y) / x } else { 0.0 };
+        say_skipped(&d);
         let (b, f) = (&out.before, &out.after);
-        say!("{:<20} {:>14} {:>14} {:>8}", "", "before", "after", "saved");
-        say!(
-            "{:<20} {:>14.1} {:>14.1} {:>7.1}%",
-            "pen-up mm (layer)",
-            b.pen_up_mm,
-            f.pen_up_mm,
-            pct(b.pen_up_mm, f.pen_up_mm)
-        );
-        say!(
-            "{:<20} {:>14.1} {:>14.1} {:>7.1}%",
-            "pen-up mm (total)",
-            b.pen_up_total_mm,
-            f.pen_up_total_mm,
-            pct(b.pen_up_total_mm, f.pen_up_total_mm)
-        );
-        say!("{:<20} {:>14} {:>14}", "pen lifts", b.lifts, f.lifts);
-        say!(
-            "{:<20} {:>14.1} {:>14.1}",
-            "pen-down mm",
-            b.draw_mm,
-            f.draw_mm
-        );
-        if let Some(o) = &a.output {
-            say!("wrote {}", o.display());
-        }
+        let t = Table::new(20);
+        t.saved("pen-up mm (layer)", b.pen_up_mm, f.pen_up_mm);
+        t.saved("pen-up mm (total)", b.pen_up_total_mm, f.pen_up_total_mm);
+        t.counts("pen lifts", b.lifts, f.lifts);
+        t.values("pen-down mm", b.draw_mm, f.draw_mm);
+        say_wrote(a.output.as_deref());
     }
     Ok(())
 }
@@ -266,13 +256,7 @@ fn optimize_dxf(a: &OptimizeArgs) -> anyhow::Result<()> {
     for w in &d.warnings {
         eprintln!("warning: {file}: {w}");
     }
-    let reversible = !a.no_reversible;
-    let solver = a
-        .solver
-        .clone()
-        .unwrap_or_else(|| pipe::DRAWING_SOLVER.to_string());
-    let mut opts = svg_options(&d, &a.drawing, reversible, &solver, a.time_limit, a.seed);
-    opts.max_evals = a.max_evals;
+    let (solver, reversible, mut opts) = optimize_options(a, &d);
     opts.cut = !a.drawing.no_inner_first;
     let out = pipe::optimize(&d, &opts)?;
     let post = dxf::Post {
@@ -297,9 +281,7 @@ fn optimize_dxf(a: &OptimizeArgs) -> anyhow::Result<()> {
         let n = dxf::verify_gcode(&d, "<optimized>", &t, &post)?;
         (t, n)
     };
-    if let Some(o) = &a.output {
-        write_atomic(o, text.as_bytes()).with_context(|| format!("writing {}", o.display()))?;
-    }
+    write_output(a.output.as_deref(), &text)?;
     let total_s = t0.elapsed().as_secs_f64();
     let closed = d.strokes.iter().filter(|s| s.closed).count();
     if a.json {
@@ -334,9 +316,7 @@ fn optimize_dxf(a: &OptimizeArgs) -> anyhow::Result<()> {
             out.solve_s,
             segments
         );
-        for s in &d.skipped {
-            say!("skipped: {s}");
-        }
+        say_skipped(&d);
         say!(
             "travel mm (file order -> optimized): {:.1} -> {:.1}; pierces {} -> {}",
             out.before.pen_up_total_mm,
@@ -344,9 +324,7 @@ fn optimize_dxf(a: &OptimizeArgs) -> anyhow::Result<()> {
             out.before.lifts,
             out.after.lifts
         );
-        if let Some(o) = &a.output {
-            say!("wrote {}", o.display());
-        }
+        say_wrote(a.output.as_deref());
     }
     Ok(())
 }

@@ -1,8 +1,9 @@
 //! `optimize`, `import` and `verify-gcode`: real programs in, better programs out.
 
-use anyhow::{Context as _, bail};
+use super::rows::{Table, say_wrote, write_output};
+use anyhow::bail;
 use cellseq::formats::write::ensure_not_input;
-use cellseq::formats::{read_text, save_instance, write_atomic};
+use cellseq::formats::{read_text, save_instance};
 use cellseq::io::gcode::{self, Figures};
 use cellseq::pipeline::Allowance;
 use cellseq::pipeline::gcode::{self as gcode_pipeline, Kept, Options};
@@ -122,35 +123,12 @@ pub(super) fn format_of(path: &Path, given: Option<&str>) -> anyhow::Result<&'st
 }
 
 fn print_figures(before: &Figures, after: &Figures) {
-    let pct = |a: f64, b: f64| if a > 0.0 { 100.0 * (a - b) / a } else { 0.0 };
-    say!("{:<16} {:>14} {:>14} {:>8}", "", "before", "after", "saved");
-    say!(
-        "{:<16} {:>14.1} {:>14.1} {:>7.1}%",
-        "air length mm",
-        before.air_length,
-        after.air_length,
-        pct(before.air_length, after.air_length)
-    );
-    say!("{:<16} {:>14} {:>14}", "lifts", before.lifts, after.lifts);
-    say!(
-        "{:<16} {:>14} {:>14}",
-        "tool changes",
-        before.tool_changes,
-        after.tool_changes
-    );
-    say!(
-        "{:<16} {:>14.1} {:>14.1} {:>7.1}%",
-        "est. time s",
-        before.est_time_s,
-        after.est_time_s,
-        pct(before.est_time_s, after.est_time_s)
-    );
-    say!(
-        "{:<16} {:>14.1} {:>14.1}",
-        "cut length mm",
-        before.cut_length,
-        after.cut_length
-    );
+    let t = Table::new(16);
+    t.saved("air length mm", before.air_length, after.air_length);
+    t.counts("lifts", before.lifts, after.lifts);
+    t.counts("tool changes", before.tool_changes, after.tool_changes);
+    t.saved("est. time s", before.est_time_s, after.est_time_s);
+    t.values("cut length mm", before.cut_length, after.cut_length);
 }
 
 /// Runs `optimize`.
@@ -221,9 +199,9 @@ fn optimize_gcode(a: &OptimizeArgs) -> anyhow::Result<()> {
     };
     let mut out = gcode_pipeline::optimize_within(&parsed, &opts, &allowance)?;
     out.timings.parse_s = parse_s;
-    if let Some(o) = &a.output {
+    if a.output.is_some() {
         let t = std::time::Instant::now();
-        write_atomic(o, out.text.as_bytes()).with_context(|| format!("writing {}", o.display()))?;
+        write_output(a.output.as_deref(), &out.text)?;
         out.timings.write_s += t.elapsed().as_secs_f64();
     }
     let reversed = out.reversed.iter().filter(|&&r| r).count();
@@ -299,9 +277,7 @@ fn optimize_gcode(a: &OptimizeArgs) -> anyhow::Result<()> {
             t.verify_s,
             t.write_s
         );
-        if let Some(o) = &a.output {
-            say!("wrote {}", o.display());
-        }
+        say_wrote(a.output.as_deref());
     }
     Ok(())
 }

@@ -18,6 +18,7 @@ mod drawing;
 mod gcode;
 mod harness;
 mod plot;
+mod rows;
 mod solve;
 
 use clap::{Parser, Subcommand};

@@ -413,11 +413,52 @@ pub fn parse_pcglns(file: &str, text: &str) -> Result<Instance> {
                 Error::parse(file, text.lines().count().max(1), format!("missing {name}"))
             })
     };
-    // groups
+    let (group_of, groups) = pcglns_groups(file, section("GTSP_SET_SECTION")?, dim, ngroups)?;
+    let lines = section("EDGE_WEIGHT_SECTION")?;
+    let mut edges: BTreeSet<(usize, usize)> = BTreeSet::new();
+    let costs = pcglns_matrix(file, (&lines, dim_line), &group_of, &groups, &mut edges)?;
+    if let Ok(order) = section("GTSP_SET_ORDERING") {
+        pcglns_ordering(file, order, ngroups, &mut edges)?;
+    }
+    let start = pcglns_start(file, section("START_GROUP_SECTION")?, &groups)?;
+    for g in 0..ngroups {
+        if g != start {
+            edges.insert((start, g));
+        }
+    }
+    let cells = groups
+        .iter()
+        .enumerate()
+        .map(|(g, nodes)| Cell::new((g + 1).to_string(), "", vec![Mode::default(); nodes.len()]))
+        .collect();
+    Ok(Instance {
+        name: instance_name(&h, file),
+        meta: Metadata {
+            generator: Some("pcglns".into()),
+            comment: h.get("COMMENT").map(|(_, v)| v.to_string()),
+            ..Default::default()
+        },
+        cells,
+        precedence: edges.into_iter().collect(),
+        matrix: Some(CostMatrix { size: dim, costs }),
+        first: Some(start),
+        closed: true,
+        ..Instance::default()
+    })
+}
+
+/// The groups of a PCGLNS file (`GTSP_SET_SECTION`): the group of every node and the nodes
+/// of every group, in file order; every node in exactly one group, no group empty.
+fn pcglns_groups(
+    file: &str,
+    lines: Vec<(usize, &str)>,
+    dim: usize,
+    ngroups: usize,
+) -> Result<(Vec<usize>, Vec<Vec<usize>>)> {
     let mut group_of = vec![usize::MAX; dim];
     let mut groups: Vec<Vec<usize>> = vec![Vec::new(); ngroups];
     let mut seen_group = vec![false; ngroups];
-    for (ln, line) in section("GTSP_SET_SECTION")? {
+    for (ln, line) in lines {
         let nums = parse_list(file, ln, line)?;
         let g = group_number(file, ln, nums[0], ngroups)?;
         if seen_group[g] {
@@ -460,20 +501,31 @@ pub fn parse_pcglns(file: &str, text: &str) -> Result<Instance> {
             format!("node {} belongs to no group", v + 1),
         ));
     }
-    // our node numbering: group by group, file order within
+    Ok((group_of, groups))
+}
+
+/// The cost matrix of a PCGLNS file (`EDGE_WEIGHT_SECTION`, `DIMENSION` on line `dim_line`) in
+/// our node numbering (group by group, file order within); a forbidden arc (-1) from node i to
+/// node j says that j's group precedes i's, which goes into `edges`.
+fn pcglns_matrix(
+    file: &str,
+    (lines, dim_line): (&[(usize, &str)], usize),
+    group_of: &[usize],
+    groups: &[Vec<usize>],
+    edges: &mut BTreeSet<(usize, usize)>,
+) -> Result<Vec<f64>> {
+    let dim = group_of.len();
     let mut new_index = vec![0usize; dim];
     let mut k = 0;
-    for g in &groups {
+    for g in groups {
         for &v in g {
             new_index[v] = k;
             k += 1;
         }
     }
-    let lines = section("EDGE_WEIGHT_SECTION")?;
-    let mut tok = Tokens::new(file, &lines);
+    let mut tok = Tokens::new(file, lines);
     check_matrix_size(file, dim_line, dim, &tok)?;
     let mut costs = vec![0.0; dim * dim];
-    let mut edges: BTreeSet<(usize, usize)> = BTreeSet::new();
     for i in 0..dim {
         for j in 0..dim {
             let (ln, v) = tok.next_num(&|| format!("matrix entry ({}, {})", i + 1, j + 1))?;
@@ -502,27 +554,39 @@ pub fn parse_pcglns(file: &str, text: &str) -> Result<Instance> {
             format!("unexpected token '{t}' after the {dim}x{dim} matrix (wrong DIMENSION?)"),
         ));
     }
-    if let Ok(order) = section("GTSP_SET_ORDERING") {
-        for (ln, line) in order {
-            let nums = parse_list(file, ln, line)?;
-            let g = group_number(file, ln, nums[0], ngroups)?;
-            for &x in &nums[1..] {
-                let hgrp = group_number(file, ln, x, ngroups)?;
-                if hgrp == g {
-                    return Err(Error::parse(
-                        file,
-                        ln,
-                        format!("group {} must precede itself", g + 1),
-                    ));
-                }
-                edges.insert((g, hgrp));
+    Ok(costs)
+}
+
+/// The precedence of `GTSP_SET_ORDERING`: each line's first group before the others.
+fn pcglns_ordering(
+    file: &str,
+    lines: Vec<(usize, &str)>,
+    ngroups: usize,
+    edges: &mut BTreeSet<(usize, usize)>,
+) -> Result<()> {
+    for (ln, line) in lines {
+        let nums = parse_list(file, ln, line)?;
+        let g = group_number(file, ln, nums[0], ngroups)?;
+        for &x in &nums[1..] {
+            let hgrp = group_number(file, ln, x, ngroups)?;
+            if hgrp == g {
+                return Err(Error::parse(
+                    file,
+                    ln,
+                    format!("group {} must precede itself", g + 1),
+                ));
             }
+            edges.insert((g, hgrp));
         }
     }
-    let start_lines = section("START_GROUP_SECTION")?;
-    let mut tok = Tokens::new(file, &start_lines);
+    Ok(())
+}
+
+/// The start group (`START_GROUP_SECTION`), which must hold a single node.
+fn pcglns_start(file: &str, lines: Vec<(usize, &str)>, groups: &[Vec<usize>]) -> Result<usize> {
+    let mut tok = Tokens::new(file, &lines);
     let (ln, s) = tok.next_int("the start group")?;
-    let start = group_number(file, ln, s, ngroups)?;
+    let start = group_number(file, ln, s, groups.len())?;
     if groups[start].len() != 1 {
         return Err(Error::parse(
             file,
@@ -534,30 +598,7 @@ pub fn parse_pcglns(file: &str, text: &str) -> Result<Instance> {
             ),
         ));
     }
-    for g in 0..ngroups {
-        if g != start {
-            edges.insert((start, g));
-        }
-    }
-    let cells = groups
-        .iter()
-        .enumerate()
-        .map(|(g, nodes)| Cell::new((g + 1).to_string(), "", vec![Mode::default(); nodes.len()]))
-        .collect();
-    Ok(Instance {
-        name: instance_name(&h, file),
-        meta: Metadata {
-            generator: Some("pcglns".into()),
-            comment: h.get("COMMENT").map(|(_, v)| v.to_string()),
-            ..Default::default()
-        },
-        cells,
-        precedence: edges.into_iter().collect(),
-        matrix: Some(CostMatrix { size: dim, costs }),
-        first: Some(start),
-        closed: true,
-        ..Instance::default()
-    })
+    Ok(start)
 }
 
 /// Parses "a b c ... -1" into the numbers before the terminating -1.

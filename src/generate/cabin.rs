@@ -112,6 +112,161 @@ impl B {
     }
 }
 
+/// The part's plan view: faces in strips along x, each at its level.
+struct Part {
+    len: f64,
+    wid: f64,
+    nfaces: usize,
+    levels: usize,
+    strip: f64,
+}
+
+impl Part {
+    /// Top height at `x`.
+    fn level_of(&self, x: f64) -> f64 {
+        -50.0 * (((x / self.strip) as usize).min(self.nfaces - 1) % self.levels) as f64
+    }
+
+    /// The face under `x`.
+    fn face_of(&self, x: f64) -> usize {
+        ((x / self.strip) as usize).min(self.nfaces - 1)
+    }
+}
+
+/// Margin of features and hole groups from the part's edges, mm.
+const MARGIN: f64 = 60.0;
+
+/// One face-milling cell per face strip.
+fn faces(b: &mut B, part: &Part, face_tool: &ToolSpec) -> Vec<usize> {
+    let (strip, wid) = (part.strip, part.wid);
+    let mut faces = Vec::with_capacity(part.nfaces);
+    for f in 0..part.nfaces {
+        let x0 = f as f64 * strip;
+        let z = part.level_of(x0 + strip / 2.0);
+        let r = face_tool.radius();
+        let passes = ((wid - 2.0 * r) / face_tool.cutting_width).ceil().max(1.0);
+        let cut = passes * (strip - 2.0 * r) + (wid - 2.0 * r);
+        let c = b.add(
+            format!("F{:02}", f + 1),
+            face_tool,
+            StepKind::Face,
+            z,
+            format!("face{}", f + 1),
+            cut,
+            stroke_modes(pt(x0 + r, r, z), pt(x0 + strip - r, wid - r, z), true),
+            (f as u64, 0),
+        );
+        faces.push(c);
+    }
+    faces
+}
+
+/// Feature `k` (open: a slot or step with two contact points; closed: one at its rotation
+/// centre): roughing then finishing, after the face it lies in. Returns the roughing cell and
+/// the feature's x.
+#[allow(clippy::too_many_arguments)]
+fn feature(
+    b: &mut B,
+    part: &Part,
+    lib: &ToolLibrary,
+    rough_tool: &ToolSpec,
+    open_fraction: f64,
+    (k, fno): (usize, u64),
+    rng: &mut ChaCha8Rng,
+) -> (usize, usize, f64) {
+    let (len, wid) = (part.len, part.wid);
+    let x = rng.random_range(MARGIN..len - MARGIN);
+    let y = rng.random_range(MARGIN..wid - MARGIN);
+    let top = part.level_of(x);
+    let d = r3(rng.random_range(5.0..40.0));
+    let z = top - d;
+    let cr = rng.random_range(3.0..12.0);
+    let fin = lib.finishing_tool(cr).clone();
+    let fid = format!("E{:03}", k + 1);
+    let open = rng.random_bool(open_fraction);
+    let (rm, fm, cut) = if open {
+        // two critical contact points: ends of a slot / step
+        let l = rng.random_range(60.0..250.0);
+        let a = if rng.random_bool(0.5) {
+            0.0
+        } else {
+            std::f64::consts::FRAC_PI_2
+        };
+        let (dx, dy) = (l / 2.0 * f64::cos(a), l / 2.0 * f64::sin(a));
+        let (p1x, p1y) = ((x - dx).clamp(0.0, len), (y - dy).clamp(0.0, wid));
+        let (p2x, p2y) = ((x + dx).clamp(0.0, len), (y + dy).clamp(0.0, wid));
+        (
+            stroke_modes(pt(p1x, p1y, z), pt(p2x, p2y, z), true),
+            stroke_modes(pt(p1x, p1y, z), pt(p2x, p2y, z), true),
+            l,
+        )
+    } else {
+        // closed: one contact point at the rotation centre
+        let rad = rng.random_range(20.0..80.0);
+        (
+            closed_modes(&[pt(x, y, z)]),
+            closed_modes(&[pt(x, y, z)]),
+            std::f64::consts::TAU * rad,
+        )
+    };
+    let kind = if open { "open" } else { "closed" };
+    let rc = b.add(
+        format!("{fid}-R"),
+        rough_tool,
+        StepKind::PocketRough,
+        z,
+        format!("{fid}-{kind}"),
+        cut * 2.0,
+        rm,
+        (fno, 0),
+    );
+    let fc = b.add(
+        format!("{fid}-F"),
+        &fin,
+        StepKind::PocketFinish,
+        z,
+        format!("{fid}-{kind}"),
+        cut,
+        fm,
+        (fno, 1),
+    );
+    b.cells[fc].layer = 1;
+    (rc, fc, x)
+}
+
+/// Hole group `g`: `nholes` holes on a circle, each after the face it lies in.
+fn hole_group(
+    b: &mut B,
+    part: &Part,
+    drill: &ToolSpec,
+    (g, fno, nholes): (usize, u64, usize),
+    faces: &[usize],
+    prec: &mut Vec<(usize, usize)>,
+    rng: &mut ChaCha8Rng,
+) {
+    let cx = rng.random_range(MARGIN..part.len - MARGIN);
+    let cy = rng.random_range(MARGIN..part.wid - MARGIN);
+    let rad = rng.random_range(20.0..(MARGIN - 5.0));
+    let top = part.level_of(cx);
+    let depth = r3(rng.random_range(10.0..30.0));
+    let phase = rng.random_range(0.0..std::f64::consts::TAU);
+    for h in 0..nholes {
+        let a = phase + std::f64::consts::TAU * h as f64 / nholes as f64;
+        let (hx, hy) = (cx + rad * a.cos(), cy + rad * a.sin());
+        let c = b.add(
+            format!("HG{:02}-{:02}", g + 1, h + 1),
+            drill,
+            StepKind::Hole,
+            top - depth,
+            format!("HG{:02}", g + 1),
+            depth,
+            closed_modes(&[pt(hx, hy, top)]),
+            (fno, h as u64),
+        );
+        prec.push((faces[part.face_of(cx)], c));
+    }
+}
+
 /// Generates a cabin part.
 pub fn generate(p: &Params, seed: u64) -> Result<Instance> {
     let nf = p.int("features") as usize;
@@ -149,115 +304,32 @@ pub fn generate(p: &Params, seed: u64) -> Result<Instance> {
         keys: Vec::new(),
     };
     let mut prec = Vec::new();
-    let strip = len / nfaces as f64;
-    let level_of =
-        |x: f64| -> f64 { -50.0 * (((x / strip) as usize).min(nfaces - 1) % levels) as f64 };
-    let face_of = |x: f64| -> usize { ((x / strip) as usize).min(nfaces - 1) };
-    let mut faces = Vec::with_capacity(nfaces);
-    for f in 0..nfaces {
-        let x0 = f as f64 * strip;
-        let z = level_of(x0 + strip / 2.0);
-        let r = face_tool.radius();
-        let passes = ((wid - 2.0 * r) / face_tool.cutting_width).ceil().max(1.0);
-        let cut = passes * (strip - 2.0 * r) + (wid - 2.0 * r);
-        let c = b.add(
-            format!("F{:02}", f + 1),
-            &face_tool,
-            StepKind::Face,
-            z,
-            format!("face{}", f + 1),
-            cut,
-            stroke_modes(pt(x0 + r, r, z), pt(x0 + strip - r, wid - r, z), true),
-            (f as u64, 0),
-        );
-        faces.push(c);
-    }
-    let margin = 60.0;
+    let part = Part {
+        len,
+        wid,
+        nfaces,
+        levels,
+        strip: len / nfaces as f64,
+    };
+    let faces = faces(&mut b, &part, &face_tool);
     for k in 0..nf {
         let fno = (nfaces + k) as u64;
-        let x = rng.random_range(margin..len - margin);
-        let y = rng.random_range(margin..wid - margin);
-        let top = level_of(x);
-        let d = r3(rng.random_range(5.0..40.0));
-        let z = top - d;
-        let cr = rng.random_range(3.0..12.0);
-        let fin = lib.finishing_tool(cr).clone();
-        let fid = format!("E{:03}", k + 1);
-        let open = rng.random_bool(of);
-        let (rm, fm, cut) = if open {
-            // two critical contact points: ends of a slot / step
-            let l = rng.random_range(60.0..250.0);
-            let a = if rng.random_bool(0.5) {
-                0.0
-            } else {
-                std::f64::consts::FRAC_PI_2
-            };
-            let (dx, dy) = (l / 2.0 * f64::cos(a), l / 2.0 * f64::sin(a));
-            let (p1x, p1y) = ((x - dx).clamp(0.0, len), (y - dy).clamp(0.0, wid));
-            let (p2x, p2y) = ((x + dx).clamp(0.0, len), (y + dy).clamp(0.0, wid));
-            (
-                stroke_modes(pt(p1x, p1y, z), pt(p2x, p2y, z), true),
-                stroke_modes(pt(p1x, p1y, z), pt(p2x, p2y, z), true),
-                l,
-            )
-        } else {
-            // closed: one contact point at the rotation centre
-            let rad = rng.random_range(20.0..80.0);
-            (
-                closed_modes(&[pt(x, y, z)]),
-                closed_modes(&[pt(x, y, z)]),
-                std::f64::consts::TAU * rad,
-            )
-        };
-        let kind = if open { "open" } else { "closed" };
-        let rc = b.add(
-            format!("{fid}-R"),
-            &rough_tool,
-            StepKind::PocketRough,
-            z,
-            format!("{fid}-{kind}"),
-            cut * 2.0,
-            rm,
-            (fno, 0),
-        );
-        let fc = b.add(
-            format!("{fid}-F"),
-            &fin,
-            StepKind::PocketFinish,
-            z,
-            format!("{fid}-{kind}"),
-            cut,
-            fm,
-            (fno, 1),
-        );
-        b.cells[fc].layer = 1;
-        prec.push((faces[face_of(x)], rc));
+        let (rc, fc, x) = feature(&mut b, &part, &lib, &rough_tool, of, (k, fno), &mut rng);
+        prec.push((faces[part.face_of(x)], rc));
         prec.push((rc, fc));
     }
     for g in 0..ngroups {
         let fno = (nfaces + nf + g) as u64;
         let drill = drills[g % drills.len()].clone();
-        let cx = rng.random_range(margin..len - margin);
-        let cy = rng.random_range(margin..wid - margin);
-        let rad = rng.random_range(20.0..(margin - 5.0));
-        let top = level_of(cx);
-        let depth = r3(rng.random_range(10.0..30.0));
-        let phase = rng.random_range(0.0..std::f64::consts::TAU);
-        for h in 0..nholes {
-            let a = phase + std::f64::consts::TAU * h as f64 / nholes as f64;
-            let (hx, hy) = (cx + rad * a.cos(), cy + rad * a.sin());
-            let c = b.add(
-                format!("HG{:02}-{:02}", g + 1, h + 1),
-                &drill,
-                StepKind::Hole,
-                top - depth,
-                format!("HG{:02}", g + 1),
-                depth,
-                closed_modes(&[pt(hx, hy, top)]),
-                (fno, h as u64),
-            );
-            prec.push((faces[face_of(cx)], c));
-        }
+        hole_group(
+            &mut b,
+            &part,
+            &drill,
+            (g, fno, nholes),
+            &faces,
+            &mut prec,
+            &mut rng,
+        );
     }
     let (used, rank) = tools_larger_first(&lib, &b.cells);
     prec.sort_unstable();

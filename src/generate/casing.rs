@@ -136,6 +136,111 @@ const SHAPES: [(&str, f64, f64); 3] = [
     ("keyway", 35.0, 50.0),
 ];
 
+/// Features per region: (start, end, appearing layer), `mean` / 2 to `max_feats` of them, one
+/// per equal slot of the circumference, each placed at random inside its slot.
+fn features(
+    regions: usize,
+    (mean, max_feats): (usize, usize),
+    circ: f64,
+    td: f64,
+    rng: &mut ChaCha8Rng,
+) -> Vec<Vec<(f64, f64, usize)>> {
+    let mut feats: Vec<Vec<(f64, f64, usize)>> = Vec::with_capacity(regions);
+    for _ in 0..regions {
+        let k = if mean == 0 {
+            0
+        } else {
+            rng.random_range(mean.div_ceil(2)..=max_feats)
+        };
+        let slot = if k > 0 { circ / k as f64 } else { circ };
+        let mut fs = Vec::with_capacity(k);
+        for s in 0..k {
+            let (_, lo, hi) = SHAPES[rng.random_range(0..SHAPES.len())];
+            let w = rng.random_range(lo..=hi);
+            let room = (slot - w) / 2.0 - td;
+            let centre = (s as f64 + 0.5) * slot + rng.random_range(-0.5..=0.5) * room.max(0.0);
+            let appear = rng.random_range(1..LAYERS_W.len());
+            fs.push((r3(centre - w / 2.0), r3(centre + w / 2.0), appear));
+        }
+        feats.push(fs);
+    }
+    feats
+}
+
+/// The cells built so far, their programming keys and precedence.
+#[derive(Default)]
+struct Cells {
+    cells: Vec<Cell>,
+    keys: Vec<(u64, u64)>,
+    prec: Vec<(usize, usize)>,
+}
+
+/// The casing's size: circumference, region width and gap.
+struct Geometry {
+    circ: f64,
+    width: f64,
+    gap: f64,
+}
+
+/// The sub-regions of layer `l` in every region: the arcs between the features present at this
+/// layer, each after the overlapping sub-regions of the layer above (`prev`, updated). Returns
+/// the layer's cells per region.
+fn layer(
+    out: &mut Cells,
+    g: &Geometry,
+    cut: &Cut,
+    l: usize,
+    feats: &[Vec<(f64, f64, usize)>],
+    prev: &mut [Vec<(f64, f64, usize)>],
+) -> Vec<Vec<usize>> {
+    let td = 2.0 * cut.radius;
+    let mut number = 0u64;
+    let mut layer_regions: Vec<Vec<usize>> = Vec::with_capacity(feats.len());
+    for (ri, fs) in feats.iter().enumerate() {
+        let y0 = ri as f64 * (g.width + g.gap);
+        let y1 = y0 + g.width;
+        let mut active: Vec<(f64, f64)> =
+            fs.iter().filter(|f| f.2 <= l).map(|f| (f.0, f.1)).collect();
+        active.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let mut cuts = vec![0.0];
+        for &(a, b) in &active {
+            cuts.push(a);
+            cuts.push(b);
+        }
+        cuts.push(g.circ);
+        let mut here = Vec::new();
+        let mut mine = Vec::new();
+        for iv in cuts.chunks(2) {
+            let (a0, a1) = (iv[0], iv[1]);
+            if a1 - a0 < 2.0 * td {
+                continue; // too narrow for the tool: left to finishing
+            }
+            number += 1;
+            let c = sub_region(
+                cut,
+                (a0, a1),
+                (y0, y1),
+                format!("L{}-R{}-S{}", l + 1, ri + 1, number),
+                l,
+                ri,
+            );
+            let idx = out.cells.len();
+            out.cells.push(c);
+            out.keys.push((l as u64, number));
+            for &(b0, b1, pc) in &prev[ri] {
+                if b0.max(a0) < b1.min(a1) {
+                    out.prec.push((pc, idx));
+                }
+            }
+            here.push((a0, a1, idx));
+            mine.push(idx);
+        }
+        prev[ri] = here;
+        layer_regions.push(mine);
+    }
+    layer_regions
+}
+
 /// Generates a casing.
 pub fn generate(p: &Params, seed: u64) -> Result<Instance> {
     let regions = p.int("regions") as usize;
@@ -167,26 +272,7 @@ pub fn generate(p: &Params, seed: u64) -> Result<Instance> {
         ));
     }
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    // features per region: (start, end, appearing layer)
-    let mut feats: Vec<Vec<(f64, f64, usize)>> = Vec::with_capacity(regions);
-    for _ in 0..regions {
-        let k = if mean == 0 {
-            0
-        } else {
-            rng.random_range(mean.div_ceil(2)..=max_feats)
-        };
-        let slot = if k > 0 { circ / k as f64 } else { circ };
-        let mut fs = Vec::with_capacity(k);
-        for s in 0..k {
-            let (_, lo, hi) = SHAPES[rng.random_range(0..SHAPES.len())];
-            let w = rng.random_range(lo..=hi);
-            let room = (slot - w) / 2.0 - td;
-            let centre = (s as f64 + 0.5) * slot + rng.random_range(-0.5..=0.5) * room.max(0.0);
-            let appear = rng.random_range(1..LAYERS_W.len());
-            fs.push((r3(centre - w / 2.0), r3(centre + w / 2.0), appear));
-        }
-        feats.push(fs);
-    }
+    let feats = features(regions, (mean, max_feats), circ, td, &mut rng);
     let r = td / 2.0;
     let tool = Tool {
         id: format!("EM{}", td),
@@ -194,73 +280,34 @@ pub fn generate(p: &Params, seed: u64) -> Result<Instance> {
         name: Some(format!("flat end mill D{td}")),
         feed: None,
     };
-    let mut cells: Vec<Cell> = Vec::new();
-    let mut keys: Vec<(u64, u64)> = Vec::new();
-    let mut prec: Vec<(usize, usize)> = Vec::new();
+    let mut cells = Cells::default();
     // cells of the previous layer per region: (start, end, cell)
     let mut prev: Vec<Vec<(f64, f64, usize)>> = vec![Vec::new(); regions];
+    let geometry = Geometry { circ, width, gap };
     for (l, &w) in LAYERS_W.iter().enumerate() {
-        let z = -w * depth;
-        let mut number = 0u64;
-        let mut layer_regions: Vec<Vec<usize>> = Vec::with_capacity(regions);
-        for (ri, fs) in feats.iter().enumerate() {
-            let y0 = ri as f64 * (width + gap);
-            let y1 = y0 + width;
-            let mut active: Vec<(f64, f64)> =
-                fs.iter().filter(|f| f.2 <= l).map(|f| (f.0, f.1)).collect();
-            active.sort_by(|a, b| a.0.total_cmp(&b.0));
-            let mut cuts = vec![0.0];
-            for &(a, b) in &active {
-                cuts.push(a);
-                cuts.push(b);
-            }
-            cuts.push(circ);
-            let mut here = Vec::new();
-            let mut mine = Vec::new();
-            for iv in cuts.chunks(2) {
-                let (a0, a1) = (iv[0], iv[1]);
-                if a1 - a0 < 2.0 * td {
-                    continue; // too narrow for the tool: left to finishing
-                }
-                number += 1;
-                let c = sub_region(
-                    &Cut {
-                        tool: &tool.id,
-                        radius: r,
-                        z,
-                        stepover,
-                        reversible: p.bool("reversible"),
-                    },
-                    (a0, a1),
-                    (y0, y1),
-                    format!("L{}-R{}-S{}", l + 1, ri + 1, number),
-                    l,
-                    ri,
-                );
-                let idx = cells.len();
-                cells.push(c);
-                keys.push((l as u64, number));
-                for &(b0, b1, pc) in &prev[ri] {
-                    if b0.max(a0) < b1.min(a1) {
-                        prec.push((pc, idx));
-                    }
-                }
-                here.push((a0, a1, idx));
-                mine.push(idx);
-            }
-            prev[ri] = here;
-            layer_regions.push(mine);
-        }
+        let cut = Cut {
+            tool: &tool.id,
+            radius: r,
+            z: -w * depth,
+            stepover,
+            reversible: p.bool("reversible"),
+        };
+        let layer_regions = layer(&mut cells, &geometry, &cut, l, &feats, &mut prev);
         if p.bool("region_first") {
             for wdw in layer_regions.windows(2) {
                 for &a in &wdw[0] {
                     for &b in &wdw[1] {
-                        prec.push((a, b));
+                        cells.prec.push((a, b));
                     }
                 }
             }
         }
     }
+    let Cells {
+        cells,
+        keys,
+        mut prec,
+    } = cells;
     prec.sort_unstable();
     prec.dedup();
     let order = programmed_order(cells.len(), &prec, &vec![0; cells.len()], &keys);

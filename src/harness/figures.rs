@@ -78,7 +78,7 @@ pub struct FigureData<'a> {
 
 type Files = std::result::Result<Vec<PathBuf>, String>;
 
-/// Writes every figure into `dir` (PNG and SVG); returns the files in order.
+/// Writes every figure into `dir` (PNG, SVG and PDF); returns the files in order.
 pub fn write_figures(dir: &Path, d: &FigureData) -> Files {
     let clock = Clock::of_rows(d.rows);
     let mut out = Vec::new();

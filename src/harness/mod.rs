@@ -12,6 +12,7 @@ pub mod figures;
 pub mod hash;
 pub mod latex;
 pub mod layers;
+pub mod manifest;
 pub mod paper;
 pub mod plan;
 pub mod plots;

@@ -361,6 +361,209 @@ fn params_suffix(p: &BTreeMap<String, String>) -> String {
         .join(",")
 }
 
+/// A budget sets at least one limit, and its limits in seconds are positive.
+fn check_budget(b: &BudgetSpec) -> std::result::Result<(), String> {
+    if b.seconds.is_none() && b.evaluations.is_none() && b.calibration_units.is_none() {
+        return Err("budget: set seconds, evaluations or calibration_units".into());
+    }
+    for (name, v) in [
+        ("seconds", b.seconds),
+        ("calibration_units", b.calibration_units),
+    ] {
+        if let Some(x) = v
+            && !(x.is_finite() && x > 0.0)
+        {
+            return Err(format!("budget.{name} must be a positive number, got {x}"));
+        }
+    }
+    Ok(())
+}
+
+/// The plan's instances in order (files matched by each pattern, or every generator parameter
+/// combination × seed), every id once; `caps` = (trial cap, directory entries per pattern).
+fn plan_instances(
+    file: &str,
+    specs: &[InstanceSpec],
+    base: &Path,
+    caps: (u64, u64),
+) -> Result<Vec<InstanceRef>> {
+    let bad = |m: String| Error::invalid(file, m);
+    if specs.is_empty() {
+        return Err(bad("no [[instances]]".into()));
+    }
+    let mut instances = Vec::new();
+    for (i, spec) in specs.iter().enumerate() {
+        let what = format!("instances[{i}]");
+        match (&spec.generator, spec.files.is_empty()) {
+            (Some(_), false) => {
+                return Err(bad(format!(
+                    "{what}: give either files or generator, not both"
+                )));
+            }
+            (None, true) => return Err(bad(format!("{what}: give files or a generator"))),
+            (None, false) => {
+                if spec.seeds.is_some() || !spec.grid.is_empty() {
+                    return Err(bad(format!(
+                        "{what}: seeds and grid apply to generators only"
+                    )));
+                }
+                file_instances(file, &what, &spec.files, base, caps, &mut instances)?;
+            }
+            (Some(kind), true) => {
+                generated_instances(file, &what, kind, spec, caps.0, &mut instances)?;
+            }
+        }
+    }
+    let mut seen = BTreeSet::new();
+    for inst in &instances {
+        if !seen.insert(inst.id.clone()) {
+            return Err(bad(format!("instance id '{}' occurs twice", inst.id)));
+        }
+    }
+    Ok(instances)
+}
+
+/// The files matched by each of `patterns` (relative to `base`), appended to `out`.
+fn file_instances(
+    file: &str,
+    what: &str,
+    patterns: &[String],
+    base: &Path,
+    (max_trials, max_files): (u64, u64),
+    out: &mut Vec<InstanceRef>,
+) -> Result<()> {
+    let bad = |m: String| Error::invalid(file, m);
+    for pat in patterns {
+        let full_s = base.join(pat).display().to_string();
+        let found = files::expand(base, pat, max_files).map_err(|e| bad(format!("{what}: {e}")))?;
+        if found.is_empty() {
+            return Err(bad(format!("{what}: '{pat}' matches no file ({full_s})")));
+        }
+        if (out.len() + found.len()) as u64 > max_trials {
+            return Err(bad(format!(
+                "{what}: more than {max_trials} instances (the trial cap); \
+                 raise it with the plan key max_trials or --max-trials"
+            )));
+        }
+        for p in found {
+            out.push(InstanceRef {
+                id: crate::formats::stem_name(&p),
+                source: Source::File(p),
+            });
+        }
+    }
+    Ok(())
+}
+
+/// Generator `kind` at every parameter combination of the spec's grid × its seeds, appended to
+/// `out`.
+fn generated_instances(
+    file: &str,
+    what: &str,
+    kind: &String,
+    spec: &InstanceSpec,
+    max_trials: u64,
+    out: &mut Vec<InstanceRef>,
+) -> Result<()> {
+    let bad = |m: String| Error::invalid(file, m);
+    let info = KINDS.iter().find(|k| k.name == kind).ok_or_else(|| {
+        bad(format!(
+            "{what}: unknown generator '{kind}' (known: {})",
+            KINDS.iter().map(|k| k.name).collect::<Vec<_>>().join(", ")
+        ))
+    })?;
+    let seeds = spec.seeds.clone().unwrap_or_else(|| vec![1]);
+    if seeds.is_empty() {
+        return Err(bad(format!("{what}: empty seeds list")));
+    }
+    for params in expand_grid(file, what, &spec.grid, max_trials)? {
+        Params::new(kind, info.params, &params).map_err(|e| bad(format!("{what}: {e}")))?;
+        for &seed in &seeds {
+            let mut id = kind.clone();
+            for (k, v) in &params {
+                id.push_str(&format!("-{k}{v}"));
+            }
+            id.push_str(&format!("-s{seed}"));
+            out.push(InstanceRef {
+                id,
+                source: Source::Generated {
+                    kind: kind.clone(),
+                    params: params.clone(),
+                    seed,
+                },
+            });
+        }
+    }
+    Ok(())
+}
+
+/// The plan's solver configurations in order (`*` = every registered solver; a parameter grid
+/// = one configuration per combination), every id once.
+fn plan_solvers(file: &str, specs: &[SolverSpec], max_trials: u64) -> Result<Vec<SolverRef>> {
+    let bad = |m: String| Error::invalid(file, m);
+    if specs.is_empty() {
+        return Err(bad("no [[solvers]]".into()));
+    }
+    let mut solvers_out = Vec::new();
+    for (i, spec) in specs.iter().enumerate() {
+        let what = format!("solvers[{i}]");
+        if spec.name == "*" {
+            if !spec.params.is_empty() {
+                return Err(bad(format!("{what}: '*' takes no parameters")));
+            }
+            for info in solvers::registry() {
+                solvers_out.push(SolverRef {
+                    id: info.name.to_string(),
+                    name: info.name.to_string(),
+                    params: BTreeMap::new(),
+                });
+            }
+            continue;
+        }
+        let info = solvers::find(&spec.name).map_err(|e| bad(format!("{what}: {e}")))?;
+        for params in expand_grid(file, &what, &spec.params, max_trials)? {
+            Params::new(info.name, info.params, &params)
+                .map_err(|e| bad(format!("{what}: {e}")))?;
+            let id = if params.is_empty() {
+                info.name.to_string()
+            } else {
+                format!("{}[{}]", info.name, params_suffix(&params))
+            };
+            solvers_out.push(SolverRef {
+                id,
+                name: info.name.to_string(),
+                params,
+            });
+        }
+    }
+    let mut seen = BTreeSet::new();
+    solvers_out.retain(|s| seen.insert(s.id.clone()));
+    Ok(solvers_out)
+}
+
+/// Every paper figure names a known metric and, if any, a solver of the plan.
+fn check_paper(p: &Paper, solvers: &[SolverRef]) -> std::result::Result<(), String> {
+    for f in &p.figures {
+        if !FIGURE_METRICS.contains(&f.metric.as_str()) {
+            return Err(format!(
+                "paper figure '{}': unknown metric '{}' (known: {})",
+                f.label,
+                f.metric,
+                FIGURE_METRICS.join(", ")
+            ));
+        }
+        if let Some(s) = &f.solver
+            && !solvers.iter().any(|x| &x.id == s)
+        {
+            return Err(format!(
+                "paper figure '{}': solver '{s}' is not in the plan",
+                f.label
+            ));
+        }
+    }
+    Ok(())
+}
+
 impl Plan {
     /// Reads and validates a plan file; relative paths are resolved against its directory.
     pub fn load(path: &Path) -> Result<Plan> {
@@ -395,24 +598,7 @@ impl Plan {
         if pf.replicates == 0 {
             return Err(bad("replicates must be at least 1".into()));
         }
-        let b = &pf.budget;
-        if b.seconds.is_none() && b.evaluations.is_none() && b.calibration_units.is_none() {
-            return Err(bad(
-                "budget: set seconds, evaluations or calibration_units".into()
-            ));
-        }
-        for (name, v) in [
-            ("seconds", b.seconds),
-            ("calibration_units", b.calibration_units),
-        ] {
-            if let Some(x) = v
-                && !(x.is_finite() && x > 0.0)
-            {
-                return Err(bad(format!(
-                    "budget.{name} must be a positive number, got {x}"
-                )));
-            }
-        }
+        check_budget(&pf.budget).map_err(bad)?;
         let objective = match &pf.objective {
             None => None,
             Some(s) => Some(Objective::parse(s).ok_or_else(|| {
@@ -421,124 +607,9 @@ impl Plan {
                 ))
             })?),
         };
-        // instances
-        if pf.instances.is_empty() {
-            return Err(bad("no [[instances]]".into()));
-        }
-        let mut instances = Vec::new();
-        for (i, spec) in pf.instances.iter().enumerate() {
-            let what = format!("instances[{i}]");
-            match (&spec.generator, spec.files.is_empty()) {
-                (Some(_), false) => {
-                    return Err(bad(format!(
-                        "{what}: give either files or generator, not both"
-                    )));
-                }
-                (None, true) => return Err(bad(format!("{what}: give files or a generator"))),
-                (None, false) => {
-                    if spec.seeds.is_some() || !spec.grid.is_empty() {
-                        return Err(bad(format!(
-                            "{what}: seeds and grid apply to generators only"
-                        )));
-                    }
-                    for pat in &spec.files {
-                        let full_s = base.join(pat).display().to_string();
-                        let found = files::expand(base, pat, max_files)
-                            .map_err(|e| bad(format!("{what}: {e}")))?;
-                        if found.is_empty() {
-                            return Err(bad(format!("{what}: '{pat}' matches no file ({full_s})")));
-                        }
-                        if (instances.len() + found.len()) as u64 > max_trials {
-                            return Err(bad(format!(
-                                "{what}: more than {max_trials} instances (the trial cap); \
-                                 raise it with the plan key max_trials or --max-trials"
-                            )));
-                        }
-                        for p in found {
-                            instances.push(InstanceRef {
-                                id: crate::formats::stem_name(&p),
-                                source: Source::File(p),
-                            });
-                        }
-                    }
-                }
-                (Some(kind), true) => {
-                    let info = KINDS.iter().find(|k| k.name == kind).ok_or_else(|| {
-                        bad(format!(
-                            "{what}: unknown generator '{kind}' (known: {})",
-                            KINDS.iter().map(|k| k.name).collect::<Vec<_>>().join(", ")
-                        ))
-                    })?;
-                    let seeds = spec.seeds.clone().unwrap_or_else(|| vec![1]);
-                    if seeds.is_empty() {
-                        return Err(bad(format!("{what}: empty seeds list")));
-                    }
-                    for params in expand_grid(file, &what, &spec.grid, max_trials)? {
-                        Params::new(kind, info.params, &params)
-                            .map_err(|e| bad(format!("{what}: {e}")))?;
-                        for &seed in &seeds {
-                            let mut id = kind.clone();
-                            for (k, v) in &params {
-                                id.push_str(&format!("-{k}{v}"));
-                            }
-                            id.push_str(&format!("-s{seed}"));
-                            instances.push(InstanceRef {
-                                id,
-                                source: Source::Generated {
-                                    kind: kind.clone(),
-                                    params: params.clone(),
-                                    seed,
-                                },
-                            });
-                        }
-                    }
-                }
-            }
-        }
-        let mut seen = BTreeSet::new();
-        for inst in &instances {
-            if !seen.insert(inst.id.clone()) {
-                return Err(bad(format!("instance id '{}' occurs twice", inst.id)));
-            }
-        }
-        // solvers
-        if pf.solvers.is_empty() {
-            return Err(bad("no [[solvers]]".into()));
-        }
-        let mut solvers_out = Vec::new();
-        for (i, spec) in pf.solvers.iter().enumerate() {
-            let what = format!("solvers[{i}]");
-            if spec.name == "*" {
-                if !spec.params.is_empty() {
-                    return Err(bad(format!("{what}: '*' takes no parameters")));
-                }
-                for info in solvers::registry() {
-                    solvers_out.push(SolverRef {
-                        id: info.name.to_string(),
-                        name: info.name.to_string(),
-                        params: BTreeMap::new(),
-                    });
-                }
-                continue;
-            }
-            let info = solvers::find(&spec.name).map_err(|e| bad(format!("{what}: {e}")))?;
-            for params in expand_grid(file, &what, &spec.params, max_trials)? {
-                Params::new(info.name, info.params, &params)
-                    .map_err(|e| bad(format!("{what}: {e}")))?;
-                let id = if params.is_empty() {
-                    info.name.to_string()
-                } else {
-                    format!("{}[{}]", info.name, params_suffix(&params))
-                };
-                solvers_out.push(SolverRef {
-                    id,
-                    name: info.name.to_string(),
-                    params,
-                });
-            }
-        }
-        let mut seen = BTreeSet::new();
-        solvers_out.retain(|s| seen.insert(s.id.clone()));
+        let caps = (max_trials, max_files);
+        let instances = plan_instances(file, &pf.instances, base, caps)?;
+        let solvers_out = plan_solvers(file, &pf.solvers, max_trials)?;
         let reference = match &pf.reference {
             Some(r) => {
                 if !solvers_out.iter().any(|s| &s.id == r) {
@@ -556,24 +627,7 @@ impl Plan {
             None => solvers_out[0].id.clone(),
         };
         if let Some(p) = &pf.paper {
-            for f in &p.figures {
-                if !FIGURE_METRICS.contains(&f.metric.as_str()) {
-                    return Err(bad(format!(
-                        "paper figure '{}': unknown metric '{}' (known: {})",
-                        f.label,
-                        f.metric,
-                        FIGURE_METRICS.join(", ")
-                    )));
-                }
-                if let Some(s) = &f.solver
-                    && !solvers_out.iter().any(|x| &x.id == s)
-                {
-                    return Err(bad(format!(
-                        "paper figure '{}': solver '{s}' is not in the plan",
-                        f.label
-                    )));
-                }
-            }
+            check_paper(p, &solvers_out).map_err(bad)?;
         }
         let trials = (instances.len() as u64)
             .checked_mul(solvers_out.len() as u64)

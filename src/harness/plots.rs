@@ -5,7 +5,9 @@
 //!
 //! Text uses the embedded DejaVu Sans (`assets/fonts/DejaVuSans.ttf`, registered through
 //! plotters' `ab_glyph` feature), so no system font is needed; in the SVG files text stays text
-//! (`font-family="DejaVu Sans, sans-serif"`), so it can be searched, edited and re-typeset.
+//! (`font-family="DejaVu Sans, sans-serif"`), so it can be searched, edited and re-typeset; the
+//! PDF of each figure ([`svg_to_pdf`]) is the SVG with its text set in that same font, the used
+//! glyphs embedded as a subset, so the PDF looks the same on every machine and in any paper.
 //!
 //! Every axis is drawn in transformed coordinates: a log axis plots `log10(v)` on a linear scale
 //! and labels the ticks with the values, which is what makes exact decade ticks possible.
@@ -710,6 +712,25 @@ where
     Ok(body.split_horizontally(w.saturating_sub(LEGEND_W)))
 }
 
+/// A figure's SVG as a PDF (one page of the SVG's size): the text stays text, set in the
+/// embedded DejaVu Sans, whose glyphs used are embedded in the file (a font subset). No system
+/// font is consulted, so the same SVG gives the same page on every machine (not the same
+/// bytes: `svg2pdf` writes resource dictionaries in hash-map order).
+pub fn svg_to_pdf(svg: &str) -> std::result::Result<Vec<u8>, String> {
+    let mut opt = svg2pdf::usvg::Options::default();
+    let db = opt.fontdb_mut();
+    db.load_font_data(FONT.to_vec());
+    db.set_sans_serif_family("DejaVu Sans");
+    let tree = svg2pdf::usvg::Tree::from_str(svg, &opt).map_err(err)?;
+    svg2pdf::to_pdf(
+        &tree,
+        svg2pdf::ConversionOptions::default(),
+        svg2pdf::PageOptions::default(),
+    )
+    .map_err(err)
+}
+
+/// Draws a figure with `$f` into `$dir/$name.png`, `.svg` and `.pdf`.
 macro_rules! both {
     ($dir:expr, $name:expr, $size:expr, $f:expr) => {{
         register();
@@ -725,6 +746,7 @@ macro_rules! both {
             crate::formats::write_atomic(&png, &bytes).map_err(err)?;
         }
         let svg: PathBuf = $dir.join(format!("{}.svg", $name));
+        let pdf: PathBuf = $dir.join(format!("{}.pdf", $name));
         {
             let mut text = String::new();
             {
@@ -732,8 +754,9 @@ macro_rules! both {
                 $f(root)?;
             }
             crate::formats::write_atomic(&svg, text.as_bytes()).map_err(err)?;
+            crate::formats::write_atomic(&pdf, &svg_to_pdf(&text)?).map_err(err)?;
         }
-        Ok(vec![png, svg])
+        Ok(vec![png, svg, pdf])
     }};
 }
 
@@ -837,7 +860,7 @@ where
 }
 
 /// Horizontal box plot of one value per group (solver); whiskers at 1.5 IQR, outliers as dots.
-/// Returns the files written (PNG and SVG).
+/// Returns the files written (PNG, SVG and PDF).
 pub fn box_plot(dir: &Path, name: &str, title: &str, xlabel: &str, groups: &[Group]) -> Files {
     let h = 110 + 30 * groups.len().max(2) as u32;
     both!(dir, name, (900, h), |r| draw_box(r, title, xlabel, groups))

@@ -396,6 +396,145 @@ pub fn write_manifest(
     )
 }
 
+/// Resume: keeps the complete rows of this plan (`order`: run key -> trial), once each, and
+/// drops torn lines and the traces and layer rows of unfinished trials. Returns the run keys of
+/// the trials done. Rows of another plan are refused unless `replace_foreign`.
+fn resume(
+    files: &OutFiles,
+    order: &HashMap<String, usize>,
+    replace_foreign: bool,
+) -> Result<BTreeSet<String>> {
+    let (mut done_rows, torn) = read_lenient::<Row>(&files.results)?;
+    let before = done_rows.len();
+    let foreign = done_rows
+        .iter()
+        .filter(|r| !order.contains_key(&r.run_key))
+        .count();
+    if foreign > 0 && !replace_foreign {
+        return Err(Error::invalid(
+            files.results.display().to_string(),
+            format!(
+                "{foreign} of its {before} trials do not belong to this plan (another plan, seed, \
+                 budget or shard wrote them); choose another --out directory"
+            ),
+        ));
+    }
+    let mut seen = BTreeSet::new();
+    done_rows.retain(|r| order.contains_key(&r.run_key) && seen.insert(r.run_key.clone()));
+    let (mut done_traces, torn_t) = read_lenient::<TraceRow>(&files.traces)?;
+    let before_t = done_traces.len();
+    done_traces.retain(|t| seen.contains(&t.run_key));
+    if torn || done_rows.len() != before {
+        write_table(&files.results, &done_rows)?;
+    }
+    if torn_t || done_traces.len() != before_t {
+        write_table(&files.traces, &done_traces)?;
+    }
+    let (mut done_layers, torn_l) = read_lenient::<LayerRow>(&files.layers)?;
+    let before_l = done_layers.len();
+    done_layers.retain(|l| seen.contains(&l.run_key));
+    if torn_l || done_layers.len() != before_l {
+        write_table(&files.layers, &done_layers)?;
+    }
+    Ok(seen)
+}
+
+/// The instance table: the old one plus the instances prepared now, in plan order.
+fn write_instance_table(
+    plan: &Plan,
+    files: &OutFiles,
+    prepared: &HashMap<usize, Prepared>,
+) -> Result<()> {
+    let (mut rows, _) = read_lenient::<InstanceRow>(&files.instances)?;
+    for (&i, p) in prepared {
+        let id = &plan.instances[i].id;
+        if !rows.iter().any(|r| &r.instance == id) {
+            rows.push(instance_row(id, &p.instance));
+        }
+    }
+    let pos: HashMap<&str, usize> = plan
+        .instances
+        .iter()
+        .enumerate()
+        .map(|(i, r)| (r.id.as_str(), i))
+        .collect();
+    rows.retain(|r| pos.contains_key(r.instance.as_str()));
+    rows.sort_by_key(|r| pos[r.instance.as_str()]);
+    write_table(&files.instances, &rows)
+}
+
+/// Runs `trials` in parallel (inside the caller's thread pool), appending each trial's traces,
+/// layer rows and result row as it completes. Returns the number of infeasible trials.
+fn run_trials(
+    plan: &Plan,
+    opts: &RunOptions,
+    files: &OutFiles,
+    trials: &[Trial],
+    prepared: &HashMap<usize, Prepared>,
+    calib: f64,
+) -> Result<usize> {
+    let writer = Mutex::new((
+        Appender::open::<Row>(&files.results)?,
+        Appender::open::<TraceRow>(&files.traces)?,
+        Appender::open::<LayerRow>(&files.layers)?,
+    ));
+    let bar = if opts.progress && std::io::stderr().is_terminal() {
+        ProgressBar::new(trials.len() as u64)
+    } else {
+        ProgressBar::with_draw_target(Some(trials.len() as u64), ProgressDrawTarget::hidden())
+    };
+    bar.set_style(
+        ProgressStyle::with_template(
+            "{bar:40} {pos}/{len} trials  {elapsed_precise} elapsed, ETA {eta_precise}  {msg}",
+        )
+        .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    let failed = std::sync::atomic::AtomicUsize::new(0);
+    let res: Result<()> = trials.par_iter().try_for_each(|t| {
+        let prep = &prepared[&t.instance];
+        let (row, traces, layers) = run_trial(plan, prep, t, calib);
+        if !row.feasible {
+            failed.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        }
+        {
+            let mut w = writer
+                .lock()
+                .map_err(|_| Error::Param("writer lock poisoned".into()))?;
+            // traces first: a trial counts as done only once its result row is there
+            w.1.append(&traces)?;
+            w.2.append(&layers)?;
+            w.0.append(&[row])?;
+        }
+        bar.inc(1);
+        if opts.throttle_ms > 0 {
+            std::thread::sleep(Duration::from_millis(opts.throttle_ms));
+        }
+        Ok(())
+    });
+    bar.finish_and_clear();
+    res?;
+    drop(writer);
+    Ok(failed.into_inner())
+}
+
+/// Rewrites the tables in plan order (one row per trial), so that the files do not depend on
+/// thread scheduling.
+fn finalise(files: &OutFiles) -> Result<()> {
+    let (mut rows, _) = read_lenient::<Row>(&files.results)?;
+    let mut seen = BTreeSet::new();
+    rows.retain(|r| seen.insert(r.run_key.clone()));
+    rows.sort_by_key(|r| r.trial);
+    write_table(&files.results, &rows)?;
+    let (mut traces, _) = read_lenient::<TraceRow>(&files.traces)?;
+    traces.sort_by_key(|t| t.trial);
+    write_table(&files.traces, &traces)?;
+    let (mut layers, _) = read_lenient::<LayerRow>(&files.layers)?;
+    let mut seen_layer = BTreeSet::new();
+    layers.retain(|l| seen.contains(&l.run_key) && seen_layer.insert((l.run_key.clone(), l.layer)));
+    layers.sort_by_key(|l| (l.trial, l.layer));
+    write_table(&files.layers, &layers)
+}
+
 /// Runs (or resumes) a plan into `opts.out`.
 pub fn run_plan(plan: &Plan, opts: &RunOptions) -> Result<RunSummary> {
     if let Some((i, n)) = opts.shard
@@ -423,40 +562,8 @@ pub fn run_plan(plan: &Plan, opts: &RunOptions) -> Result<RunSummary> {
     let planned = trials.len();
     let order: HashMap<String, usize> = trials.iter().map(|t| (t.key.clone(), t.index)).collect();
 
-    // resume: keep complete rows of this plan, drop torn lines and traces of unfinished trials
-    let (mut done_rows, torn) = read_lenient::<Row>(&files.results)?;
-    let before = done_rows.len();
-    let foreign = done_rows
-        .iter()
-        .filter(|r| !order.contains_key(&r.run_key))
-        .count();
-    if foreign > 0 && !opts.replace_foreign {
-        return Err(Error::invalid(
-            files.results.display().to_string(),
-            format!(
-                "{foreign} of its {before} trials do not belong to this plan (another plan, seed, \
-                 budget or shard wrote them); choose another --out directory"
-            ),
-        ));
-    }
-    let mut seen = BTreeSet::new();
-    done_rows.retain(|r| order.contains_key(&r.run_key) && seen.insert(r.run_key.clone()));
-    let (mut done_traces, torn_t) = read_lenient::<TraceRow>(&files.traces)?;
-    let before_t = done_traces.len();
-    done_traces.retain(|t| seen.contains(&t.run_key));
-    if torn || done_rows.len() != before {
-        write_table(&files.results, &done_rows)?;
-    }
-    if torn_t || done_traces.len() != before_t {
-        write_table(&files.traces, &done_traces)?;
-    }
-    let (mut done_layers, torn_l) = read_lenient::<LayerRow>(&files.layers)?;
-    let before_l = done_layers.len();
-    done_layers.retain(|l| seen.contains(&l.run_key));
-    if torn_l || done_layers.len() != before_l {
-        write_table(&files.layers, &done_layers)?;
-    }
-    let skipped = done_rows.len();
+    let seen = resume(&files, &order, opts.replace_foreign)?;
+    let skipped = seen.len();
     trials.retain(|t| !seen.contains(&t.key));
 
     // instances needed by the remaining trials
@@ -471,89 +578,14 @@ pub fn run_plan(plan: &Plan, opts: &RunOptions) -> Result<RunSummary> {
             .map(|&i| prepare(plan, i).map(|p| (i, p)))
             .collect::<Result<HashMap<_, _>>>()
     })?;
-
-    {
-        // instance table: the old one plus the instances prepared now, in plan order
-        let (mut rows, _) = read_lenient::<InstanceRow>(&files.instances)?;
-        for (&i, p) in &prepared {
-            let id = &plan.instances[i].id;
-            if !rows.iter().any(|r| &r.instance == id) {
-                rows.push(instance_row(id, &p.instance));
-            }
-        }
-        let pos: HashMap<&str, usize> = plan
-            .instances
-            .iter()
-            .enumerate()
-            .map(|(i, r)| (r.id.as_str(), i))
-            .collect();
-        rows.retain(|r| pos.contains_key(r.instance.as_str()));
-        rows.sort_by_key(|r| pos[r.instance.as_str()]);
-        write_table(&files.instances, &rows)?;
-    }
-    let writer = Mutex::new((
-        Appender::open::<Row>(&files.results)?,
-        Appender::open::<TraceRow>(&files.traces)?,
-        Appender::open::<LayerRow>(&files.layers)?,
-    ));
-    let bar = if opts.progress && std::io::stderr().is_terminal() {
-        ProgressBar::new(trials.len() as u64)
-    } else {
-        ProgressBar::with_draw_target(Some(trials.len() as u64), ProgressDrawTarget::hidden())
-    };
-    bar.set_style(
-        ProgressStyle::with_template(
-            "{bar:40} {pos}/{len} trials  {elapsed_precise} elapsed, ETA {eta_precise}  {msg}",
-        )
-        .unwrap_or_else(|_| ProgressStyle::default_bar()),
-    );
-    let failed = std::sync::atomic::AtomicUsize::new(0);
-    let res: Result<()> = pool.install(|| {
-        trials.par_iter().try_for_each(|t| {
-            let prep = &prepared[&t.instance];
-            let (row, traces, layers) = run_trial(plan, prep, t, calib);
-            if !row.feasible {
-                failed.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-            }
-            {
-                let mut w = writer
-                    .lock()
-                    .map_err(|_| Error::Param("writer lock poisoned".into()))?;
-                // traces first: a trial counts as done only once its result row is there
-                w.1.append(&traces)?;
-                w.2.append(&layers)?;
-                w.0.append(&[row])?;
-            }
-            bar.inc(1);
-            if opts.throttle_ms > 0 {
-                std::thread::sleep(Duration::from_millis(opts.throttle_ms));
-            }
-            Ok(())
-        })
-    });
-    bar.finish_and_clear();
-    res?;
-    drop(writer);
-
-    // finalise: rewrite in plan order so files do not depend on thread scheduling
-    let (mut rows, _) = read_lenient::<Row>(&files.results)?;
-    let mut seen = BTreeSet::new();
-    rows.retain(|r| seen.insert(r.run_key.clone()));
-    rows.sort_by_key(|r| r.trial);
-    write_table(&files.results, &rows)?;
-    let (mut traces, _) = read_lenient::<TraceRow>(&files.traces)?;
-    traces.sort_by_key(|t| t.trial);
-    write_table(&files.traces, &traces)?;
-    let (mut layers, _) = read_lenient::<LayerRow>(&files.layers)?;
-    let mut seen_layer = BTreeSet::new();
-    layers.retain(|l| seen.contains(&l.run_key) && seen_layer.insert((l.run_key.clone(), l.layer)));
-    layers.sort_by_key(|l| (l.trial, l.layer));
-    write_table(&files.layers, &layers)?;
+    write_instance_table(plan, &files, &prepared)?;
+    let failed = pool.install(|| run_trials(plan, opts, &files, &trials, &prepared, calib))?;
+    finalise(&files)?;
     let summary = RunSummary {
         planned,
         skipped,
         ran: trials.len(),
-        failed: failed.into_inner(),
+        failed,
         files: files.clone(),
     };
     write_manifest(plan, opts, &files, threads, calib, Some(&summary))?;
