@@ -163,9 +163,8 @@ fn optimize_svg(a: &OptimizeArgs) -> anyhow::Result<()> {
         .unwrap_or_else(|| pipe::DRAWING_SOLVER.to_string());
     let mut opts = svg_options(&d, &a.drawing, reversible, &solver, a.time_limit, a.seed);
     opts.max_evals = a.max_evals;
-    let out = pipe::optimize(&d, &opts)?;
-    let text = svg::write(&d, &out.strokes);
-    let segments = svg::verify(&d, "<optimized>", &text)?;
+    let mut out = pipe::optimize(&d, &opts)?;
+    let (text, segments) = pipe::render(&d, &mut out, pipe::Output::Svg)?;
     if let Some(o) = &a.output {
         write_atomic(o, text.as_bytes()).with_context(|| format!("writing {}", o.display()))?;
     }
@@ -185,6 +184,7 @@ fn optimize_svg(a: &OptimizeArgs) -> anyhow::Result<()> {
             "solve_s": out.solve_s,
             "total_s": total_s,
             "kept_original_scopes": out.kept_original,
+            "kept_note": out.note,
             "before": out.before,
             "after": out.after,
         });
@@ -201,6 +201,9 @@ fn optimize_svg(a: &OptimizeArgs) -> anyhow::Result<()> {
         );
         for s in &d.skipped {
             say!("skipped: {s}");
+        }
+        if let Some(n) = &out.note {
+            say!("note: the drawing is kept in its original order ({n})");
         }
         let pct = |x: f64, y: f64| if x > 0.0 { 100.0 * (x - y) / x } else { 0.0 };
         let (b, f) = (&out.before, &out.after);
@@ -274,7 +277,7 @@ fn optimize_dxf(a: &OptimizeArgs) -> anyhow::Result<()> {
     let mut opts = svg_options(&d, &a.drawing, reversible, &solver, a.time_limit, a.seed);
     opts.max_evals = a.max_evals;
     opts.cut = !a.drawing.no_inner_first;
-    let out = pipe::optimize(&d, &opts)?;
+    let mut out = pipe::optimize(&d, &opts)?;
     let post = dxf::Post {
         safe_height: a.drawing.safe_height,
         depth: a.drawing.cut_depth,
@@ -288,15 +291,12 @@ fn optimize_dxf(a: &OptimizeArgs) -> anyhow::Result<()> {
         .as_ref()
         .and_then(|o| o.extension())
         .is_some_and(|e| e.eq_ignore_ascii_case("svg"));
-    let (text, segments) = if preview {
-        let t = svg::write(&d, &out.strokes);
-        let n = svg::verify(&d, "<optimized>", &t)?;
-        (t, n)
+    let kind = if preview {
+        pipe::Output::Svg
     } else {
-        let t = dxf::write_gcode(&d, &out.strokes, &post);
-        let n = dxf::verify_gcode(&d, "<optimized>", &t, &post)?;
-        (t, n)
+        pipe::Output::Gcode(&post)
     };
+    let (text, segments) = pipe::render(&d, &mut out, kind)?;
     if let Some(o) = &a.output {
         write_atomic(o, text.as_bytes()).with_context(|| format!("writing {}", o.display()))?;
     }
@@ -318,6 +318,7 @@ fn optimize_dxf(a: &OptimizeArgs) -> anyhow::Result<()> {
             "skipped": d.skipped,
             "warnings": d.warnings,
             "mm_per_unit": d.mm_per_unit,
+            "kept_note": out.note,
             "solve_s": out.solve_s,
             "total_s": total_s,
             "before": out.before,
@@ -336,6 +337,9 @@ fn optimize_dxf(a: &OptimizeArgs) -> anyhow::Result<()> {
         );
         for s in &d.skipped {
             say!("skipped: {s}");
+        }
+        if let Some(n) = &out.note {
+            say!("note: the drawing is kept in its original order ({n})");
         }
         say!(
             "travel mm (file order -> optimized): {:.1} -> {:.1}; pierces {} -> {}",
