@@ -1,6 +1,7 @@
 //! G-code import, reordering, writing and verification on small self-written fixtures.
 
-use cellseq::io::gcode::{self, Options};
+use cellseq::io::gcode;
+use cellseq::pipeline::gcode::{Options, optimize};
 use proptest::prelude::*;
 
 const FIXTURES: [&str; 3] = ["mill.ngc", "laser.gcode", "inch_plasma.ngc"];
@@ -18,7 +19,7 @@ fn optimize_keeps_every_cut_and_never_adds_air() {
     for name in FIXTURES {
         let text = fixture(name);
         let p = gcode::parse(name, &text).unwrap();
-        let out = gcode::optimize(&p, &Options::default()).unwrap();
+        let out = optimize(&p, &Options::default()).unwrap();
         let mut sorted = out.order.clone();
         sorted.sort();
         assert_eq!(
@@ -66,7 +67,7 @@ fn mill_fixture_rules() {
     assert!(inst.precedence.contains(&(at(39), at(43))));
     // the solver's order follows them; here it is worse on lifts than the program's own
     // order, which is then kept (never worse): the rules are checked on the solver's order
-    let out = gcode::optimize(&p, &Options::default()).unwrap();
+    let out = optimize(&p, &Options::default()).unwrap();
     assert!(out.after.not_worse_than(&out.before));
     if out.kept == cellseq::pipeline::gcode::Kept::Whole {
         assert_eq!(out.text, text);
@@ -94,7 +95,7 @@ fn mill_fixture_rules() {
 fn tampered_output_is_rejected() {
     let text = fixture("mill.ngc");
     let p = gcode::parse("mill.ngc", &text).unwrap();
-    let out = gcode::optimize(&p, &Options::default()).unwrap();
+    let out = optimize(&p, &Options::default()).unwrap();
     let bad = out.text.replacen("G1 X40 F600", "G1 X40.01 F600", 1);
     assert_ne!(bad, out.text);
     let e = gcode::verify_files("mill.ngc", &text, "bad.ngc", &bad).unwrap_err();
@@ -126,13 +127,13 @@ fn unsupported_constructs_are_refused_with_line() {
 fn merge_tool_blocks_reduces_changes() {
     let src = "G21 G90\nT1 M6\nG0 Z5\nG0 X0 Y0\nG1 Z-1 F100\nG0 Z5\nT2 M6\nG0 X10 Y0\nG1 Z-1 F100\nG0 Z5\nT1 M6\nG0 X1 Y0\nG1 Z-1 F100\nG0 Z5\nM2\n";
     let p = gcode::parse("m.ngc", src).unwrap();
-    let keep = gcode::optimize(&p, &Options::default()).unwrap();
+    let keep = optimize(&p, &Options::default()).unwrap();
     assert_eq!(keep.after.tool_changes, 3);
     let opts = Options {
         merge: true,
         ..Options::default()
     };
-    let merged = gcode::optimize(&p, &opts).unwrap();
+    let merged = optimize(&p, &opts).unwrap();
     assert_eq!(merged.after.tool_changes, 2);
     assert_eq!(merged.cuts, keep.cuts);
 }
@@ -153,7 +154,7 @@ proptest! {
     fn random_bytes_never_panic(bytes in proptest::collection::vec(any::<u8>(), 0..400)) {
         let text = String::from_utf8_lossy(&bytes);
         if let Ok(p) = gcode::parse("f.ngc", &text) {
-            let _ = gcode::optimize(&p, &Options::default());
+            let _ = optimize(&p, &Options::default());
         }
     }
 
@@ -173,7 +174,7 @@ proptest! {
         let text = toks.join(" ");
         if let Ok(p) = gcode::parse("f.ngc", &text) {
             // whatever the solver does, the written program must verify or be refused
-            let _ = gcode::optimize(&p, &Options::default());
+            let _ = optimize(&p, &Options::default());
         }
     }
 }
@@ -199,7 +200,7 @@ fn operator_state_stays_unset() {
     // must not set any of them, and must link at the program's own Z2, not its final Z30
     let text = fixture("operator_state.ngc");
     let p = gcode::parse("operator_state.ngc", &text).unwrap();
-    let out = gcode::optimize(&p, &Options::default()).unwrap();
+    let out = optimize(&p, &Options::default()).unwrap();
     assert!(!out.kept_original(), "{:?}", out.note);
     assert_ne!(out.text, text);
     assert!(
@@ -223,7 +224,7 @@ fn state_is_reestablished_only_where_the_order_changed_it() {
     let src = "G21 G90\nS1000 M3\nG0 Z5\nG0 X50 Y0\nG1 Z-1 F100\nG1 X60\nG0 Z5\nG0 X0 Y0\nG1 Z-1\nG1 X10\nG0 Z5\nM8\nG0 X52 Y0\nG1 Z-1\nG1 X58\nG0 Z5\nS2000\nG0 X2 Y0\nG1 Z-1\nG1 X8\nG0 Z5\nG0 X54 Y1\nG1 Z-1\nG1 X56\nG0 Z5\nM5 M9\nM2\n";
     let p = gcode::parse("s.ngc", src).unwrap();
     let first_m8 = p.layout.cells.iter().position(|c| c.state.flood).unwrap();
-    let out = gcode::optimize(&p, &Options::default()).unwrap();
+    let out = optimize(&p, &Options::default()).unwrap();
     assert!(modal_words(&out.text).is_subset(&modal_words(src)));
     let pos = |c: usize| out.order.iter().position(|&x| x == c).unwrap();
     for c in 0..first_m8 {
@@ -265,7 +266,7 @@ fn as_given_writes_the_program_as_it_is() {
     ] {
         let text = fixture(name);
         let p = gcode::parse(name, &text).unwrap();
-        let out = gcode::optimize(
+        let out = optimize(
             &p,
             &Options {
                 solver: "as-given".into(),
@@ -285,7 +286,7 @@ fn silkscreen_at_z0_is_sequenced_by_strokes() {
     let text = fixture("silkscreen_z0.ngc");
     let p = gcode::parse("silkscreen_z0.ngc", &text).unwrap();
     assert_eq!(p.layout.cells.len(), 4);
-    let out = gcode::optimize(&p, &Options::default()).unwrap();
+    let out = optimize(&p, &Options::default()).unwrap();
     assert!(out.after.air_length < out.before.air_length);
     assert_eq!(out.reversed.iter().filter(|&&r| r).count(), 0);
 }
@@ -294,7 +295,7 @@ fn silkscreen_at_z0_is_sequenced_by_strokes() {
 fn grbl_dialect_is_carried_through_in_place() {
     let text = fixture("grbl_dialect.nc");
     let p = gcode::parse("grbl_dialect.nc", &text).unwrap();
-    let out = gcode::optimize(&p, &Options::default()).unwrap();
+    let out = optimize(&p, &Options::default()).unwrap();
     let keep = |t: &str| -> Vec<String> {
         t.lines()
             .filter(|l| l.starts_with('$') || l.contains("G28") || l.contains("G53"))
@@ -319,7 +320,7 @@ fn grbl_dialect_is_carried_through_in_place() {
 fn unicode_whitespace_is_written_as_ascii() {
     let src = "G21 G90\u{a0}\nG0 Z5\nG0\u{2028}X0 Y0\nG1 Z-1 F100\nG1 X10\u{85}\nG0 Z5 (caf\u{e9}\u{a0})\nG0 X20 Y0\nG1 Z-1\nG1 X30\nG0 Z5\nM2\n";
     let p = gcode::parse("u.ngc", src).unwrap();
-    let out = gcode::optimize(&p, &Options::default()).unwrap();
+    let out = optimize(&p, &Options::default()).unwrap();
     let code: String = out
         .text
         .lines()
@@ -360,7 +361,7 @@ fn never_worse_on_any_figure() {
     ] {
         let text = fixture(name);
         let p = gcode::parse(name, &text).unwrap();
-        let out = gcode::optimize(&p, &Options::default()).unwrap();
+        let out = optimize(&p, &Options::default()).unwrap();
         assert!(
             out.after.not_worse_than(&out.before),
             "{name}: {:?} vs {:?}",

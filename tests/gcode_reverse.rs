@@ -1,7 +1,8 @@
 //! Reversal of G-code cells: air saved on a laser program, arcs (IJK and R, both directions,
 //! full circle, inch) reversed and verified, milling off by default and refused per cell.
 
-use cellseq::io::gcode::{self, Options, interp::CutKind};
+use cellseq::io::gcode::{self, interp::CutKind};
+use cellseq::pipeline::gcode::{Options, optimize};
 
 fn fixture(name: &str) -> String {
     std::fs::read_to_string(format!(
@@ -22,8 +23,8 @@ fn opts(reversible: Option<bool>) -> Options {
 fn laser_reversal_reduces_air_and_verifies() {
     let text = fixture("laser_zigzag.gcode");
     let p = gcode::parse("laser_zigzag.gcode", &text).unwrap();
-    let on = gcode::optimize(&p, &opts(None)).unwrap(); // 2-D: on by default
-    let off = gcode::optimize(&p, &opts(Some(false))).unwrap();
+    let on = optimize(&p, &opts(None)).unwrap(); // 2-D: on by default
+    let off = optimize(&p, &opts(Some(false))).unwrap();
     assert_eq!(off.reversible_cells, 0);
     assert!(off.reversed.iter().all(|&r| !r));
     assert!(on.reversible_cells >= 3);
@@ -143,10 +144,10 @@ fn arc_centres_and_feeds_kept() {
 fn milling_not_reversed_by_default_and_refused_per_cell() {
     let text = fixture("mill_feed_retract.ngc");
     let p = gcode::parse("mill_feed_retract.ngc", &text).unwrap();
-    let def = gcode::optimize(&p, &opts(None)).unwrap();
+    let def = optimize(&p, &opts(None)).unwrap();
     assert_eq!(def.reversible_cells, 0);
     assert!(def.reversed.iter().all(|&r| !r));
-    let on = gcode::optimize(&p, &opts(Some(true))).unwrap();
+    let on = optimize(&p, &opts(Some(true))).unwrap();
     // three single-depth slots plunged and retracted at feed; the two-depth cell and the
     // rapid-retract cell stay one-mode
     assert_eq!(on.reversible_cells, 3);
@@ -157,12 +158,7 @@ fn milling_not_reversed_by_default_and_refused_per_cell() {
     // the usual G1 plunge + G0 retract program has no reversible cell
     let mill = fixture("mill.ngc");
     let m = gcode::parse("mill.ngc", &mill).unwrap();
-    assert_eq!(
-        gcode::optimize(&m, &opts(Some(true)))
-            .unwrap()
-            .reversible_cells,
-        0
-    );
+    assert_eq!(optimize(&m, &opts(Some(true))).unwrap().reversible_cells, 0);
 }
 
 #[test]
@@ -241,8 +237,8 @@ mod props {
             let back = all_reversed(&q);
             gcode::verify_with(&p, "back", &back, false)
                 .map_err(|e| TestCaseError::fail(format!("{e}\n{text}\n{back}")))?;
-            let out = gcode::optimize(&p, &opts(None)).unwrap();
-            let off = gcode::optimize(&p, &opts(Some(false))).unwrap();
+            let out = optimize(&p, &opts(None)).unwrap();
+            let off = optimize(&p, &opts(Some(false))).unwrap();
             prop_assert_eq!(out.cuts, off.cuts);
         }
     }

@@ -959,17 +959,6 @@ fn row(file: &str, run: &str, o: &Outcome) -> String {
     }
 }
 
-/// Programs whose rewrite rs274 still finds not state-exact: in each, a dwell (`G4`) that sat
-/// in the gap between two cells runs in another state after the reorder (pcb2gcode's drill
-/// program: the dwell after a tool's spindle start lands in another tool's state; its
-/// silkscreen program: two `G4 P0` at the cutting height now run at the link height). They are
-/// listed so that the test still judges them (and fails when a new file joins them, or when one
-/// of them passes and should leave the list); issue 25 stays open until the list is empty.
-const KNOWN_FAILURES: &[&str] = &[
-    "real/pcb2gcode_easysdr_drill.ngc",
-    "real/pcb2gcode_keyboard_silkscreen_front.ngc",
-];
-
 /// Every program of the corpus, rewritten by cellseq three ways, judged by rs274.
 #[test]
 fn rs274_corpus_state_exact() {
@@ -1012,40 +1001,20 @@ fn rs274_corpus_state_exact() {
         "|---|---|---|---|---|---|---|".to_string(),
     ];
     let mut failed = Vec::new();
-    let mut still_known = Vec::new();
     for (i, r, o) in &results {
         let f = rel(&files[*i]);
         table.push(row(&f, RUNS[*r].0, o));
-        let known = KNOWN_FAILURES.iter().any(|k| *k == f);
-        match (o.passed(), known) {
-            (false, false) => failed.push(format!("{f} ({})", RUNS[*r].0)),
-            (false, true) => still_known.push(format!("{f} ({})", RUNS[*r].0)),
-            (true, _) => {}
+        if !o.passed() {
+            failed.push(format!("{f} ({})", RUNS[*r].0));
         }
     }
-    // a known failure that passes in every option set must leave the list
-    for k in KNOWN_FAILURES {
-        if filter.is_empty() || k.contains(&filter) {
-            assert!(
-                still_known.iter().any(|s| s.starts_with(k)),
-                "{k} passes now: remove it from KNOWN_FAILURES"
-            );
-        }
-    }
-    if !still_known.is_empty() {
-        println!(
-            "known failures (issue 25, open; see notes/gcode-corpus.md): {}",
-            still_known.join(", ")
-        );
-    }
-    let passed = results.len() - failed.len() - still_known.len();
+    let passed = results.len() - failed.len();
     table.push(String::new());
     table.push(format!(
-        "{passed} of {} runs pass ({} files × {} option sets); {} known failures.",
+        "{passed} of {} runs pass ({} files × {} option sets).",
         results.len(),
         files.len(),
-        RUNS.len(),
-        still_known.len()
+        RUNS.len()
     ));
     let table = table.join("\n");
     println!("{table}");

@@ -164,10 +164,13 @@ fn optimize_options(a: &OptimizeArgs, d: &svg::Drawing) -> (String, bool, pipe::
     (solver, reversible, opts)
 }
 
-/// The elements the reader skipped, one line each.
-fn say_skipped(d: &svg::Drawing) {
+/// The elements the reader skipped, and the note when the original order was kept.
+fn say_skipped(d: &svg::Drawing, note: Option<&String>) {
     for s in &d.skipped {
         say!("skipped: {s}");
+    }
+    if let Some(n) = note {
+        say!("note: the drawing is kept in its original order ({n})");
     }
 }
 
@@ -177,9 +180,8 @@ fn optimize_svg(a: &OptimizeArgs) -> anyhow::Result<()> {
     let d = read_svg(&a.input, &a.drawing)?;
     let read_s = t0.elapsed().as_secs_f64();
     let (solver, reversible, opts) = optimize_options(a, &d);
-    let out = pipe::optimize(&d, &opts)?;
-    let text = svg::write(&d, &out.strokes);
-    let segments = svg::verify(&d, "<optimized>", &text)?;
+    let mut out = pipe::optimize(&d, &opts)?;
+    let (text, segments) = pipe::render(&d, &mut out, pipe::Output::Svg)?;
     write_output(a.output.as_deref(), &text)?;
     let total_s = t0.elapsed().as_secs_f64();
     if a.json {
@@ -197,6 +199,7 @@ fn optimize_svg(a: &OptimizeArgs) -> anyhow::Result<()> {
             "solve_s": out.solve_s,
             "total_s": total_s,
             "kept_original_scopes": out.kept_original,
+            "kept_note": out.note,
             "before": out.before,
             "after": out.after,
         });
@@ -211,7 +214,7 @@ fn optimize_svg(a: &OptimizeArgs) -> anyhow::Result<()> {
             total_s,
             segments
         );
-        say_skipped(&d);
+        say_skipped(&d, out.note.as_ref());
         let (b, f) = (&out.before, &out.after);
         let t = Table::new(20);
         t.saved("pen-up mm (layer)", b.pen_up_mm, f.pen_up_mm);
@@ -258,7 +261,7 @@ fn optimize_dxf(a: &OptimizeArgs) -> anyhow::Result<()> {
     }
     let (solver, reversible, mut opts) = optimize_options(a, &d);
     opts.cut = !a.drawing.no_inner_first;
-    let out = pipe::optimize(&d, &opts)?;
+    let mut out = pipe::optimize(&d, &opts)?;
     let post = dxf::Post {
         safe_height: a.drawing.safe_height,
         depth: a.drawing.cut_depth,
@@ -272,15 +275,12 @@ fn optimize_dxf(a: &OptimizeArgs) -> anyhow::Result<()> {
         .as_ref()
         .and_then(|o| o.extension())
         .is_some_and(|e| e.eq_ignore_ascii_case("svg"));
-    let (text, segments) = if preview {
-        let t = svg::write(&d, &out.strokes);
-        let n = svg::verify(&d, "<optimized>", &t)?;
-        (t, n)
+    let kind = if preview {
+        pipe::Output::Svg
     } else {
-        let t = dxf::write_gcode(&d, &out.strokes, &post);
-        let n = dxf::verify_gcode(&d, "<optimized>", &t, &post)?;
-        (t, n)
+        pipe::Output::Gcode(&post)
     };
+    let (text, segments) = pipe::render(&d, &mut out, kind)?;
     write_output(a.output.as_deref(), &text)?;
     let total_s = t0.elapsed().as_secs_f64();
     let closed = d.strokes.iter().filter(|s| s.closed).count();
@@ -300,6 +300,7 @@ fn optimize_dxf(a: &OptimizeArgs) -> anyhow::Result<()> {
             "skipped": d.skipped,
             "warnings": d.warnings,
             "mm_per_unit": d.mm_per_unit,
+            "kept_note": out.note,
             "solve_s": out.solve_s,
             "total_s": total_s,
             "before": out.before,
@@ -316,7 +317,7 @@ fn optimize_dxf(a: &OptimizeArgs) -> anyhow::Result<()> {
             out.solve_s,
             segments
         );
-        say_skipped(&d);
+        say_skipped(&d, out.note.as_ref());
         say!(
             "travel mm (file order -> optimized): {:.1} -> {:.1}; pierces {} -> {}",
             out.before.pen_up_total_mm,

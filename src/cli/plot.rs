@@ -103,7 +103,10 @@ fn panels_of(
             let parsed = gcode::parse(&file, &text)?;
             out.push(cellseq::plot::program_panel(title, &parsed.program));
             if optimized {
-                let o = gcode::optimize(&parsed, &gcode::Options::default())?;
+                let o = cellseq::pipeline::gcode::optimize(
+                    &parsed,
+                    &cellseq::pipeline::gcode::Options::default(),
+                )?;
                 let prog = gcode::interp::interpret(&o.text)
                     .map_err(|(l, m)| anyhow::anyhow!("<optimized>:{l}: {m}"))?;
                 out.push(cellseq::plot::program_panel("optimized", &prog));

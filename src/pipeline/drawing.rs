@@ -1,13 +1,18 @@
-//! The drawing pipeline: a drawing's strokes, grouped in scopes (layer and stroke colour) in
-//! their required order, become one instance per scope; a registry solver sequences it under
-//! the caller's budget; the file's own order is kept where the solver's is not shorter; the
-//! caller then writes and verifies. Cut mode adds inner-before-outer precedence.
+//! The drawing pipeline, the same steps as the G-code one: a drawing's strokes, grouped in
+//! scopes (layer and stroke colour) in their required order, become one instance per scope; a
+//! registry solver sequences it with the scope's share of the command's [`Allowance`]
+//! ([`solve_group`]: the file's own order kept where the solver's is not shorter); [`render`]
+//! writes the result (SVG, or G-code from a DXF) and verifies it, keeping the file's order if
+//! the new one fails the check; the caller writes the text atomically. Cut mode adds
+//! inner-before-outer precedence.
 
+use super::{Allowance, solve_group};
 use crate::error::{Error, Result};
 use crate::geom::Point3;
 use crate::io::drawing::{Drawing, PenUp, Stroke, dist, pen_up};
+use crate::io::dxf::{self, Post};
+use crate::io::svg;
 use crate::model::{Cell, Instance, Machine, Metadata, Mode, Objective, StepKind, Tool, Visit};
-use crate::solvers::{self, Budget, NoObserver};
 
 /// The registry solver drawings get by default ([`crate::solvers::drawing`]).
 pub const DRAWING_SOLVER: &str = "drawing";
@@ -352,65 +357,63 @@ pub struct Optimized {
     pub scopes: usize,
     /// Precedence edges (cut mode).
     pub edges: usize,
-    /// The solver's order was worse than the file's in some scope; that scope kept its order.
+    /// Scopes where the solver's order was not shorter than the file's: they kept the file's
+    /// order.
     pub kept_original: usize,
+    /// Why the whole drawing was kept in the file's order, when it was (the new order failed
+    /// the built-in check; see [`render`]).
+    pub note: Option<String>,
 }
 
 fn layer_label(d: &Drawing) -> impl Fn(&Stroke) -> String + '_ {
     move |s: &Stroke| d.layers[s.layer].label.clone()
 }
 
-/// Sequences each scope with a registry solver (air-travel objective, start at the previous
-/// scope's exit, the first at the origin).
+/// The default evaluation budget of a scope of `size` strokes (no time limit, no evaluation
+/// budget given): [`EVALS_PER_STROKE`] per stroke, at least [`MIN_EVALS`].
+pub fn default_evals(size: usize) -> u64 {
+    (EVALS_PER_STROKE * size as u64).max(MIN_EVALS)
+}
+
+/// [`optimize_within`] with an allowance starting now, from the options' budget.
 pub fn optimize(d: &Drawing, opts: &Options) -> Result<Optimized> {
+    optimize_within(d, opts, &Allowance::new(opts.time_limit, opts.max_evals))
+}
+
+/// Sequences each scope with a registry solver through the steps the G-code pipeline uses:
+/// the scope's share of the command's [`Allowance`], [`solve_group`] (air-travel objective,
+/// start at the previous scope's exit, the first at the origin; the file's order kept unless
+/// the solver's is shorter). [`render`] then writes and verifies the result.
+pub fn optimize_within(d: &Drawing, opts: &Options, allowance: &Allowance) -> Result<Optimized> {
     let mut sc = scopes(d, opts.scopes);
     if opts.cut && sc.len() > 1 {
         sc = inner_scopes_first(d, sc, opts.contain_tol);
     }
     let total = d.strokes.len().max(1);
+    let mut left = total;
     let mut home = [0.0, 0.0];
     let mut out: Vec<Stroke> = Vec::with_capacity(d.strokes.len());
     let mut solve_s = 0.0;
     let mut edges = 0;
     let mut kept = 0;
+    // keep time for writing and verifying: both linear in the drawing
+    let reserve_s = 0.02 * allowance.time_limit.unwrap_or(0.0);
     for s in &sc {
         let (inst, orient) = scope_instance(d, s, home, opts);
         edges += inst.precedence.len();
-        crate::validate::validate(&inst, &d.file)?;
-        let share = s.len() as f64 / total as f64;
-        let default_evals = (opts.time_limit.is_none() && opts.max_evals.is_none())
-            .then(|| (EVALS_PER_STROKE * s.len() as u64).max(MIN_EVALS));
-        let budget = Budget {
-            time_limit: opts
-                .time_limit
-                .map(|t| std::time::Duration::from_secs_f64(t * share)),
-            max_evals: opts
-                .max_evals
-                .map(|e| ((e as f64 * share) as u64).max(1))
-                .or(default_evals),
-        };
-        let r = solvers::run(
-            &opts.solver,
+        let budget = allowance.share_or(s.len(), left, total, reserve_s, default_evals(s.len()));
+        left = left.saturating_sub(s.len());
+        let r = solve_group(
             &inst,
             Objective::Air,
+            &opts.solver,
             &opts.params,
             opts.seed,
             budget,
-            &mut NoObserver,
         )?;
         solve_s += r.elapsed_s;
-        let (seq, cost) = (r.outcome.sequence, r.report.cost);
-        let given = inst.as_given.clone().unwrap_or_default();
-        let given_cost = crate::check::check(&inst, &given, Objective::Air)
-            .map(|r| r.cost)
-            .unwrap_or(f64::INFINITY);
-        let seq: Vec<Visit> = if cost > given_cost + 1e-9 {
-            kept += 1;
-            given
-        } else {
-            seq
-        };
-        for v in &seq {
+        kept += usize::from(r.kept_original && opts.solver != "as-given");
+        for v in &r.sequence {
             let (rev, k) = orient[v.cell][v.mode];
             out.push(d.strokes[s[v.cell]].oriented(rev, k));
         }
@@ -427,5 +430,48 @@ pub fn optimize(d: &Drawing, opts: &Options) -> Result<Optimized> {
         scopes: sc.len(),
         edges,
         kept_original: kept,
+        note: None,
     })
+}
+
+/// What [`render`] writes.
+#[derive(Debug, Clone, Copy)]
+pub enum Output<'a> {
+    /// The drawing as SVG (also the preview of a DXF).
+    Svg,
+    /// A DXF's G-code, by its post.
+    Gcode(&'a Post),
+}
+
+/// Writes the optimized drawing as `output` and verifies the text against the input (the same
+/// segments, the kept elements; for G-code, the post's own check). When the new order fails
+/// the check, the file's order is written instead (and verified), `opt` is updated to say so
+/// and why; when that fails too, the error is returned. Returns the text and the number of
+/// segments verified; the caller writes it atomically.
+pub fn render(d: &Drawing, opt: &mut Optimized, output: Output) -> Result<(String, usize)> {
+    let emit = |strokes: &[Stroke]| -> Result<(String, usize)> {
+        match output {
+            Output::Svg => {
+                let t = svg::write(d, strokes);
+                let n = svg::verify(d, "<optimized>", &t)?;
+                Ok((t, n))
+            }
+            Output::Gcode(post) => {
+                let t = dxf::write_gcode(d, strokes, post);
+                let n = dxf::verify_gcode(d, "<optimized>", &t, post)?;
+                Ok((t, n))
+            }
+        }
+    };
+    match emit(&opt.strokes) {
+        Ok(r) => Ok(r),
+        // when in doubt, keep the original: the file's order, checked the same way
+        Err(e) => {
+            let r = emit(&d.strokes)?;
+            opt.strokes = d.strokes.clone();
+            opt.after = opt.before;
+            opt.note = Some(format!("the new order failed the built-in check: {e}"));
+            Ok(r)
+        }
+    }
 }

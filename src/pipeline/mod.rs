@@ -74,6 +74,21 @@ impl Allowance {
     /// shared by size among what is left, so a group that finishes early leaves its time to
     /// the next; evaluations are shared by size of the whole (`total` items), deterministically.
     pub fn share(&self, size: usize, left: usize, total: usize, reserve_s: f64) -> Budget {
+        let default = (size as u64 * 20_000).clamp(100_000, 10_000_000);
+        self.share_or(size, left, total, reserve_s, default)
+    }
+
+    /// [`share`](Self::share) with the evaluation budget a group gets when the command has
+    /// neither a time limit nor an evaluation budget (`default_evals`: each input kind has its
+    /// own, deterministic and linear in the group's size).
+    pub fn share_or(
+        &self,
+        size: usize,
+        left: usize,
+        total: usize,
+        reserve_s: f64,
+        default_evals: u64,
+    ) -> Budget {
         let frac = |part: usize, whole: usize| part as f64 / whole.max(1) as f64;
         let time_limit = self.remaining_s().map(|r| {
             let usable = (r - reserve_s).max(0.0);
@@ -82,7 +97,7 @@ impl Allowance {
         let max_evals = match (self.max_evals, self.time_limit) {
             (Some(n), _) => Some(((n as f64) * frac(size, total)).ceil().max(1.0) as u64),
             // without a time limit: an evaluation budget, so the output is deterministic
-            (None, None) => Some((size as u64 * 20_000).clamp(100_000, 10_000_000)),
+            (None, None) => Some(default_evals),
             (None, Some(_)) => None,
         };
         Budget {

@@ -9,6 +9,8 @@
 //! lists of the K nearest cells ([`crate::engine::neighbours`], k-d trees, no n × n matrix).
 //! Then, while the budget lasts, iterated local search: a random swap of two short adjacent
 //! blocks, the queue-driven repair around it, and the change undone unless it saves travel.
+//! Last, on drawings of up to 3000 strokes, sweeps of 2-opt and Or-opt over every pair (not
+//! only the candidate lists) to a local optimum.
 //! Every move costs O(1) to evaluate; a 2-opt costs the length of the reversed block to
 //! apply. Other instances (precedence, several tools, lifts, matrix costs) get `local-search`.
 
@@ -91,6 +93,7 @@ impl Solver for Drawing {
         while limited && !ctx.exhausted() {
             p.kick(ctx, &mut rng, self.kick_len);
         }
+        p.polish(ctx);
         let out = outcome_of(m, p.t);
         ctx.report(out.cost);
         Ok(out)
@@ -184,6 +187,12 @@ struct Path<'m> {
 }
 
 const EPS: f64 = 1e-9;
+
+/// Largest drawing (strokes) that gets the final all-pairs pass ([`Path::polish`]).
+const POLISH_MAX: usize = 3000;
+
+/// Most sweeps of the final all-pairs pass.
+const POLISH_SWEEPS: usize = 20;
 
 impl<'m> Path<'m> {
     fn new(m: &'m CostModel, t: Vec<Visit>, cands: Vec<Vec<u32>>) -> Self {
@@ -478,6 +487,77 @@ impl<'m> Path<'m> {
             self.log.truncate(mark);
         } else {
             self.undo(mark);
+        }
+    }
+
+    /// Cost of going from `a` to `b` (`None`: the path's start or end).
+    fn link(&self, a: Option<Visit>, b: Option<Visit>) -> f64 {
+        match (a, b) {
+            (Some(a), Some(b)) => self.m.arc(a.cell, a.mode, b.cell, b.mode),
+            (None, Some(b)) => self.m.start(b.cell, b.mode),
+            (Some(a), None) => self.m.finish(a.cell, a.mode),
+            (None, None) => 0.0,
+        }
+    }
+
+    /// The final pass to a local optimum over every pair, not only the candidate lists:
+    /// sweeps of 2-opt (every block reversed, strokes turned) and Or-opt (every stroke moved to
+    /// every place, in every mode) until a sweep finds nothing, on drawings of at most
+    /// [`POLISH_MAX`] strokes, at most [`POLISH_SWEEPS`] sweeps. It runs after the budget (a
+    /// sweep is O(n²) cheap evaluations, milliseconds at the cap) and depends on nothing but
+    /// the path, so results stay deterministic.
+    fn polish(&mut self, ctx: &mut Context) {
+        let n = self.t.len();
+        if n > POLISH_MAX {
+            return;
+        }
+        for _ in 0..POLISH_SWEEPS {
+            let mut improved = false;
+            for i in 0..n {
+                for j in i + 1..n {
+                    if self.reverse_gain(i, j) > EPS {
+                        self.reverse(i, j);
+                        improved = true;
+                    }
+                }
+            }
+            ctx.count((n * n / 2) as u64);
+            for p in 0..n {
+                let v = self.t[p];
+                let (prev, next) = (
+                    p.checked_sub(1).map(|k| self.t[k]),
+                    self.t.get(p + 1).copied(),
+                );
+                let removal =
+                    self.link(prev, Some(v)) + self.link(Some(v), next) - self.link(prev, next);
+                // the path without v: s[k] = t[k] before p, t[k + 1] from p on
+                let s = |k: usize| if k < p { self.t[k] } else { self.t[k + 1] };
+                let mut best = (EPS, p, v.mode);
+                for to in 0..n {
+                    let a = (to > 0).then(|| s(to - 1));
+                    let b = (to + 1 < n).then(|| s(to));
+                    let gap = self.link(a, b);
+                    for md in 0..self.m.modes(v.cell) {
+                        if to == p && md == v.mode {
+                            continue;
+                        }
+                        let w = Visit::new(v.cell, md);
+                        let g = removal - (self.link(a, Some(w)) + self.link(Some(w), b) - gap);
+                        if g > best.0 {
+                            best = (g, to, md);
+                        }
+                    }
+                }
+                ctx.count(n as u64);
+                if best.0 > EPS {
+                    self.move_to(p, best.1, best.2);
+                    improved = true;
+                }
+            }
+            self.log.clear();
+            if !improved {
+                break;
+            }
         }
     }
 

@@ -245,6 +245,7 @@ pub fn split(p: &Program) -> Result<Layout, (usize, String)> {
                         g <= last_change
                             || p.lines[g].motion == Motion::None
                             || has_other_words(p, g)
+                            || vertical(p, g)
                     })
                     .collect(),
                 gap_start: prev_end,
@@ -500,6 +501,19 @@ fn cuts_something(li: &super::interp::LineInfo) -> bool {
     li.cuts
         .iter()
         .any(|c| !matches!(c.kind, CutKind::Line) || c.length() > super::verify::ZERO_MOVE)
+}
+
+/// True for a rapid that moves only in Z (a block's descent to its working height after a
+/// tool change): the writer keeps it in a block's preamble so that what follows (a dwell while
+/// the spindle comes up to speed) happens at the height the program gives it.
+pub fn vertical(p: &Program, i: usize) -> bool {
+    let li = &p.lines[i];
+    li.motion == Motion::Rapid
+        && li.cuts.is_empty()
+        && !li.words.has('X')
+        && !li.words.has('Y')
+        && matches!((li.pos_before, li.pos_after), (a, b) if a[0] == b[0] && a[1] == b[1])
+        && li.pos_after[2].is_some()
 }
 
 /// True when some cut runs below `safe`.

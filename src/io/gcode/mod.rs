@@ -83,8 +83,6 @@ pub fn groups(p: &Parsed, merge: bool) -> Vec<Vec<usize>> {
     out
 }
 
-pub use crate::pipeline::gcode::{Optimized, Options, optimize};
-
 fn p3(a: [f64; 3]) -> Point3 {
     Point3::new(a[0], a[1], a[2])
 }
@@ -227,7 +225,7 @@ fn with_leads(l: &Layout, cells: &[usize], margin: f64) -> (Vec<(usize, usize)>,
 }
 
 /// The whole program as one instance (groups chained by precedence), for `cellseq import`;
-/// `reversible` as in [`Options::reversible`].
+/// `reversible` as in `pipeline::gcode::Options::reversible`.
 pub fn import(p: &Parsed, merge: bool, margin: f64, reversible: Option<bool>) -> Result<Instance> {
     let gs = groups(p, merge);
     let all: Vec<usize> = gs.iter().flatten().copied().collect();

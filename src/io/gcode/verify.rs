@@ -470,7 +470,13 @@ fn events(li: &LineInfo, text: &str) -> Vec<(bool, u128)> {
     if li.dwell {
         v.push((
             true,
-            hash128(&("dwell", w.get('P').map(|x| (x * 1e6) as i64), t)),
+            // at its height (at the bottom of a hole, or where the spindle comes up to speed)
+            hash128(&(
+                "dwell",
+                w.get('P').map(|x| (x * 1e6) as i64),
+                li.pos_before[2].map(|z| (z * 1e3).round() as i64),
+                t,
+            )),
         ));
     }
     if li.pause || li.user_m {

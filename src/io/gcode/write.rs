@@ -1,6 +1,8 @@
 //! Writing the program back in a new cell order.
 
-use super::cells::{Block, GCell, Layout, Split, entry_state, free_bits, is_boundary, is_motion_g};
+use super::cells::{
+    Block, GCell, Layout, Split, entry_state, free_bits, is_boundary, is_motion_g, vertical,
+};
 use super::interp::{CutKind, Motion, Program, State, el, known};
 use super::reverse::{Plan, write_reversed};
 use std::fmt::Write as _;
@@ -207,7 +209,7 @@ impl Writer<'_> {
             self.out.push_str(&self.p.text[i]);
             self.out.push('\n');
             if self.p.lines[i].motion != Motion::None {
-                self.pos = known(&self.p.lines[i].pos_after);
+                self.pos = self.track(i);
             }
             if self.p.lines[i].explicit_motion {
                 self.motion = self.p.lines[i].after.motion;
@@ -216,6 +218,30 @@ impl Writer<'_> {
         if e > s {
             self.cur = self.p.lines[e - 1].after;
         }
+    }
+
+    /// The output's position after line `i` of the original, written as it is: the axes the
+    /// line names move as in the original (to the same place in G90, by the same amount in
+    /// G91), the others stay where the output is (which need not be where the original was).
+    fn track(&self, i: usize) -> Option<[f64; 3]> {
+        let li = &self.p.lines[i];
+        let after = known(&li.pos_after);
+        if !matches!(li.motion, Motion::Rapid | Motion::Feed) {
+            return after;
+        }
+        let (Some(mut q), Some(b), Some(a)) = (self.pos, known(&li.pos_before), after) else {
+            return after;
+        };
+        for (k, axis) in ['X', 'Y', 'Z'].into_iter().enumerate() {
+            if (a[k] - b[k]).abs() > 1e-12 || li.words.has(axis) {
+                q[k] = if li.after.absolute {
+                    a[k]
+                } else {
+                    q[k] + (a[k] - b[k])
+                };
+            }
+        }
+        Some(q)
     }
 
     /// A gap line: as written when it does not move, else its other words only.
@@ -290,8 +316,11 @@ impl Writer<'_> {
     }
 
     /// The block's preamble when the output enters the block at another cell than its first:
-    /// the lines up to its last boundary as written, then its other words without their motion.
-    fn preamble(&mut self, b: &Block, first_start: usize) {
+    /// the lines up to its last boundary as written, then, up to the first move across, the
+    /// rapids straight down or up to a height no lower than `low` (the block's own link
+    /// height) as written (so that a dwell after the spindle start happens at the height the
+    /// program gives it), then the other words without their motion.
+    fn preamble(&mut self, b: &Block, first_start: usize, low: f64) {
         let p = self.p;
         let last = b
             .preamble
@@ -300,8 +329,15 @@ impl Writer<'_> {
             .find(|&&g| is_boundary(p, g))
             .copied()
             .unwrap_or(0);
+        let across = (last.max(b.gap_start)..first_start)
+            .find(|&g| {
+                g > last
+                    && p.lines[g].motion != Motion::None
+                    && !(vertical(p, g) && p.lines[g].pos_after[2].is_some_and(|z| z >= low - 1e-9))
+            })
+            .unwrap_or(first_start);
         for &g in &b.preamble {
-            if g <= last {
+            if g <= last || g < across {
                 self.verbatim(g, g + 1);
             } else {
                 self.gap(g);
@@ -341,6 +377,12 @@ pub fn write_checked(
         w.out.push('\n');
     }
     let z = matches!(l.split, Split::Z { .. });
+    // the lowest height at which the program rapids across (2-D splits of programs with Z)
+    let lowest_across = p
+        .lines
+        .iter()
+        .filter_map(|li| li.xy_rapid_z)
+        .fold(f64::INFINITY, f64::min);
     let mut block = l.cells[0].block;
     let mut prev: Option<(usize, bool)> = None;
     for (k, &ci) in order.iter().enumerate() {
@@ -373,7 +415,12 @@ pub fn write_checked(
             } else {
                 if enter {
                     w.reach(&p.lines[b.gap_start].before, 0)?;
-                    w.preamble(b, l.cells[first].start);
+                    let low = if z {
+                        l.clearance[c.block]
+                    } else {
+                        lowest_across
+                    };
+                    w.preamble(b, l.cells[first].start, low);
                 }
                 if c.pinned {
                     return Err(format!(
