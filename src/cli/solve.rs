@@ -82,7 +82,8 @@ pub struct GenerateArgs {
     /// Seed.
     #[arg(long, default_value_t = 1)]
     seed: u64,
-    /// Output instance file.
+    /// Output instance file: `cellseq-instance/1` JSON, or TSPLIB SOP when it ends in `.sop`
+    /// (SOP-shaped matrix families).
     #[arg(short, long)]
     out: PathBuf,
 }
@@ -367,7 +368,16 @@ pub fn solvers() -> Result<()> {
 pub fn generate(a: GenerateArgs) -> Result<()> {
     let params = parse_kv(&a.params)?;
     let inst = cellseq::generate::generate(&a.kind, &params, a.seed)?;
-    formats::save_instance(&a.out, &inst)?;
+    let sop = a
+        .out
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("sop"));
+    if sop {
+        let text = cellseq::generate::families::sop::to_sop_text(&inst)?;
+        formats::write_atomic(&a.out, text.as_bytes())?;
+    } else {
+        formats::save_instance(&a.out, &inst)?;
+    }
     say!("wrote {} ({} cells)", a.out.display(), inst.n());
     Ok(())
 }

@@ -1,10 +1,11 @@
 //! Reading and writing instances and solutions.
 //!
-//! [`load_instance`] picks the reader from the extension (`.json`, `.sop`, `.pcglns`) or, failing
+//! [`load_instance`] picks the reader from the extension (`.json`, `.sop`, `.pcglns`, `.pcgtsp`) or, failing
 //! that, from the `TYPE:` header, and validates the result. Every file cellseq writes goes
 //! through [`write`](mod@write) ([`write_atomic`]).
 
 pub mod json;
+pub mod pcgtsp;
 pub mod tsplib;
 pub mod write;
 
@@ -19,8 +20,10 @@ pub enum Format {
     Json,
     /// TSPLIB SOP.
     Sop,
-    /// PCGLNS / PCGTSP.
+    /// PCGLNS (integer PCGTSPLIB layout).
     Pcglns,
+    /// PCGTSP (original PCGTSPLIB layout: float costs, node weights, `NODE_GROUP_SECTION`).
+    Pcgtsp,
 }
 
 /// Guesses the format from the file name, then from the content.
@@ -32,7 +35,8 @@ pub fn detect(path: &Path, text: &str) -> Option<Format> {
     {
         Some(e) if e == "json" => return Some(Format::Json),
         Some(e) if e == "sop" => return Some(Format::Sop),
-        Some(e) if e == "pcglns" || e == "pcgtsp" => return Some(Format::Pcglns),
+        Some(e) if e == "pcglns" => return Some(Format::Pcglns),
+        Some(e) if e == "pcgtsp" => return Some(Format::Pcgtsp),
         _ => {}
     }
     let head = text.trim_start();
@@ -45,7 +49,8 @@ pub fn detect(path: &Path, text: &str) -> Option<Format> {
         {
             match v.trim() {
                 "SOP" => return Some(Format::Sop),
-                "PCGLNS" | "PCGTSP" => return Some(Format::Pcglns),
+                "PCGLNS" => return Some(Format::Pcglns),
+                "PCGTSP" => return Some(Format::Pcgtsp),
                 _ => {}
             }
         }
@@ -74,6 +79,7 @@ pub fn parse_instance(file: &str, text: &str, format: Format) -> Result<Instance
         Format::Json => json::parse_instance(file, text),
         Format::Sop => tsplib::parse_sop(file, text),
         Format::Pcglns => tsplib::parse_pcglns(file, text),
+        Format::Pcgtsp => pcgtsp::parse_pcgtsp(file, text),
     }
 }
 
@@ -84,7 +90,7 @@ pub fn load_instance(path: &Path) -> Result<Instance> {
     let format = detect(path, &text).ok_or_else(|| {
         Error::invalid(
             &file,
-            "unknown instance format (expected .json, .sop or .pcglns)",
+            "unknown instance format (expected .json, .sop, .pcglns or .pcgtsp)",
         )
     })?;
     let inst = parse_instance(&file, &text, format)?;

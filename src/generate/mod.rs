@@ -8,6 +8,7 @@
 pub mod cabin;
 pub mod casing;
 pub mod common;
+pub mod families;
 pub mod panel;
 pub mod toolsel;
 pub mod uniform;
@@ -54,6 +55,48 @@ pub static KINDS: &[GeneratorInfo] = &[
         summary: "cells at random in a box (n, modes, tools, precedence density) for scaling studies",
         params: uniform::SPECS,
         generate: uniform::generate,
+    },
+    GeneratorInfo {
+        name: "random-sop",
+        summary: "SOP with asymmetric integer costs uniform in [0, c] and precedence of closure density p % (training family)",
+        params: families::matrix::RANDOM_SOP_SPECS,
+        generate: families::matrix::random_sop,
+    },
+    GeneratorInfo {
+        name: "atsp",
+        summary: "asymmetric costs without precedence, open path (class amat: uniform; tmat: shortest-path closure)",
+        params: families::matrix::ATSP_SPECS,
+        generate: families::matrix::atsp,
+    },
+    GeneratorInfo {
+        name: "symmetric",
+        summary: "symmetric integer costs uniform in [0, c], precedence of closure density p %",
+        params: families::matrix::SYMMETRIC_SPECS,
+        generate: families::matrix::symmetric,
+    },
+    GeneratorInfo {
+        name: "near-symmetric",
+        summary: "symmetric costs plus an asymmetric part of up to asym % of c, precedence density p %",
+        params: families::matrix::NEAR_SYMMETRIC_SPECS,
+        generate: families::matrix::near_symmetric,
+    },
+    GeneratorInfo {
+        name: "compiler-dag",
+        summary: "instruction block: Hamming switching costs of 32-bit words, register/flag/memory dependences (sparse, not closed)",
+        params: families::compiler::SPECS,
+        generate: families::compiler::generate,
+    },
+    GeneratorInfo {
+        name: "geometric-sparse",
+        summary: "CNC part: pockets roughed in layers then finished, holes spot-drilled then drilled; sparse precedence, 10^3-10^5 cells",
+        params: families::geometric::GEOMETRIC_SPECS,
+        generate: families::geometric::geometric_sparse,
+    },
+    GeneratorInfo {
+        name: "generalized",
+        summary: "matrix instance whose cells have 1..=modes nodes near each other, precedence density p %",
+        params: families::geometric::GENERALIZED_SPECS,
+        generate: families::geometric::generalized,
     },
 ];
 

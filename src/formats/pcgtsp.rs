@@ -1,0 +1,519 @@
+//! Reader for the original PCGTSPLIB format, `TYPE: PCGTSP` (Salman, Ekstedt et al.):
+//! float costs, node weights, groups of nodes and a start group.
+//!
+//! ```text
+//! NAME: ESC07.pcgtsp
+//! TYPE: PCGTSP
+//! DIMENSION: 39                 nodes
+//! GROUPS: 8                     groups (clusters)
+//! EDGE_WEIGHT_TYPE: EXPLICIT
+//! EDGE_WEIGHT_FORMAT: FULL_MATRIX
+//! NODE_WEIGHT_SECTION           DIMENSION numbers: the cost of visiting each node
+//! EDGE_WEIGHT_SECTION           DIMENSION x DIMENSION numbers (no repeated dimension);
+//!                               -1 at (i, j): the group of node j precedes the group of node i
+//! NODE_GROUP_SECTION            lines "g v1 v2 ... -1": the nodes (1-based) of group g
+//! START_GROUP_SECTION           the start group (a single node)
+//! EOF
+//! ```
+//!
+//! A solution visits one node per group as a closed tour from the start group. Group g
+//! becomes cell `"g"` whose modes are its nodes in file order (like the PCGLNS reader), a −1
+//! entry a precedence edge and a forbidden arc, and a node's weight is added to every
+//! allowed arc into it: a closed tour enters each node it visits exactly once, so the tour's
+//! cost is its arcs plus its nodes' weights. A file in the integer PCGLNS layout
+//! (`GTSP_SETS`, `GTSP_SET_SECTION`) is handed to [`super::tsplib::parse_pcglns`].
+//!
+//! Sizes are checked before anything of that size is allocated (DIMENSION against
+//! [`super::tsplib::max_nodes`], and the number of matrix entries the file really holds);
+//! every error names the file and the line.
+
+use super::tsplib::{FORBIDDEN_ARC, MAX_NODES_ENV, max_nodes};
+use crate::error::{Error, Result};
+use crate::model::{Cell, CostMatrix, Instance, Metadata, Mode};
+use std::collections::BTreeSet;
+
+const SECTIONS: [&str; 4] = [
+    "NODE_WEIGHT_SECTION",
+    "EDGE_WEIGHT_SECTION",
+    "NODE_GROUP_SECTION",
+    "START_GROUP_SECTION",
+];
+
+/// Numbered lines of a section.
+type Lines<'a> = Vec<(usize, &'a str)>;
+
+struct Parts<'a> {
+    header: Vec<(usize, String, &'a str)>,
+    sections: Vec<(&'static str, Lines<'a>)>,
+    last_line: usize,
+}
+
+impl Parts<'_> {
+    fn get(&self, key: &str) -> Option<(usize, &str)> {
+        self.header
+            .iter()
+            .find(|(_, k, _)| k == key)
+            .map(|(l, _, v)| (*l, *v))
+    }
+    fn section(&self, name: &str) -> Option<&Lines<'_>> {
+        self.sections
+            .iter()
+            .find(|(k, _)| *k == name)
+            .map(|(_, l)| l)
+    }
+}
+
+fn split<'a>(file: &str, text: &'a str) -> Result<Parts<'a>> {
+    let mut parts = Parts {
+        header: Vec::new(),
+        sections: Vec::new(),
+        last_line: 1,
+    };
+    for (i, raw) in text.lines().enumerate() {
+        let ln = i + 1;
+        parts.last_line = ln;
+        let line = raw.trim();
+        if line.is_empty() {
+            continue;
+        }
+        if line == "EOF" {
+            break;
+        }
+        let key = line.split([':', ' ', '\t']).next().unwrap_or("");
+        if let Some(&name) = SECTIONS.iter().find(|s| **s == key) {
+            if parts.sections.iter().any(|(k, _)| *k == name) {
+                return Err(Error::parse(file, ln, format!("{name} appears twice")));
+            }
+            parts.sections.push((name, Vec::new()));
+            continue;
+        }
+        if let Some((_, lines)) = parts.sections.last_mut() {
+            lines.push((ln, line));
+        } else if let Some((k, v)) = line.split_once(':') {
+            parts
+                .header
+                .push((ln, k.trim().to_ascii_uppercase(), v.trim()));
+        } else {
+            return Err(Error::parse(
+                file,
+                ln,
+                format!("expected 'KEY: VALUE' or a section name, found '{line}'"),
+            ));
+        }
+    }
+    Ok(parts)
+}
+
+/// Whitespace tokens of numbered lines.
+fn tokens<'a>(lines: &'a [(usize, &'a str)]) -> impl Iterator<Item = (usize, &'a str)> + 'a {
+    lines
+        .iter()
+        .flat_map(|&(ln, l)| l.split_whitespace().map(move |t| (ln, t)))
+}
+
+fn number(file: &str, ln: usize, t: &str, what: &dyn Fn() -> String) -> Result<f64> {
+    match t.parse::<f64>() {
+        Ok(v) if v.is_finite() => Ok(v),
+        _ => Err(Error::parse(
+            file,
+            ln,
+            format!("expected a number for {}, found '{t}'", what()),
+        )),
+    }
+}
+
+fn positive(file: &str, p: &Parts, key: &str) -> Result<(usize, usize)> {
+    let (ln, v) = p
+        .get(key)
+        .ok_or_else(|| Error::parse(file, 1, format!("missing header field {key}")))?;
+    let n = v.parse::<usize>().ok().filter(|&d| d > 0).ok_or_else(|| {
+        Error::parse(
+            file,
+            ln,
+            format!("{key} must be a positive integer, found '{v}'"),
+        )
+    })?;
+    Ok((ln, n))
+}
+
+/// Parses a `TYPE: PCGTSP` file (see the module documentation); no validation.
+pub fn parse_pcgtsp(file: &str, text: &str) -> Result<Instance> {
+    let p = split(file, text)?;
+    if p.get("GTSP_SETS").is_some() {
+        return super::tsplib::parse_pcglns(file, text);
+    }
+    if let Some((ln, t)) = p.get("TYPE")
+        && t != "PCGTSP"
+    {
+        return Err(Error::parse(
+            file,
+            ln,
+            format!("TYPE is '{t}', expected PCGTSP"),
+        ));
+    }
+    if let Some((ln, v)) = p.get("EDGE_WEIGHT_TYPE")
+        && v != "EXPLICIT"
+    {
+        return Err(Error::parse(
+            file,
+            ln,
+            format!("EDGE_WEIGHT_TYPE {v} is not supported (EXPLICIT only)"),
+        ));
+    }
+    if let Some((ln, v)) = p.get("EDGE_WEIGHT_FORMAT")
+        && v != "FULL_MATRIX"
+    {
+        return Err(Error::parse(
+            file,
+            ln,
+            format!("EDGE_WEIGHT_FORMAT {v} is not supported (FULL_MATRIX only)"),
+        ));
+    }
+    let (dim_line, dim) = positive(file, &p, "DIMENSION")?;
+    let (groups_line, ngroups) = positive(file, &p, "GROUPS")?;
+    let limit = max_nodes();
+    if dim > limit {
+        return Err(Error::parse(
+            file,
+            dim_line,
+            format!(
+                "DIMENSION {dim} is above the limit of {limit} nodes (the matrix would take \
+                 {:.1} GB); set {MAX_NODES_ENV} to raise it",
+                8.0 * (dim as f64) * (dim as f64) / 1e9
+            ),
+        ));
+    }
+    if ngroups > dim {
+        return Err(Error::parse(
+            file,
+            groups_line,
+            format!("GROUPS {ngroups} is more than the {dim} nodes (every group needs a node)"),
+        ));
+    }
+    let missing = |name: &str| Error::parse(file, p.last_line, format!("missing {name}"));
+    let max = crate::validate::MAX_MATRIX_COST;
+    // node weights (optional: 0 when absent)
+    let mut weight = vec![0.0; dim];
+    if let Some(lines) = p.section("NODE_WEIGHT_SECTION") {
+        let mut k = 0;
+        for (ln, t) in tokens(lines) {
+            if k == dim {
+                return Err(Error::parse(
+                    file,
+                    ln,
+                    format!("NODE_WEIGHT_SECTION holds more than the {dim} node weights"),
+                ));
+            }
+            let v = number(file, ln, t, &|| format!("the weight of node {}", k + 1))?;
+            if !(0.0..=max).contains(&v) {
+                return Err(Error::parse(
+                    file,
+                    ln,
+                    format!(
+                        "weight of node {} is {}: weights must lie in 0..={max:e}",
+                        k + 1,
+                        crate::validate::show(v)
+                    ),
+                ));
+            }
+            weight[k] = v;
+            k += 1;
+        }
+        if k < dim {
+            return Err(Error::parse(
+                file,
+                lines.last().map_or(p.last_line, |l| l.0),
+                format!("NODE_WEIGHT_SECTION holds {k} weights, DIMENSION says {dim}"),
+            ));
+        }
+    }
+    // groups
+    let mut group_of = vec![usize::MAX; dim];
+    let mut groups: Vec<Vec<usize>> = vec![Vec::new(); ngroups];
+    for &(ln, line) in p
+        .section("NODE_GROUP_SECTION")
+        .ok_or_else(|| missing("NODE_GROUP_SECTION"))?
+    {
+        let nums = list(file, ln, line)?;
+        let g = group_number(file, ln, nums[0], ngroups)?;
+        if !groups[g].is_empty() {
+            return Err(Error::parse(
+                file,
+                ln,
+                format!("group {} listed twice", g + 1),
+            ));
+        }
+        if nums.len() < 2 {
+            return Err(Error::parse(
+                file,
+                ln,
+                format!("group {} has no nodes", g + 1),
+            ));
+        }
+        for &v in &nums[1..] {
+            if v < 1 || v as usize > dim {
+                return Err(Error::parse(
+                    file,
+                    ln,
+                    format!("node {v} out of range 1..{dim}"),
+                ));
+            }
+            let v = v as usize - 1;
+            if group_of[v] != usize::MAX {
+                return Err(Error::parse(
+                    file,
+                    ln,
+                    format!("node {} is in two groups", v + 1),
+                ));
+            }
+            group_of[v] = g;
+            groups[g].push(v);
+        }
+    }
+    if let Some(g) = groups.iter().position(|g| g.is_empty()) {
+        return Err(Error::invalid(
+            file,
+            format!("group {} has no nodes", g + 1),
+        ));
+    }
+    if let Some(v) = group_of.iter().position(|&g| g == usize::MAX) {
+        return Err(Error::invalid(
+            file,
+            format!("node {} belongs to no group", v + 1),
+        ));
+    }
+    let mut new_index = vec![0usize; dim];
+    for (k, &v) in groups.iter().flatten().enumerate() {
+        new_index[v] = k;
+    }
+    // the matrix: count what the section holds before allocating dim x dim
+    let lines = p
+        .section("EDGE_WEIGHT_SECTION")
+        .ok_or_else(|| missing("EDGE_WEIGHT_SECTION"))?;
+    let need = dim * dim;
+    let have = tokens(lines).take(need + 1).count();
+    if have != need {
+        let ln = lines.last().map_or(p.last_line, |l| l.0);
+        return Err(Error::parse(
+            file,
+            ln,
+            format!(
+                "EDGE_WEIGHT_SECTION holds {}{have} numbers, but a {dim}x{dim} matrix needs {need}",
+                if have > need { "more than " } else { "" },
+            ),
+        ));
+    }
+    let mut costs = vec![0.0; need];
+    let mut edges: BTreeSet<(usize, usize)> = BTreeSet::new();
+    for (k, (ln, t)) in tokens(lines).enumerate() {
+        let (i, j) = (k / dim, k % dim);
+        let v = number(file, ln, t, &|| {
+            format!("matrix entry ({}, {})", i + 1, j + 1)
+        })?;
+        let slot = new_index[i] * dim + new_index[j];
+        if v == -1.0 {
+            let (gi, gj) = (group_of[i], group_of[j]);
+            if gi == gj {
+                return Err(Error::parse(
+                    file,
+                    ln,
+                    format!("group {} must precede itself", gi + 1),
+                ));
+            }
+            edges.insert((gj, gi));
+            costs[slot] = FORBIDDEN_ARC;
+            continue;
+        }
+        if !(0.0..=max).contains(&v) {
+            return Err(Error::parse(
+                file,
+                ln,
+                format!(
+                    "matrix entry ({}, {}) is {}: entries must lie in 0..={max:e}, or be -1 \
+                     for precedence",
+                    i + 1,
+                    j + 1,
+                    crate::validate::show(v)
+                ),
+            ));
+        }
+        let with_weight = v + weight[j];
+        if with_weight > max {
+            return Err(Error::parse(
+                file,
+                ln,
+                format!(
+                    "matrix entry ({}, {}) plus the weight of node {} is above {max:e}",
+                    i + 1,
+                    j + 1,
+                    j + 1
+                ),
+            ));
+        }
+        costs[slot] = if i == j { 0.0 } else { with_weight };
+    }
+    // start group
+    let start_lines = p
+        .section("START_GROUP_SECTION")
+        .ok_or_else(|| missing("START_GROUP_SECTION"))?;
+    let mut it = tokens(start_lines);
+    let Some((ln, t)) = it.next() else {
+        return Err(Error::parse(
+            file,
+            p.last_line,
+            "START_GROUP_SECTION holds no group",
+        ));
+    };
+    let s: i64 = t
+        .parse()
+        .map_err(|_| Error::parse(file, ln, format!("expected a group number, found '{t}'")))?;
+    let start = group_number(file, ln, s, ngroups)?;
+    if let Some((ln, t)) = it.find(|&(_, t)| t != "-1") {
+        return Err(Error::parse(
+            file,
+            ln,
+            format!("unexpected token '{t}' after the start group"),
+        ));
+    }
+    if groups[start].len() != 1 {
+        return Err(Error::parse(
+            file,
+            ln,
+            format!(
+                "start group {} has {} nodes; a closed PCGTSP tour needs a single-node start group",
+                start + 1,
+                groups[start].len()
+            ),
+        ));
+    }
+    for g in 0..ngroups {
+        if g != start {
+            edges.insert((start, g));
+        }
+    }
+    let cells = groups
+        .iter()
+        .enumerate()
+        .map(|(g, nodes)| Cell::new((g + 1).to_string(), "", vec![Mode::default(); nodes.len()]))
+        .collect();
+    Ok(Instance {
+        name: instance_name(&p, file),
+        meta: Metadata {
+            generator: Some("pcgtsp".into()),
+            comment: p.get("COMMENT").map(|(_, v)| v.to_string()),
+            ..Default::default()
+        },
+        cells,
+        precedence: edges.into_iter().collect(),
+        matrix: Some(CostMatrix { size: dim, costs }),
+        first: Some(start),
+        closed: true,
+        ..Instance::default()
+    })
+}
+
+fn instance_name(p: &Parts, file: &str) -> String {
+    let stem = std::path::Path::new(file)
+        .file_name()
+        .and_then(|s| s.to_str())
+        .unwrap_or(file);
+    let stem = stem.strip_suffix(".pcgtsp").unwrap_or(stem);
+    if stem.is_empty() {
+        p.get("NAME")
+            .map(|(_, v)| v.to_string())
+            .unwrap_or_default()
+    } else {
+        stem.to_string()
+    }
+}
+
+/// "a b c ... -1" → the numbers before the terminating -1.
+fn list(file: &str, ln: usize, line: &str) -> Result<Vec<i64>> {
+    let mut out = Vec::new();
+    let mut ended = false;
+    for t in line.split_whitespace() {
+        if ended {
+            return Err(Error::parse(
+                file,
+                ln,
+                format!("token '{t}' after the terminating -1"),
+            ));
+        }
+        let v: i64 = t
+            .parse()
+            .map_err(|_| Error::parse(file, ln, format!("expected an integer, found '{t}'")))?;
+        if v == -1 {
+            ended = true;
+        } else {
+            out.push(v);
+        }
+    }
+    if !ended {
+        return Err(Error::parse(file, ln, "list is not terminated by -1"));
+    }
+    if out.is_empty() {
+        return Err(Error::parse(file, ln, "empty list"));
+    }
+    Ok(out)
+}
+
+fn group_number(file: &str, ln: usize, g: i64, ngroups: usize) -> Result<usize> {
+    if g < 1 || g as usize > ngroups {
+        return Err(Error::parse(
+            file,
+            ln,
+            format!("group {g} out of range 1..{ngroups}"),
+        ));
+    }
+    Ok(g as usize - 1)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const SMALL: &str = "NAME: t.pcgtsp\nTYPE: PCGTSP \nDIMENSION: 4\nGROUPS: 3\n\
+        EDGE_WEIGHT_TYPE: EXPLICIT \nEDGE_WEIGHT_FORMAT : FULL_MATRIX \n\
+        NODE_WEIGHT_SECTION \n0 0 0.5 1\nEDGE_WEIGHT_SECTION \n\
+        0 1.5 2 3\n0 0 -1 4\n0 5 0 6\n0 7 8.25 0\n\
+        NODE_GROUP_SECTION \n1 1 -1\n2 2 -1\n3 3 4 -1\nSTART_GROUP_SECTION \n1\nEOF\n";
+
+    #[test]
+    fn reads_floats_weights_groups_and_precedence() {
+        let inst = parse_pcgtsp("t.pcgtsp", SMALL).unwrap();
+        crate::validate::validate(&inst, "t.pcgtsp").unwrap();
+        assert_eq!(inst.n(), 3);
+        assert_eq!(inst.cells[2].modes.len(), 2);
+        assert!(inst.closed);
+        assert_eq!(inst.first, Some(0));
+        // -1 at (2, 3): group 3 precedes group 2
+        assert!(inst.precedence.contains(&(2, 1)));
+        let m = inst.matrix.as_ref().unwrap();
+        assert_eq!(m.get(0, 1), 1.5); // no weight on node 2
+        assert_eq!(m.get(0, 2), 2.5); // node 3 weighs 0.5
+        assert_eq!(m.get(3, 2), 8.75);
+        assert_eq!(m.get(1, 2), FORBIDDEN_ARC);
+        assert_eq!(m.get(2, 3), 7.0); // node 3 -> node 4 (weight 1)
+    }
+
+    #[test]
+    fn errors_name_the_line() {
+        let cases = [
+            (SMALL.replace("0 0 -1 4", "0 0 -2 4"), "line 11"),
+            (SMALL.replace("0 7 8.25 0\n", ""), "needs 16"),
+            (SMALL.replace("GROUPS: 3", "GROUPS: 9"), "line 4"),
+            (
+                SMALL.replace("DIMENSION: 4", "DIMENSION: 99999999"),
+                "limit",
+            ),
+            (SMALL.replace("3 3 4 -1", "3 3 4"), "line 17"),
+            (SMALL.replace("0 0 0.5 1", "0 0 x 1"), "line 8"),
+            (SMALL.replace("\n1\nEOF", "\n3\nEOF"), "single-node"),
+            (SMALL.replace("2 2 -1", "2 1 -1"), "two groups"),
+        ];
+        for (text, want) in cases {
+            let e = parse_pcgtsp("t.pcgtsp", &text).unwrap_err().to_string();
+            assert!(e.contains("t.pcgtsp") && e.contains(want), "{want}: {e}");
+        }
+    }
+}

@@ -1,0 +1,159 @@
+//! Random matrix families: `random-sop`, `atsp`, `symmetric`, `near-symmetric`.
+
+use super::{C_SPEC, check_matrix_n, check_p, dag::random_dag, n_spec, p_spec, sop_shaped};
+use crate::error::{Error, Result};
+use crate::model::Instance;
+use crate::params::{ParamKind, ParamSpec, Params};
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+/// `random-sop` parameters.
+pub static RANDOM_SOP_SPECS: &[ParamSpec] = &[n_spec("200"), C_SPEC, p_spec("15")];
+
+/// `atsp` parameters.
+pub static ATSP_SPECS: &[ParamSpec] = &[
+    n_spec("200"),
+    C_SPEC,
+    ParamSpec {
+        name: "class",
+        default: "amat",
+        kind: ParamKind::Choice(&["amat", "tmat"]),
+        help: "amat: costs uniform in [0, c]; tmat: their shortest-path closure (triangle inequality holds; n <= 2000)",
+    },
+];
+
+/// `symmetric` parameters.
+pub static SYMMETRIC_SPECS: &[ParamSpec] = &[n_spec("200"), C_SPEC, p_spec("0")];
+
+/// `near-symmetric` parameters.
+pub static NEAR_SYMMETRIC_SPECS: &[ParamSpec] = &[
+    n_spec("200"),
+    C_SPEC,
+    p_spec("0"),
+    ParamSpec {
+        name: "asym",
+        default: "5",
+        kind: ParamKind::Float,
+        help: "asymmetric part: each arc adds an integer uniform in [0, asym % of c]",
+    },
+];
+
+/// Integer costs uniform in [0, c] for every ordered pair of `n` cells (row-major, diagonal 0).
+fn uniform_costs(n: usize, c: u64, rng: &mut ChaCha8Rng) -> Vec<f64> {
+    let mut m = vec![0.0; n * n];
+    for i in 0..n {
+        for j in 0..n {
+            if i != j {
+                m[i * n + j] = rng.random_range(0..=c) as f64;
+            }
+        }
+    }
+    m
+}
+
+/// Symmetric integer costs uniform in [0, c].
+fn symmetric_costs(n: usize, c: u64, rng: &mut ChaCha8Rng) -> Vec<f64> {
+    let mut m = vec![0.0; n * n];
+    for i in 0..n {
+        for j in i + 1..n {
+            let v = rng.random_range(0..=c) as f64;
+            m[i * n + j] = v;
+            m[j * n + i] = v;
+        }
+    }
+    m
+}
+
+fn cost_range(kind: &str, p: &Params) -> Result<u64> {
+    let c = p.int("c");
+    if c == 0 || c > 1_000_000 {
+        return Err(Error::Param(format!(
+            "{kind}: c must lie in 1..=1000000, got {c}"
+        )));
+    }
+    Ok(c)
+}
+
+/// `random-sop`: asymmetric costs uniform in [0, c], precedence of closure density p %.
+pub fn random_sop(p: &Params, seed: u64) -> Result<Instance> {
+    let n = p.int("n") as usize;
+    check_matrix_n("random-sop", n, 1)?;
+    let c = cost_range("random-sop", p)?;
+    let density = check_p("random-sop", p.float("p"))?;
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let m = uniform_costs(n, c, &mut rng);
+    let edges = random_dag(n, density, &mut rng);
+    let name = format!("random-sop-n{n}-c{c}-p{}-s{seed}", p.float("p"));
+    Ok(sop_shaped(name, &vec![1; n], |u, v| m[u * n + v], &edges))
+}
+
+/// `atsp`: no precedence; `amat` costs uniform in [0, c], `tmat` their shortest-path closure.
+pub fn atsp(p: &Params, seed: u64) -> Result<Instance> {
+    let n = p.int("n") as usize;
+    check_matrix_n("atsp", n, 1)?;
+    let c = cost_range("atsp", p)?;
+    let class = p.word("class").to_string();
+    if class == "tmat" && n > 2000 {
+        return Err(Error::Param(format!(
+            "atsp: class=tmat is O(n^3): n must be at most 2000, got {n}"
+        )));
+    }
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let mut m = uniform_costs(n, c, &mut rng);
+    if class == "tmat" {
+        // Floyd–Warshall: every cost becomes the shortest path's
+        for k in 0..n {
+            for i in 0..n {
+                let ik = m[i * n + k];
+                for j in 0..n {
+                    let via = ik + m[k * n + j];
+                    if via < m[i * n + j] {
+                        m[i * n + j] = via;
+                    }
+                }
+            }
+        }
+    }
+    let name = format!("atsp-{class}-n{n}-c{c}-s{seed}");
+    Ok(sop_shaped(name, &vec![1; n], |u, v| m[u * n + v], &[]))
+}
+
+/// `symmetric`: symmetric costs uniform in [0, c], precedence of closure density p %.
+pub fn symmetric(p: &Params, seed: u64) -> Result<Instance> {
+    let n = p.int("n") as usize;
+    check_matrix_n("symmetric", n, 1)?;
+    let c = cost_range("symmetric", p)?;
+    let density = check_p("symmetric", p.float("p"))?;
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let m = symmetric_costs(n, c, &mut rng);
+    let edges = random_dag(n, density, &mut rng);
+    let name = format!("symmetric-n{n}-c{c}-p{}-s{seed}", p.float("p"));
+    Ok(sop_shaped(name, &vec![1; n], |u, v| m[u * n + v], &edges))
+}
+
+/// `near-symmetric`: symmetric costs plus an asymmetric part in [0, asym % of c].
+pub fn near_symmetric(p: &Params, seed: u64) -> Result<Instance> {
+    let n = p.int("n") as usize;
+    check_matrix_n("near-symmetric", n, 1)?;
+    let c = cost_range("near-symmetric", p)?;
+    let density = check_p("near-symmetric", p.float("p"))?;
+    let asym = p.float("asym");
+    if !(0.0..=100.0).contains(&asym) {
+        return Err(Error::Param(format!(
+            "near-symmetric: asym is a percentage in 0..=100, got {asym}"
+        )));
+    }
+    let top = (asym / 100.0 * c as f64).round() as u64;
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let mut m = symmetric_costs(n, c, &mut rng);
+    for i in 0..n {
+        for j in 0..n {
+            if i != j {
+                m[i * n + j] += rng.random_range(0..=top) as f64;
+            }
+        }
+    }
+    let edges = random_dag(n, density, &mut rng);
+    let name = format!("near-symmetric-n{n}-c{c}-p{}-s{seed}", p.float("p"));
+    Ok(sop_shaped(name, &vec![1; n], |u, v| m[u * n + v], &edges))
+}

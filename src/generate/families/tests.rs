@@ -1,0 +1,207 @@
+//! Families: determinism per seed, densities on target, acyclic and unclosed DAGs, the
+//! SOP text read back as the same instance, fixed first and last cells, and solvability.
+
+use super::sop::to_sop_text;
+use crate::formats::json::instance_to_json;
+use crate::generate::generate;
+use crate::model::{Instance, Objective};
+use crate::precedence::{Dag, closure_density, closure_size, topological_order};
+use std::collections::BTreeMap;
+
+const MATRIX_KINDS: &[&str] = &[
+    "random-sop",
+    "atsp",
+    "symmetric",
+    "near-symmetric",
+    "compiler-dag",
+    "generalized",
+];
+
+fn kv(pairs: &[(&str, &str)]) -> BTreeMap<String, String> {
+    pairs
+        .iter()
+        .map(|(k, v)| (k.to_string(), v.to_string()))
+        .collect()
+}
+
+fn gen_(kind: &str, pairs: &[(&str, &str)], seed: u64) -> Instance {
+    generate(kind, &kv(pairs), seed).unwrap_or_else(|e| panic!("{kind}: {e}"))
+}
+
+/// Precedence edges between free cells (dummies dropped), renumbered from 0.
+fn free_edges(inst: &Instance) -> (usize, Vec<(usize, usize)>) {
+    let n = inst.n() - 2;
+    let last = inst.n() - 1;
+    let e = inst
+        .precedence
+        .iter()
+        .filter(|&&(a, b)| a != 0 && b != last)
+        .map(|&(a, b)| (a - 1, b - 1))
+        .collect();
+    (n, e)
+}
+
+#[test]
+fn same_seed_same_bytes_other_seed_other_instance() {
+    for kind in MATRIX_KINDS.iter().chain(&["geometric-sparse"]) {
+        let p = [("n", "40")];
+        let a = instance_to_json(&gen_(kind, &p, 5));
+        let b = instance_to_json(&gen_(kind, &p, 5));
+        assert_eq!(a, b, "{kind}: not deterministic");
+        let (x, y) = (gen_(kind, &p, 5), gen_(kind, &p, 6));
+        assert!(
+            x.matrix != y.matrix || x.cells != y.cells,
+            "{kind}: the seed changes nothing"
+        );
+    }
+}
+
+#[test]
+fn closure_density_of_free_cells_is_on_target() {
+    for kind in ["random-sop", "symmetric", "near-symmetric", "generalized"] {
+        for p in [0.0, 1.0, 5.0, 15.0, 30.0, 60.0] {
+            let inst = gen_(kind, &[("n", "200"), ("p", &p.to_string())], 3);
+            let (n, e) = free_edges(&inst);
+            let d = closure_density(&Dag::new(n, &e));
+            // target plus at most max(n, 0.5 % of pairs) pairs: 1 percentage point at n = 200
+            assert!(
+                d * 100.0 >= p - 1e-9 && d * 100.0 <= p + 1.0 + 1e-9,
+                "{kind} p={p}: closure density {:.3} %",
+                d * 100.0
+            );
+        }
+    }
+}
+
+#[test]
+fn atsp_has_only_the_dummy_precedence_and_tmat_satisfies_the_triangle_inequality() {
+    let inst = gen_("atsp", &[("n", "60"), ("class", "tmat")], 2);
+    let (n, e) = free_edges(&inst);
+    assert!(e.is_empty());
+    let m = inst.matrix.as_ref().unwrap();
+    for i in 1..=n {
+        for j in 1..=n {
+            for k in 1..=n {
+                if i != j && j != k && i != k {
+                    assert!(m.get(i, k) <= m.get(i, j) + m.get(j, k) + 1e-9);
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn compiler_dag_is_acyclic_sparse_and_not_transitively_closed() {
+    for seed in 1..=5 {
+        let inst = gen_("compiler-dag", &[("n", "300")], seed);
+        let (n, e) = free_edges(&inst);
+        let dag = Dag::new(n, &e);
+        assert!(topological_order(&dag).is_ok());
+        // program order is a schedule
+        assert!(e.iter().all(|&(a, b)| a < b));
+        let closed = closure_size(n, &e);
+        assert!(
+            closed > e.len(),
+            "seed {seed}: {} edges, closure {closed}",
+            e.len()
+        );
+        assert!((e.len() as f64) < 0.1 * (n * (n - 1) / 2) as f64, "sparse");
+        let m = inst.matrix.as_ref().unwrap();
+        for i in 1..=n {
+            for j in 1..=n {
+                let c = m.get(i, j);
+                assert!(c >= crate::model::CostMatrix::FORBIDDEN || (0.0..=32.0).contains(&c));
+            }
+        }
+    }
+}
+
+#[test]
+fn sop_text_reads_back_as_the_same_instance() {
+    for kind in MATRIX_KINDS.iter().filter(|k| **k != "generalized") {
+        let inst = gen_(kind, &[("n", "25")], 9);
+        let text = to_sop_text(&inst).unwrap();
+        let back = crate::formats::tsplib::parse_sop("x.sop", &text).unwrap();
+        crate::validate::validate(&back, "x.sop").unwrap();
+        assert_eq!(back.matrix, inst.matrix, "{kind}: matrix");
+        let mut a = inst.precedence.clone();
+        let mut b = back.precedence.clone();
+        a.sort_unstable();
+        b.sort_unstable();
+        assert_eq!(a, b, "{kind}: precedence");
+        assert_eq!((back.first, back.last), (inst.first, inst.last));
+        assert_eq!(back.cells, inst.cells, "{kind}: cells");
+    }
+    let g = gen_("generalized", &[("n", "10")], 1);
+    assert!(to_sop_text(&g).is_err(), "several modes are not SOP");
+    let geo = gen_("geometric-sparse", &[("n", "10")], 1);
+    assert!(to_sop_text(&geo).is_err());
+}
+
+#[test]
+fn first_and_last_cells_are_the_dummies() {
+    for kind in MATRIX_KINDS {
+        let inst = gen_(kind, &[("n", "30")], 4);
+        let last = inst.n() - 1;
+        assert_eq!(inst.first, Some(0), "{kind}");
+        assert_eq!(inst.last, Some(last), "{kind}");
+        assert!(!inst.closed);
+        assert_eq!(inst.cells[0].modes.len(), 1);
+        assert_eq!(inst.cells[last].modes.len(), 1);
+        let seq = inst.as_given.as_ref().unwrap();
+        assert_eq!(seq.first().unwrap().cell, 0);
+        assert_eq!(seq.last().unwrap().cell, last);
+        crate::check::check(&inst, seq, Objective::Matrix)
+            .unwrap_or_else(|v| panic!("{kind}: as-given infeasible: {v}"));
+    }
+    let geo = gen_("geometric-sparse", &[("n", "500")], 2);
+    crate::check::check(&geo, geo.as_given.as_ref().unwrap(), Objective::Time).unwrap();
+    let d = closure_density(&Dag::new(geo.n(), &geo.precedence));
+    assert!(d > 0.0 && d < 0.01, "sparse: {d}");
+}
+
+#[test]
+fn every_family_is_solved_by_the_registry() {
+    for kind in MATRIX_KINDS.iter().chain(&["geometric-sparse"]) {
+        let inst = gen_(kind, &[("n", "40")], 1);
+        let obj = inst.default_objective();
+        for solver in ["greedy", "local-search", "auto"] {
+            let r = crate::solvers::run(
+                solver,
+                &inst,
+                obj,
+                &BTreeMap::new(),
+                1,
+                crate::solvers::Budget {
+                    time_limit: None,
+                    max_evals: Some(20_000),
+                },
+                &mut crate::solvers::NoObserver,
+            )
+            .unwrap_or_else(|e| panic!("{kind} / {solver}: {e}"));
+            let seq = &r.outcome.sequence;
+            crate::check::check(&inst, seq, obj)
+                .unwrap_or_else(|v| panic!("{kind} / {solver}: infeasible: {v}"));
+        }
+    }
+}
+
+#[test]
+fn bad_parameters_are_refused() {
+    for (kind, pairs) in [
+        ("random-sop", vec![("p", "101")]),
+        ("random-sop", vec![("n", "0")]),
+        ("random-sop", vec![("n", "6000")]),
+        ("atsp", vec![("c", "0")]),
+        ("atsp", vec![("class", "tmat"), ("n", "2500")]),
+        ("compiler-dag", vec![("regs", "1")]),
+        ("generalized", vec![("modes", "0")]),
+        ("generalized", vec![("n", "2000"), ("modes", "4")]),
+        ("geometric-sparse", vec![("size", "1")]),
+    ] {
+        assert!(
+            generate(kind, &kv(&pairs), 1).is_err(),
+            "{kind} {pairs:?} accepted"
+        );
+    }
+}

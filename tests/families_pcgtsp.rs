@@ -1,0 +1,129 @@
+//! The PCGTSP reader on real PCGTSPLIB files (`tests/fixtures/pcgtsp/`, see SOURCES.md):
+//! dispatch by extension and by `TYPE:`, agreement with the integer PCGLNS version of the same
+//! instance, solving, and mutated copies that must give an error, never a panic.
+
+use cellseq::formats::{self, Format};
+use cellseq::model::Objective;
+use cellseq::solvers::{self, Budget, NoObserver};
+use std::collections::BTreeMap;
+use std::path::PathBuf;
+
+fn fixture(name: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(format!("tests/fixtures/pcgtsp/{name}"))
+}
+
+#[test]
+fn real_files_load_by_extension_and_by_type() {
+    for (name, groups, nodes) in [("ESC07.pcgtsp", 8, 39), ("br17.10.pcgtsp", 17, 88)] {
+        let inst = formats::load_instance(&fixture(name)).unwrap();
+        assert_eq!(inst.n(), groups, "{name}");
+        assert_eq!(inst.matrix.as_ref().unwrap().size, nodes);
+        assert_eq!(inst.first, Some(0));
+        assert!(inst.closed);
+        let text = std::fs::read_to_string(fixture(name)).unwrap();
+        assert_eq!(
+            formats::detect(std::path::Path::new("x.txt"), &text),
+            Some(Format::Pcgtsp)
+        );
+    }
+}
+
+#[test]
+fn agrees_with_the_integer_pcglns_file_of_the_same_instance() {
+    let float = formats::load_instance(&fixture("ESC07.pcgtsp")).unwrap();
+    let int_path =
+        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("instances/pcgtsplib/ESC07.pcglns");
+    let int = formats::load_instance(&int_path).unwrap();
+    let modes = |i: &cellseq::model::Instance| -> Vec<usize> {
+        i.cells.iter().map(|c| c.modes.len()).collect()
+    };
+    assert_eq!(modes(&float), modes(&int));
+    assert_eq!(float.precedence, int.precedence);
+    let (a, b) = (float.matrix.unwrap(), int.matrix.unwrap());
+    for (x, y) in a.costs.iter().zip(&b.costs) {
+        // the PCGLNS file holds the same costs rounded to integers
+        assert!((x - y).abs() <= 0.5 + 1e-9, "{x} vs {y}");
+    }
+}
+
+#[test]
+fn solvers_solve_it_and_the_checker_agrees() {
+    let inst = formats::load_instance(&fixture("br17.10.pcgtsp")).unwrap();
+    let budget = Budget {
+        time_limit: None,
+        max_evals: Some(200_000),
+    };
+    for solver in ["greedy", "auto"] {
+        let r = solvers::run(
+            solver,
+            &inst,
+            Objective::Matrix,
+            &BTreeMap::new(),
+            1,
+            budget,
+            &mut NoObserver,
+        )
+        .unwrap();
+        let rep = cellseq::check(&inst, &r.outcome.sequence, Objective::Matrix).unwrap();
+        assert!((rep.cost - r.outcome.cost).abs() < 1e-6 * rep.cost.max(1.0));
+        assert!(rep.cost > 0.0);
+    }
+}
+
+/// Seeded mutations (truncation, byte changes, deleted and repeated lines): the reader and
+/// the validator return, with an error naming the file when they refuse.
+#[test]
+fn mutated_files_are_refused_cleanly() {
+    let orig = std::fs::read(fixture("ESC07.pcgtsp")).unwrap();
+    let mut state = 0x9e37_79b9_7f4a_7c15u64;
+    let mut next = move || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        state
+    };
+    let subs: &[&[u8]] = &[
+        b"-1",
+        b"-2",
+        b"1e400",
+        b"NaN",
+        b" ",
+        b"\n",
+        b"x",
+        b"99999999",
+        b"0",
+    ];
+    for case in 0..400 {
+        let mut d = orig.clone();
+        match case % 4 {
+            0 => d.truncate(next() as usize % d.len()),
+            1 => {
+                let at = next() as usize % d.len();
+                let s = subs[next() as usize % subs.len()];
+                let end = (at + 1 + next() as usize % 4).min(d.len());
+                d.splice(at..end, s.iter().copied());
+            }
+            2 => {
+                let text = String::from_utf8_lossy(&d).to_string();
+                let mut lines: Vec<&str> = text.lines().collect();
+                let k = next() as usize % lines.len();
+                lines.remove(k);
+                d = lines.join("\n").into_bytes();
+            }
+            _ => {
+                let text = String::from_utf8_lossy(&d).to_string();
+                let mut lines: Vec<&str> = text.lines().collect();
+                let k = next() as usize % lines.len();
+                lines.insert(k, lines[k]);
+                d = lines.join("\n").into_bytes();
+            }
+        }
+        let text = String::from_utf8_lossy(&d);
+        match formats::parse_instance("m.pcgtsp", &text, Format::Pcgtsp) {
+            Ok(inst) => {
+                let _ = cellseq::validate::validate(&inst, "m.pcgtsp");
+            }
+            Err(e) => assert!(e.to_string().contains("m.pcgtsp"), "{e}"),
+        }
+    }
+}
