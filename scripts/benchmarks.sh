@@ -15,7 +15,9 @@
 #   --report-only  do not run anything; rewrite results/benchmarks.md from existing results.
 # Every plan runs with `cellseq run PLAN --threads 1` (one trial at a time, one thread each).
 # Finished trials are skipped on a rerun (the harness resumes), so a rerun only fills gaps;
-# delete results/<plan>/ to measure again. Run it alone: the budgets are wall clock.
+# delete results/benchmarks/<plan>/ to measure again. The report's raw inputs (each plan's
+# results.csv, machine.txt, scale-1e6.csv) live in results/benchmarks/.
+# Run it alone: the budgets are wall clock.
 #   env: CARGO_TARGET_DIR (where cargo builds), PYTHON (default python3)
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -28,7 +30,7 @@ for a in "$@"; do
     --median) mode=median ;;
     --full) mode=full ;;
     --report-only) run=0 ;;
-    -h|--help) sed -n '2,19p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,21p' "$0"; exit 0 ;;
     *) echo "benchmarks.sh: unknown argument $a" >&2; exit 2 ;;
   esac
 done
@@ -39,7 +41,8 @@ case "$mode" in
   full) plans=(sop sop-quick pcgtsp scale) ;;
 esac
 py=${PYTHON:-python3}
-mkdir -p results
+mkdir -p results/benchmarks
+R=results/benchmarks
 if [ "$run" = 1 ]; then
   cargo build --release --bin cellseq --example scale
   bin="${CARGO_TARGET_DIR:-target}/release/cellseq"
@@ -55,30 +58,30 @@ if [ "$run" = 1 ]; then
     echo "memory: $(awk '/MemTotal/ {printf "%.1f GiB", $2/1048576}' /proc/meminfo)"
     echo "load average before the runs: $(cut -d' ' -f1-3 /proc/loadavg)"
     echo "plans: ${plans[*]} (each with cellseq run PLAN --threads 1)"
-  } > results/machine.txt
+  } > $R/machine.txt
   for p in "${plans[@]}"; do
     echo "== $p" >&2
-    "$bin" run "experiments/$p.toml" --threads 1
+    "$bin" run "experiments/$p.toml" --threads 1 --out "$R/$p"
   done
   # 10^6 cells: greedy (no budget); greedy + one improvement pass (the linked-list Or-opt pass,
   # local-search vnd=false, no budget: does it finish within 60 s? without and with precedence); greedy + the search capped at
   # the issue's 60 s (the two-level search where it applies, else the VND; plus greedy at 10^5
   # for the memory growth), one process each so that the peak resident memory is that run's.
-  if [ ! -s results/scale-1e6.csv ]; then
+  if [ ! -s $R/scale-1e6.csv ]; then
     for pl in "0 0" "0 7" "1 7"; do
       set -- $pl
-      g="gen.preds=$1 gen.lift=$2 csv=results/scale-1e6.csv"
+      g="gen.preds=$1 gen.lift=$2 csv=$R/scale-1e6.csv"
       "$ex" 100000 greedy $g   # memory at 10^5, for linearity
       "$ex" 1000000 greedy $g
       "$ex" 1000000 local-search kicks=0 seconds=60 $g
     done
-    "$ex" 1000000 local-search kicks=0 vnd=false gen.preds=0 gen.lift=0 csv=results/scale-1e6.csv
-    "$ex" 1000000 local-search kicks=0 vnd=false gen.preds=0 gen.lift=7 csv=results/scale-1e6.csv
-    "$ex" 1000000 local-search kicks=0 vnd=false gen.preds=1 gen.lift=0 csv=results/scale-1e6.csv
-    "$ex" 1000000 local-search kicks=0 vnd=false gen.preds=1 gen.lift=7 csv=results/scale-1e6.csv
-    "$ex" 1000000 greedy-edge gen.preds=0 gen.lift=0 csv=results/scale-1e6.csv
+    "$ex" 1000000 local-search kicks=0 vnd=false gen.preds=0 gen.lift=0 csv=$R/scale-1e6.csv
+    "$ex" 1000000 local-search kicks=0 vnd=false gen.preds=0 gen.lift=7 csv=$R/scale-1e6.csv
+    "$ex" 1000000 local-search kicks=0 vnd=false gen.preds=1 gen.lift=0 csv=$R/scale-1e6.csv
+    "$ex" 1000000 local-search kicks=0 vnd=false gen.preds=1 gen.lift=7 csv=$R/scale-1e6.csv
+    "$ex" 1000000 greedy-edge gen.preds=0 gen.lift=0 csv=$R/scale-1e6.csv
   fi
-  echo "load average after the runs: $(cut -d' ' -f1-3 /proc/loadavg)" >> results/machine.txt
-  echo "date (UTC, end): $(date -u '+%Y-%m-%d %H:%M')" >> results/machine.txt
+  echo "load average after the runs: $(cut -d' ' -f1-3 /proc/loadavg)" >> $R/machine.txt
+  echo "date (UTC, end): $(date -u '+%Y-%m-%d %H:%M')" >> $R/machine.txt
 fi
-"$py" scripts/benchmarks_report.py --results results --out results/benchmarks.md
+"$py" scripts/benchmarks_report.py --results $R --out results/benchmarks.md

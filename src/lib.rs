@@ -19,6 +19,12 @@
 //! # Ok::<(), cellseq::Error>(())
 //! ```
 
+// No unsafe code in the library. Unit tests may use it only where allowed by name (one helper
+// in `formats::write`'s tests makes a FIFO through libc), so tests are built with `deny`.
+#![cfg_attr(not(test), forbid(unsafe_code))]
+#![cfg_attr(test, deny(unsafe_code))]
+// Every public item has a doc comment (CI turns this warning into an error).
+#![warn(missing_docs)]
 // Index loops are the clearest form for the graph and DP code here.
 #![allow(clippy::needless_range_loop)]
 

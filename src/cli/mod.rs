@@ -41,8 +41,8 @@ enum Command {
     Solve(solve::SolveArgs),
     /// Check and report a given solution.
     Eval(solve::EvalArgs),
-    /// List every solver with its parameters and defaults.
-    Solvers,
+    /// List every solver with its parameters and defaults (`--markdown`: docs/solvers.md).
+    Solvers(solve::SolversArgs),
     /// Generate an instance from a seeded generator.
     Generate(solve::GenerateArgs),
     /// Lower bounds on the optimum of an instance.
@@ -104,7 +104,7 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<()> {
         Command::Validate(a) => solve::validate(a),
         Command::Solve(a) => solve::solve(a),
         Command::Eval(a) => solve::eval(a),
-        Command::Solvers => solve::solvers(),
+        Command::Solvers(a) => solve::solvers(a),
         Command::Generate(a) => solve::generate(a),
         Command::Bound(a) => bound::bound(a),
         Command::Demo(a) => demo::demo(a),

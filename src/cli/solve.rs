@@ -4,7 +4,7 @@ use anyhow::{Context as _, Result, bail};
 use cellseq::formats::json::{self, SOLUTION_FORMAT, SolutionFile};
 use cellseq::formats::{self, best_known};
 use cellseq::model::{Instance, Objective};
-use cellseq::solvers::{self, Budget, NoObserver, ParamKind, RunResult, parse_kv};
+use cellseq::solvers::{self, Budget, NoObserver, RunResult, parse_kv};
 use clap::Args;
 use serde_json::json;
 use std::path::{Path, PathBuf};
@@ -343,7 +343,18 @@ pub fn eval(a: EvalArgs) -> Result<()> {
     Ok(())
 }
 
-pub fn solvers() -> Result<()> {
+#[derive(Args, Debug)]
+pub struct SolversArgs {
+    /// Print `docs/solvers.md` instead (Markdown: every solver's description and parameters).
+    #[arg(long)]
+    markdown: bool,
+}
+
+pub fn solvers(a: SolversArgs) -> Result<()> {
+    if a.markdown {
+        say!("{}", solvers::docs::markdown().trim_end());
+        return Ok(());
+    }
     for s in solvers::registry() {
         let default = if s.name == solvers::DEFAULT_SOLVER {
             "  (default)"
@@ -352,13 +363,7 @@ pub fn solvers() -> Result<()> {
         };
         say!("{}{default}\n    {}", s.name, s.summary);
         for p in s.params {
-            let kind = match p.kind {
-                ParamKind::Int => "int".to_string(),
-                ParamKind::Float => "float".to_string(),
-                ParamKind::Bool => "bool".to_string(),
-                ParamKind::Choice(c) => c.join("|"),
-                ParamKind::Text => "text".to_string(),
-            };
+            let kind = solvers::docs::kind_label(&p.kind);
             say!("    --param {}={}  [{kind}]  {}", p.name, p.default, p.help);
         }
     }

@@ -18,7 +18,7 @@
 //! places, with `s + d ≤ k`), any number of these at once when they do not overlap, and the
 //! best modes for each, so a pass ends in a local optimum of all of them together. `ils`
 //! runs it over the span of every kick (`--param shift-repair=K`); on PCGTSPLIB p43.2 it
-//! takes the runs at 10 s below the best known more often (notes/sopq9.md). States are kept
+//! takes the runs at 10 s below the best known more often (notes/lab/sopq9.md). States are kept
 //! in a hash map per stage; a stage that would hold more than `max_states` ends the pass
 //! without a change.
 

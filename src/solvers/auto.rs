@@ -14,14 +14,14 @@
 //!    and its Lin–Kernighan chains more of the time; there, when the beam phase ran, it gets
 //!    `symmetric-beam-share` (30 %) and is followed by `symmetric-beam-plan` (`ils` in a
 //!    1 % band): `ils` started from the beam's sequence (on prob.100 at 10 s the median of
-//!    16 seeds went from 1210.5 to 1172; notes/sopq5.md). On other matrix instances whose
+//!    16 seeds went from 1210.5 to 1172; notes/lab/sopq5.md). On other matrix instances whose
 //!    precedence closure is sparser than `dense-density` (0.8) the default is `sparse-plan`:
 //!    a shorter `local-search`, the colony run backwards, `ils` in a narrow and then a
 //!    wider acceptance band, and a short window re-optimization (see [`SPARSE_PLAN`]). On
 //!    the other matrix instances (dense precedence) of at most `dense-beam-max-cells` (300)
 //!    cells the beam gets `dense-beam-share` (50 %): there its wider passes find what the
 //!    plan misses (PCGTSPLIB rbg174a: 1641, the proven optimum, on 13 of 13 seeds at 10 s,
-//!    against 1642–1643 with 10 %; notes/sopq8.md). On larger dense instances
+//!    against 1642–1643 with 10 %; notes/lab/sopq8.md). On larger dense instances
 //!    (rbg323a–rbg378a) the passes do not finish: there is no beam phase, and the default is
 //!    `large-dense-plan`: `ils` with longer kicks (see [`LARGE_DENSE_PLAN`]).
 //!
@@ -187,17 +187,17 @@ pub const PLAN: &str = "local-search:0.3,eacs:0.5,ils*:1";
 /// Default phases on matrix instances with symmetric costs: `ils` (with its Lin–Kernighan
 /// chains) gets 56 % of the time instead of 35 %. On prob.100 the median of 5 seeds at 10 s
 /// went from 1238 to 1211 and of 10 seeds at 1 s from 1380.5 to 1282; prob.42 from 245.5
-/// to 243 at 1 s (notes/sopq3.md).
+/// to 243 at 1 s (notes/lab/sopq3.md).
 pub const SYMMETRIC_PLAN: &str = "local-search:0.2,eacs*:0.3,ils*:1";
 
 /// Default phases on matrix instances with symmetric costs after a beam phase that ran:
 /// `ils` from the beam's sequence. The beam builds its paths with bounds over the whole
 /// remainder and lands in a better basin for `ils` than greedy, `local-search` or `eacs`
 /// starts: on prob.100 at 10 s, median of 16 seeds 1172 against the symmetric plan's 1210.5
-/// (and 1205 from local-search, 1217 from eacs; notes/sopq5.md). Its acceptance band is
+/// (and 1205 from local-search, 1217 from eacs; notes/lab/sopq5.md). Its acceptance band is
 /// 1 % (the default 0.1 % stalls: a walk that finds no new best in 2000 kicks goes back
 /// to the best): prob.100 at 10 s, seeds 1–20, 12 runs at or below the best known 1163
-/// and median 1161, against 6 and 1172 (notes/sopq10.md).
+/// and median 1161, against 6 and 1172 (notes/lab/sopq10.md).
 pub const SYMMETRIC_BEAM_PLAN: &str = "ils[accept=0.01]*:1";
 
 /// Default phases on asymmetric matrix instances whose precedence closure is sparser than
@@ -206,20 +206,20 @@ pub const SYMMETRIC_BEAM_PLAN: &str = "ils[accept=0.01]*:1";
 /// to 3 % above the best instead of 0.1 %. With few precedences the walk needs the wider
 /// band to leave the basin that `eacs` hands it (kro124p.3: median 49703 → 49499, its best
 /// known), while on the dense rbg instances the wider band wanders (rbg358a: 2545 → 2565;
-/// notes/sopq5.md, notes/sopq6.md). Its colony runs backwards (`~eacs`, on the transposed
+/// notes/lab/sopq5.md, notes/lab/sopq6.md). Its colony runs backwards (`~eacs`, on the transposed
 /// twin of the instance) and gets the time `local-search` gave up (0.3 → 0.1): built from
 /// the other end, the ants fall less often into the basin that holds forward colonies on
 /// kro124p.3 (10 s, seeds 1–10: 8 runs at the best known 49499 and 2 at 49519, against 6
-/// and 4 in the 50183–50207 basin; notes/sopq7.md). The last `ils` ends every kick's repair
+/// and 4 in the 50183–50207 basin; notes/lab/sopq7.md). The last `ils` ends every kick's repair
 /// with the bounded-shift DP at shift 2 (adjacent swaps and the modes re-chosen over the
 /// kicked span): PCGTSPLIB p43.2 16/16 and kro124p.4 11/16 seeds at or below the best known,
-/// against 13/16 and 8/16 without; shift 5 lost rbg050c (12/16 against 16/16; notes/sopq9.md).
+/// against 13/16 and 8/16 without; shift 5 lost rbg050c (12/16 against 16/16; notes/lab/sopq9.md).
 /// The `ils` time is split: first a walk in a 1 % band from the colony's sequence, which
 /// stays in that basin and settles there (PCGTSPLIB kro124p.4 reaches 62818 or 62831, where
 /// the 3 % band wanders to 62915–62953), then the 3 % walk from the best, which leaves a poor
 /// basin that the narrow one cannot (PCGTSPLIB ft70.2: 33912 from the colony), then window
 /// re-optimization ([`super::reopt`], windows of 16) of the best, which turns 62831 into
-/// 62818: kro124p.4 at 10 s, seeds 101–112, 8/12 at 62818 against 6/12 (notes/sopq10.md).
+/// 62818: kro124p.4 at 10 s, seeds 101–112, 8/12 at 62818 against 6/12 (notes/lab/sopq10.md).
 pub const SPARSE_PLAN: &str = "local-search:0.1,~eacs:0.5,ils[accept=0.01;shift-repair=2]*:0.25,ils[accept=0.03;shift-repair=2]*:0.85,reopt[window=16]*:1";
 
 /// Default phases on asymmetric matrix instances with dense precedence and more than
@@ -231,7 +231,7 @@ pub const SPARSE_PLAN: &str = "local-search:0.1,~eacs:0.5,ils[accept=0.01;shift-
 /// (60, 80) bury in repair. At 10 s, seeds 101–108 on the four instances, 23 of 32 runs
 /// reach the best known value, against 5 with the plan before (`ils` for 40 %, then window
 /// re-optimization by the exact tree search, [`super::reopt`]) and 15 and 15 with kicks of
-/// 60 and 80; seeds 109–116 gave 17 of 32 (notes/sopq11.md).
+/// 60 and 80; seeds 109–116 gave 17 of 32 (notes/lab/sopq11.md).
 pub const LARGE_DENSE_PLAN: &str = "local-search:0.1,ils[max-seg=45]*:1";
 
 /// The solvers a plan phase can start from an earlier sequence (`*`, `+`).

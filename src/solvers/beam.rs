@@ -355,7 +355,7 @@ fn arc_mu(mu_arc: &[f64], n: usize, i: usize, j: usize) -> f64 {
 /// Evaluations charged per generated child (and per refined candidate): a child copies a
 /// prefix, computes its bound and probes the dominance map, which takes about as long as 8
 /// arc evaluations of the local search (evaluations per second on TSPLIB SOP: beam 2.4–7.6
-/// million, ils 17–75 million: 5–16 times as many, about 9 in the median; notes/sopq5.md).
+/// million, ils 17–75 million: 5–16 times as many, about 9 in the median; notes/lab/sopq5.md).
 /// So an evaluation budget buys the beam about the wall time it buys the other solvers, and
 /// `auto`'s shares of an evaluation budget match its shares of a time budget.
 pub const CHILD_EVALS: u64 = 8;

@@ -8,6 +8,7 @@ pub mod aco;
 pub mod as_given;
 pub mod auto;
 pub mod beam;
+pub mod docs;
 pub mod drawing;
 pub mod eacs;
 pub mod edge;

@@ -18,7 +18,7 @@
 //! (TSPLIB's rbg instances) windows of 80 cells are proven in 0.1–3 s, and a window holds
 //! what the local searches miss: on rbg323a a 3141 sequence of `auto` had one window of
 //! 80 cells whose optimum is one lower, which makes 3140, the proven optimum
-//! (notes/sopq9.md).
+//! (notes/lab/sopq9.md).
 //!
 //! The first sweep covers the sequence with windows of `window` cells, `step` apart, from a
 //! random offset. Each later sweep has windows a quarter larger, centred on the windows of

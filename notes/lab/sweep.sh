@@ -1,5 +1,5 @@
 #!/bin/sh
-# Beam proof sweep: one instance at a time, 60 s each. Usage: sh notes/sweep.sh [instances...]
+# Beam proof sweep: one instance at a time, 60 s each. Usage: sh notes/lab/sweep.sh [instances...]
 B=${CELLSEQ:-target/release/cellseq}
 for i in "$@"; do
   timeout 75 $B solve instances/tsplib-sop/$i.sop --solver beam --time-limit 60 --json --no-bound 2>&1 | python3 -c "
