@@ -12,6 +12,9 @@
 //!
 //! [`CASES`] cases per reader by default; `CELLSEQ_MUTATION_CASES=N` runs more. A failing case
 //! is written to `$CARGO_TARGET_TMPDIR/mutations/` so it can be replayed with the CLI.
+//!
+//! This file is a test binary of its own, not a module of `tests/it/`: its counting
+//! `#[global_allocator]` would otherwise count (and cap) the allocations of every test there.
 
 use cellseq::formats::{self, Format, json};
 use cellseq::harness::plan::Plan;
@@ -130,9 +133,10 @@ static ALLOCATOR: Counting = Counting;
 // ---------------------------------------------------------------------------------------------
 // seeds and mutations
 
-fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-}
+// the integration tests' shared paths (this file is a binary of its own: see below)
+#[path = "it/common.rs"]
+mod common;
+use common::root;
 
 fn walk(dir: &Path, out: &mut Vec<PathBuf>) {
     let Ok(rd) = std::fs::read_dir(dir) else {

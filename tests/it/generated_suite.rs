@@ -3,7 +3,6 @@
 
 use cellseq::formats::json::instance_to_json;
 use std::collections::BTreeMap;
-use std::path::Path;
 
 struct Entry {
     file: String,
@@ -13,7 +12,7 @@ struct Entry {
 }
 
 fn suite() -> Vec<Entry> {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("instances/generated");
+    let dir = crate::common::instance_path("generated");
     let text = std::fs::read_to_string(dir.join("suite.tsv")).unwrap();
     text.lines()
         .filter(|l| !l.trim().is_empty() && !l.starts_with('#'))
@@ -43,7 +42,7 @@ fn suite() -> Vec<Entry> {
 
 #[test]
 fn small_suite_instances_regenerate_byte_for_byte() {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("instances/generated");
+    let dir = crate::common::instance_path("generated");
     let mut compared = 0;
     for e in suite()
         .iter()
@@ -63,7 +62,7 @@ fn small_suite_instances_regenerate_byte_for_byte() {
 
 #[test]
 fn every_shipped_instance_validates() {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("instances/generated");
+    let dir = crate::common::instance_path("generated");
     for e in suite().iter().filter(|e| !e.file.starts_with("large/")) {
         let path = dir.join(&e.file);
         let inst = cellseq::formats::load_instance(&path).unwrap();

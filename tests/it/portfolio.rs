@@ -1,16 +1,11 @@
 //! The default portfolio (`auto`) and the enhanced ant colony (`eacs`): plans, determinism
 //! under an evaluation budget, and solution quality on a small TSPLIB SOP instance.
 
-use cellseq::formats::load_instance;
 use cellseq::solvers::auto::{Start, parse_plan};
 use cellseq::solvers::{Budget, NoObserver, run};
 use std::collections::BTreeMap;
-use std::path::Path;
 
-fn sop(name: &str) -> cellseq::model::Instance {
-    let p = Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("instances/tsplib-sop/{name}.sop"));
-    load_instance(&p).unwrap()
-}
+use crate::common::sop;
 
 fn evals(n: u64) -> Budget {
     Budget {

@@ -7,11 +7,7 @@ use proptest::prelude::*;
 const FIXTURES: [&str; 3] = ["mill.ngc", "laser.gcode", "inch_plasma.ngc"];
 
 fn fixture(name: &str) -> String {
-    std::fs::read_to_string(format!(
-        "{}/tests/fixtures/gcode/{name}",
-        env!("CARGO_MANIFEST_DIR")
-    ))
-    .unwrap()
+    crate::common::fixture_text(&format!("gcode/{name}"))
 }
 
 #[test]
@@ -378,10 +374,10 @@ fn never_worse_on_any_figure() {
 fn gcode_is_never_written_into_an_svg() {
     let dir = tempfile::tempdir().unwrap();
     let o = dir.path().join("x.svg");
-    let st = std::process::Command::new(env!("CARGO_BIN_EXE_cellseq"))
+    let st = crate::common::cellseq()
         .args(["optimize", "tests/fixtures/gcode/mill.ngc", "-o"])
         .arg(&o)
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .current_dir(crate::common::root())
         .output()
         .unwrap();
     assert!(!st.status.success());

@@ -5,11 +5,7 @@ use cellseq::io::gcode::{self, interp::CutKind};
 use cellseq::pipeline::gcode::{Options, optimize};
 
 fn fixture(name: &str) -> String {
-    std::fs::read_to_string(format!(
-        "{}/tests/fixtures/gcode/{name}",
-        env!("CARGO_MANIFEST_DIR")
-    ))
-    .unwrap()
+    crate::common::fixture_text(&format!("gcode/{name}"))
 }
 
 fn opts(reversible: Option<bool>) -> Options {

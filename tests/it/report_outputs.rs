@@ -7,7 +7,7 @@ use cellseq::harness::run::{RunOptions, run_plan};
 use std::path::Path;
 use std::process::Command;
 
-const BIN: &str = env!("CARGO_BIN_EXE_cellseq");
+use crate::common::BIN;
 
 fn plan(budget: &str) -> String {
     format!(

@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::{Duration, Instant};
 
-const BIN: &str = env!("CARGO_BIN_EXE_cellseq");
+use crate::common::BIN;
 
 const PLAN: &str = r#"
 name = "t"
@@ -319,7 +319,7 @@ fn report_is_deterministic_and_complete() {
 
 #[test]
 fn shipped_plans_parse_against_the_registries() {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let root = crate::common::root();
     let demo = Plan::parse("demo", cellseq::harness::DEMO_PLAN, root).unwrap();
     assert!(demo.file.budget.evaluations.is_some() && demo.file.budget.seconds.is_none());
     assert_eq!(demo.solvers.len(), cellseq::solvers::registry().len());
@@ -333,7 +333,7 @@ fn shipped_plans_parse_against_the_registries() {
 fn paper_plans_are_well_formed_toml_plans() {
     // Full validation needs the casing/panel generators and tabu/sa/aco solvers; until they are
     // registered, `check` must fail only because of them.
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let root = crate::common::root();
     for f in [
         "experiments/paper-casing.toml",
         "experiments/paper-panel.toml",
@@ -401,7 +401,7 @@ layers = true
 tools = true
 source = "test"
 "#;
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let root = crate::common::root();
     std::fs::copy(
         root.join("instances/pcgtsplib/ESC07.pcglns"),
         dir.path().join("ESC07.pcglns"),

@@ -197,7 +197,7 @@ proptest! {
         // asymmetric matrices (every reversal changes the inside links' cost) one time in four
         let inst = if matrix == 0 {
             let f = ["ESC12", "br17.10", "p43.1", "ft53.1"][(seed % 4) as usize];
-            cellseq::formats::load_instance(std::path::Path::new(&format!("instances/tsplib-sop/{f}.sop"))).unwrap()
+            crate::common::sop(f)
         } else {
             generate("uniform", &kv, seed).unwrap()
         };

@@ -1,12 +1,10 @@
 //! Core tests: exact optima, checker violations, JSON round trip, greedy on the benchmarks.
 
-mod common;
-
+use crate::common::{instance_path, line_instance};
 use cellseq::check::{Violation, check};
 use cellseq::formats::{self, json};
 use cellseq::model::{Objective, Visit};
 use cellseq::solvers::{self, Budget, NoObserver};
-use common::{instance_path, line_instance};
 use std::collections::BTreeMap;
 
 fn solve(name: &str, inst: &cellseq::Instance) -> cellseq::solvers::RunResult {

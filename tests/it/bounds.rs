@@ -8,11 +8,9 @@ use cellseq::model::{Instance, Objective, Sequence};
 use cellseq::solvers::{self, Budget, NoObserver};
 use proptest::prelude::*;
 use std::collections::BTreeMap;
-use std::path::Path;
 
 fn load(rel: &str) -> Instance {
-    formats::load_instance(&Path::new(env!("CARGO_MANIFEST_DIR")).join(rel))
-        .expect("instance loads")
+    formats::load_instance(&crate::common::root().join(rel)).expect("instance loads")
 }
 
 fn exact(inst: &Instance, obj: Objective) -> f64 {

@@ -34,7 +34,7 @@ fn bad_output_names_are_errors() {
 
 #[test]
 fn cli_generate_solve_plot() {
-    let exe = env!("CARGO_BIN_EXE_cellseq");
+    let exe = crate::common::BIN;
     let dir = tempfile::tempdir().unwrap();
     let inst = dir.path().join("p.json");
     let sol = dir.path().join("s.json");
@@ -119,13 +119,15 @@ fn programs_and_drawings_plot_directly_right_way_up() {
 
 #[test]
 fn cli_plots_svg_with_optimized_side_by_side() {
-    let exe = env!("CARGO_BIN_EXE_cellseq");
+    let exe = crate::common::BIN;
     let dir = tempfile::tempdir().unwrap();
     let pic = dir.path().join("s.png");
     let o = std::process::Command::new(exe)
         .args([
             "plot",
-            "tests/fixtures/svg/shapes.svg",
+            crate::common::fixture_path("svg/shapes.svg")
+                .to_str()
+                .unwrap(),
             "--optimized",
             "-o",
             pic.to_str().unwrap(),

@@ -779,7 +779,7 @@ fn judge(path: &Path, flags: &[&str], work: &Path) -> Outcome {
     let _ = std::fs::create_dir_all(work);
     let out_path = work.join(format!("out_{name}"));
     let ran = run(
-        Command::new(env!("CARGO_BIN_EXE_cellseq"))
+        crate::common::cellseq()
             .arg("optimize")
             .arg(path)
             .arg("-o")
@@ -874,7 +874,7 @@ fn judge(path: &Path, flags: &[&str], work: &Path) -> Outcome {
 // ---------------------------------------------------------------------------------------------
 
 fn fixtures() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/gcode")
+    crate::common::fixture_path("gcode")
 }
 
 /// Every G-code program under `tests/fixtures/gcode/` (and `real/`), sorted.

@@ -27,7 +27,7 @@ fn limited(input: &Path, output: &Path) -> std::process::Output {
     Command::new("sh")
         .arg("-c")
         .arg(r#"ulimit -v 4194304; ulimit -t 30; exec "$0" optimize "$1" -o "$2""#)
-        .arg(env!("CARGO_BIN_EXE_cellseq"))
+        .arg(crate::common::BIN)
         .arg(input)
         .arg(output)
         .output()

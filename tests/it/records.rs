@@ -3,11 +3,10 @@
 
 use cellseq::formats::{json, load_instance, read_text};
 use cellseq::model::Objective;
-use std::path::Path;
 
 #[test]
 fn prob100_paths_below_the_published_best_known_are_feasible() {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let root = crate::common::root();
     let inst = load_instance(&root.join("instances/tsplib-sop/prob.100.sop")).unwrap();
     // the shipped best known value (the literature's) is 1163
     let bks = std::fs::read_to_string(root.join("instances/tsplib-sop/bks.csv")).unwrap();

@@ -5,7 +5,7 @@ use cellseq::pipeline::drawing::{self as pipe, Options};
 use proptest::prelude::*;
 
 fn fixture(name: &str) -> String {
-    std::fs::read_to_string(format!("tests/fixtures/svg/{name}")).unwrap()
+    crate::common::fixture_text(&format!("svg/{name}"))
 }
 
 #[test]

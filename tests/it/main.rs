@@ -1,0 +1,41 @@
+//! The integration tests, one binary (each test binary links the whole crate, so one binary
+//! builds and links once). Every former `tests/<name>.rs` is a module here; shared helpers
+//! (paths of instances and fixtures, the `cellseq` binary, small instances) live in
+//! `common.rs`. Run one module with `cargo test --release --test it <module>::`.
+//!
+//! To add tests: put them in `tests/it/<topic>.rs` (use `crate::common::*` for every path to
+//! a repository file, so that no test depends on the working directory), add `mod <topic>;`
+//! below, and keep proptest regression files in `tests/proptest-regressions/<topic>.txt`
+//! (where proptest looks for a module of this binary). A file that needs a process of its
+//! own — a `#[global_allocator]`, a global setting of the process — stays a binary of its own
+//! in `tests/` (as `tests/mutations.rs`, whose counting allocator would otherwise account for
+//! every test of this binary).
+
+mod common;
+
+mod bad_instances;
+mod bounds;
+mod cli;
+mod conformance;
+mod core;
+mod dxf;
+mod edge;
+mod engine_props;
+mod gcode;
+mod gcode_reverse;
+mod generated_suite;
+mod generators;
+mod golden;
+mod harness;
+mod insertion;
+mod keep_out;
+mod plot;
+mod portfolio;
+mod props;
+mod reader_regressions;
+mod records;
+mod report_outputs;
+mod rs274;
+mod safe_writes;
+mod svg;
+mod two_level;
