@@ -7,7 +7,7 @@ const REGENERATE: &str = "cargo run --release -- solvers --markdown > docs/solve
 
 #[test]
 fn docs_solvers_md_is_current() {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/solvers.md");
+    let path = crate::common::root().join("docs/solvers.md");
     let committed = std::fs::read_to_string(&path)
         .unwrap_or_else(|e| panic!("{}: {e}; create it with `{REGENERATE}`", path.display()));
     let current = cellseq::solvers::docs::markdown();
