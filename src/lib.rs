@@ -37,6 +37,7 @@ pub mod params;
 pub mod pipeline;
 pub mod plot;
 pub mod precedence;
+pub mod search;
 pub mod solvers;
 pub mod validate;
 

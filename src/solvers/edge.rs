@@ -16,7 +16,7 @@
 //! order, so it applies to geometric instances without precedence that use one tool; on any
 //! other instance this solver returns the nearest-neighbour `greedy` sequence.
 
-use super::{Context, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo, greedy};
+use super::{Caps, Context, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo, greedy};
 use crate::cost::CostModel;
 use crate::engine::solution::flip_mode;
 use crate::error::Result;
@@ -35,10 +35,11 @@ pub static INFO: SolverInfo = SolverInfo {
         kind: ParamKind::Int,
         help: "candidate successors per cell",
     }],
+    caps: Caps { ..Caps::NONE },
     make: |p: &Params| {
-        Box::new(GreedyEdge {
+        Ok(Box::new(GreedyEdge {
             k: p.int("k").max(1) as usize,
-        })
+        }))
     },
 };
 

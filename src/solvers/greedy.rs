@@ -6,7 +6,7 @@
 //! the best exact arc cost found, so each step is exact and costs O(log n) in practice.
 //! Matrix instances scan the ready cells.
 
-use super::{Context, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo, outcome_of};
+use super::{Caps, Context, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo, outcome_of};
 use crate::cost::CostModel;
 use crate::error::Result;
 use crate::model::{Objective, Sequence, Visit};
@@ -23,10 +23,11 @@ pub static INFO: SolverInfo = SolverInfo {
         kind: ParamKind::Float,
         help: "probability of taking the second-best candidate at a step (0 = pure greedy)",
     }],
+    caps: Caps { ..Caps::NONE },
     make: |p: &Params| {
-        Box::new(Greedy {
+        Ok(Box::new(Greedy {
             randomize: p.float("randomize"),
-        })
+        }))
     },
 };
 

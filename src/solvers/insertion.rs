@@ -24,7 +24,7 @@
 //! is in); with points instead of strokes 0.75 × at 10^5. `local-search` starting from it
 //! reaches 0.70–0.72 × the walk at 10^5 cells in 10 s, against 0.895 × from the walk itself.
 
-use super::{Context, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo, outcome_of};
+use super::{Caps, Context, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo, outcome_of};
 use crate::cost::CostModel;
 use crate::engine::order::OrderList;
 use crate::engine::{Costs, Slot};
@@ -46,10 +46,11 @@ pub static INFO: SolverInfo = SolverInfo {
         kind: ParamKind::Int,
         help: "feasible places next to nearby inserted cells to try per cell (geometric instances)",
     }],
+    caps: Caps { ..Caps::NONE },
     make: |p: &Params| {
-        Box::new(Insertion {
+        Ok(Box::new(Insertion {
             k: p.int("k").max(1) as usize,
-        })
+        }))
     },
 };
 
