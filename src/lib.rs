@@ -24,6 +24,7 @@
 
 pub mod bound;
 pub mod check;
+pub mod construct;
 pub mod cost;
 pub mod engine;
 pub mod error;

@@ -61,7 +61,7 @@ impl Solver for Drawing {
         if !m.is_geometric() {
             return fallback(ctx);
         }
-        let start = super::greedy::geometric(m, &mut |k| ctx.count(k));
+        let start = crate::construct::greedy::geometric(m, &mut |k| ctx.count(k));
         if !flat(m) || start.len() < 4 {
             let out = outcome_of(m, start);
             ctx.report(out.cost);
