@@ -95,27 +95,6 @@ impl<'a> Context<'a> {
             best: f64::INFINITY,
         }
     }
-    /// A context for a sub-solver run inside this one (portfolio phases, warm starts): the same
-    /// instance, model and seed, its own parameters, budget and observer; its clock starts now.
-    /// The caller adds the sub-run's evaluations back with [`Context::count`].
-    pub fn sub<'b>(
-        &self,
-        params: &'b Params,
-        budget: Budget,
-        observer: &'b mut dyn Observer,
-    ) -> Context<'b>
-    where
-        'a: 'b,
-    {
-        Context::new(
-            self.instance,
-            self.model,
-            params,
-            self.seed,
-            budget,
-            observer,
-        )
-    }
     /// Counts `k` evaluations.
     #[inline]
     pub fn count(&mut self, k: u64) {

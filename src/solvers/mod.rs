@@ -292,3 +292,59 @@ pub fn run(
         objective,
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::formats::{Format, parse_instance};
+
+    fn tiny() -> Instance {
+        // 5 nodes, node 1 first and node 5 last, 2 before 4
+        let text = "TYPE: SOP\nDIMENSION: 5\nEDGE_WEIGHT_SECTION\n5\n\
+                    0 4 1 9 9\n-1 0 3 2 8\n-1 1 0 -1 6\n-1 -1 1 0 1\n-1 -1 -1 -1 0\nEOF\n";
+        parse_instance("tiny.sop", text, Format::Sop).unwrap()
+    }
+
+    #[test]
+    fn building_auto_refuses_a_malformed_plan() {
+        let info = find("auto").unwrap();
+        let kv = |v: &str| BTreeMap::from([("plan".to_string(), v.to_string())]);
+        assert!(info.build(&kv("local-search:0.5,ils*:1")).is_ok());
+        let e = info.build(&kv("nosuch:1")).err().unwrap().to_string();
+        assert!(e.contains("nosuch"), "{e}");
+        let e = info.build(&kv("greedy*:1")).err().unwrap().to_string();
+        assert!(
+            e.contains("only ils, eacs and reopt can start from an earlier sequence"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn sub_runs_start_only_solvers_that_take_a_start() {
+        let inst = tiny();
+        let model = CostModel::new(&inst, inst.default_objective());
+        let params = Params::new("as-given", &[], &BTreeMap::new()).unwrap();
+        let mut obs = NoObserver;
+        let budget = Budget {
+            time_limit: None,
+            max_evals: Some(5_000),
+        };
+        let mut ctx = Context::new(&inst, &model, &params, 3, budget, &mut obs);
+        let start = sub_run(&mut ctx, Sub::new("as-given", budget, 3)).unwrap();
+        let used = ctx.evaluations();
+        for info in registry() {
+            let sub = Sub {
+                start: Some(&start.sequence),
+                ..Sub::new(info.name, budget, 3)
+            };
+            let out = sub_run(&mut ctx, sub);
+            if info.caps.takes_start() {
+                let out = out.unwrap_or_else(|e| panic!("{}: {e}", info.name));
+                assert!(out.cost <= start.cost, "{} worse than its start", info.name);
+                assert!(ctx.evaluations() >= used, "{}", info.name);
+            } else {
+                assert!(out.is_err(), "{} took a start it cannot use", info.name);
+            }
+        }
+    }
+}
