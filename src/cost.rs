@@ -5,9 +5,9 @@
 //! It is the solvers' incremental evaluator; the independent checker in [`crate::check()`]
 //! recomputes everything from the raw instance without using this module.
 
-use crate::bound::closure::Closure;
 use crate::geom::Point3;
 use crate::model::{CostMatrix, Instance, Objective, Sequence};
+use crate::precedence::Closure;
 use crate::precedence::{Dag, topological_order};
 use std::sync::OnceLock;
 

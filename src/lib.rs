@@ -30,6 +30,7 @@
 
 pub mod bound;
 pub mod check;
+pub mod construct;
 pub mod cost;
 pub mod engine;
 pub mod error;
@@ -43,6 +44,7 @@ pub mod params;
 pub mod pipeline;
 pub mod plot;
 pub mod precedence;
+pub mod search;
 pub mod solvers;
 pub mod validate;
 

@@ -1,8 +1,8 @@
 //! The cell graph used by the dense bounds: min-over-modes arc costs between cells plus a
 //! home node, with every arc that precedence forbids removed (set to infinity).
 
-use super::closure::Closure;
 use crate::cost::CostModel;
+use crate::precedence::Closure;
 
 /// Dense (n+1) × (n+1) cost matrix over cells; index `n` is home (start before / end after).
 ///

@@ -18,14 +18,16 @@
 pub mod arborescence;
 pub mod assignment;
 pub mod cells;
-pub mod closure;
 pub mod knn;
 pub mod qpath;
 pub mod sec;
 
 use crate::cost::CostModel;
+use crate::precedence::Closure;
+/// The precedence closure, which lives with the DAG ([`crate::precedence::closure`]);
+/// re-exported here for callers that named it `bound::closure`.
+pub use crate::precedence::closure;
 use cells::CellGraph;
-use closure::Closure;
 use std::time::Instant;
 
 /// Which bounds to compute and the size limits of the dense ones.

@@ -13,8 +13,8 @@
 //! least `h(p, l) + Σ_U λ` ([`QPath::completion`]). Dense precedence (narrow windows) makes the
 //! bound strong: on rbg048a the root value is 348.8 against an optimum of 351.
 
-use super::closure::Closure;
 use crate::cost::CostModel;
+use crate::precedence::Closure;
 
 const NONE: u32 = u32::MAX;
 

@@ -23,7 +23,7 @@
 
 use super::assignment;
 use super::cells::CellGraph;
-use super::closure::Closure;
+use crate::precedence::Closure;
 use rustc_hash::FxHashMap;
 
 /// Multipliers, sets and duals of the subtour-elimination Lagrangian.

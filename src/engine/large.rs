@@ -18,7 +18,7 @@ use super::search::improves;
 use super::twolevel::{TwoLevel, turn};
 use super::{Costs, Neighbours, Slot, Solution};
 use crate::model::Objective;
-use crate::solvers::Context;
+use crate::search::Context;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::collections::VecDeque;

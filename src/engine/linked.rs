@@ -15,7 +15,7 @@
 use super::order::OrderList;
 use super::{Costs, Neighbours, Solution};
 use crate::cost::CostModel;
-use crate::solvers::Context;
+use crate::search::Context;
 use std::collections::VecDeque;
 
 /// The path as a cyclic linked list with order labels, and the cells' modes.

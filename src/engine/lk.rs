@@ -21,7 +21,7 @@ use super::search::{Search, improves};
 use super::solution::flip_mode;
 use super::{Costs, Neighbours, Slot, Solution};
 use crate::model::CostMatrix;
-use crate::solvers::Context;
+use crate::search::Context;
 use std::collections::VecDeque;
 
 /// Instances with at most this many nodes are tested for symmetric costs (O(nodes²)).
@@ -477,7 +477,8 @@ mod tests {
     use crate::cost::CostModel;
     use crate::engine::search::Search;
     use crate::model::{Instance, Objective, Sequence, Visit};
-    use crate::solvers::{Budget, NoObserver, Params};
+    use crate::params::Params;
+    use crate::search::{Budget, NoObserver};
     use rand::{RngExt, SeedableRng};
     use rand_chacha::ChaCha8Rng;
 

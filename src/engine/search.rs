@@ -7,7 +7,7 @@ use super::moves::{
 use super::sop3x::{Labels, forward};
 use super::window::ModeWindow;
 use super::{Costs, Neighbours, Solution};
-use crate::solvers::Context;
+use crate::search::Context;
 use std::collections::VecDeque;
 
 /// Improvement threshold (relative) below which a delta does not count as an improvement.

@@ -24,7 +24,7 @@
 
 use super::search::improves;
 use super::{Costs, Slot, Solution};
-use crate::solvers::Context;
+use crate::search::Context;
 use rustc_hash::FxHashMap;
 
 /// No last cell yet: the run's left neighbour (or the path start) comes before.

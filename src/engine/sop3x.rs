@@ -22,8 +22,8 @@
 use super::moves::sop3_sum;
 use super::search::{Search, improves};
 use super::{Costs, Solution};
-use crate::bound::closure::Closure;
-use crate::solvers::Context;
+use crate::precedence::Closure;
+use crate::search::Context;
 
 /// Labelling scratch space of SOP-3-exchange: a stamp per cell and the current label.
 #[derive(Debug, Default, Clone)]
@@ -304,7 +304,8 @@ mod tests {
     use super::*;
     use crate::cost::CostModel;
     use crate::model::{Instance, Objective};
-    use crate::solvers::{Budget, NoObserver, Params};
+    use crate::params::Params;
+    use crate::search::{Budget, NoObserver};
     use rand::{RngExt, SeedableRng};
     use rand_chacha::ChaCha8Rng;
 

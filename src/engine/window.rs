@@ -15,7 +15,7 @@ use super::modes::ModeLayers;
 use super::moves::window;
 use super::search::improves;
 use super::{Costs, Slot, Solution};
-use crate::solvers::Context;
+use crate::search::Context;
 
 /// Scratch space for window moves.
 #[derive(Debug, Default)]

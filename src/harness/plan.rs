@@ -522,7 +522,8 @@ fn plan_solvers(file: &str, specs: &[SolverSpec], max_trials: u64) -> Result<Vec
         }
         let info = solvers::find(&spec.name).map_err(|e| bad(format!("{what}: {e}")))?;
         for params in expand_grid(file, &what, &spec.params, max_trials)? {
-            Params::new(info.name, info.params, &params)
+            // building the solver validates what its parameters mean (an `auto` plan)
+            info.build(&params)
                 .map_err(|e| bad(format!("{what}: {e}")))?;
             let id = if params.is_empty() {
                 info.name.to_string()

@@ -6,7 +6,7 @@
 //! the ants, and the mode DP (the greedy pass over contact points) on every tour.
 
 use super::start::{greedy_solution, outcome};
-use super::{Context, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo};
+use super::{Caps, Context, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo};
 use crate::engine::modes::mode_dp;
 use crate::engine::search::Search;
 use crate::engine::{Costs, Solution};
@@ -85,8 +85,12 @@ pub static INFO: SolverInfo = SolverInfo {
             help: "candidate neighbours per cell (local search)",
         },
     ],
+    caps: Caps {
+        improves: true,
+        ..Caps::NONE
+    },
     make: |p: &Params| {
-        Box::new(Aco {
+        Ok(Box::new(Aco {
             ants: p.int("ants").max(1) as usize,
             beta: p.float("beta"),
             s: p.float("s"),
@@ -96,7 +100,7 @@ pub static INFO: SolverInfo = SolverInfo {
             stall: p.int("stall").max(1),
             ls: p.word("ls").to_string(),
             k: p.int("k").max(1) as usize,
-        })
+        }))
     },
 };
 

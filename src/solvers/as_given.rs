@@ -1,7 +1,7 @@
 //! `as-given`: the instance's own programmed order (the papers' "unoptimized" baseline),
 //! else file order, repaired to respect precedence.
 
-use super::{Context, Outcome, Params, Solver, SolverInfo, outcome_of};
+use super::{Caps, Context, Outcome, Params, Solver, SolverInfo, outcome_of};
 use crate::error::Result;
 use crate::model::Visit;
 use crate::precedence::ranked_topological_order;
@@ -11,7 +11,8 @@ pub static INFO: SolverInfo = SolverInfo {
     name: "as-given",
     summary: "the instance's as-programmed order (else file order), repaired to respect precedence",
     params: &[],
-    make: |_p: &Params| Box::new(AsGiven),
+    caps: Caps { ..Caps::NONE },
+    make: |_p: &Params| Ok(Box::new(AsGiven)),
 };
 
 /// The as-given solver.

@@ -37,10 +37,10 @@
 //! `seconds` of wall-clock time.
 
 use super::{
-    Budget, Context, NoObserver, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo,
+    Budget, Caps, Context, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo, Sub, sub_run,
 };
 use crate::cost::CostModel;
-use crate::engine::{Costs, Solution, lk};
+use crate::engine::{Costs, lk};
 use crate::error::{Error, Result};
 use crate::model::Instance;
 use crate::precedence::closure_density;
@@ -131,8 +131,9 @@ pub static INFO: SolverInfo = SolverInfo {
             help: "phases after the beam: solver[key=value;...]:share,... (share of what is left; optional parameters in brackets; a '*' after the name starts ils, eacs or reopt from the best so far, a '+' from the sequence of the phase before; a '~' before the name runs the phase on the matrix instance travelled backwards; a solver named twice gets a new seed each time)",
         },
     ],
+    caps: Caps { ..Caps::NONE },
     make: |p: &Params| {
-        Box::new(Auto {
+        let auto = Auto {
             seconds: p.float("seconds").max(0.001),
             beam_share: p.float("beam-share").clamp(0.0, 1.0),
             beam_max_cells: p.int("beam-max-cells") as usize,
@@ -146,7 +147,12 @@ pub static INFO: SolverInfo = SolverInfo {
             dense_beam_max_cells: p.int("dense-beam-max-cells") as usize,
             large_dense_plan: p.word("large-dense-plan").to_string(),
             beam_min_seconds: p.float("beam-min-seconds").max(0.0),
-        })
+        };
+        // every plan is parsed, so a malformed one is refused when the solver is built
+        for plan in auto.plans() {
+            parse_plan(plan)?;
+        }
+        Ok(Box::new(auto))
     },
 };
 
@@ -234,9 +240,6 @@ pub const SPARSE_PLAN: &str = "local-search:0.1,~eacs:0.5,ils[accept=0.01;shift-
 /// 60 and 80; seeds 109–116 gave 17 of 32 (notes/lab/sopq11.md).
 pub const LARGE_DENSE_PLAN: &str = "local-search:0.1,ils[max-seg=45]*:1";
 
-/// The solvers a plan phase can start from an earlier sequence (`*`, `+`).
-pub const STARTABLE: [&str; 3] = ["ils", "eacs", "reopt"];
-
 /// Where a plan phase starts.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Start {
@@ -315,11 +318,12 @@ pub fn parse_plan(plan: &str) -> Result<Vec<Phase>> {
             return Err(bad("a plan cannot contain auto itself".to_string()));
         }
         let info = super::find(&solver)?;
-        Params::new(&solver, info.params, &params)
+        info.build(&params)
             .map_err(|e| bad(format!("plan phase '{part}': {e}")))?;
-        if start != Start::Fresh && !STARTABLE.contains(&solver.as_str()) {
+        if start != Start::Fresh && !info.caps.starts_from {
             return Err(bad(format!(
-                "plan phase '{part}': only ils, eacs and reopt can start from an earlier sequence"
+                "plan phase '{part}': only {} can start from an earlier sequence",
+                startable()
             )));
         }
         if start == Start::Previous && out.is_empty() {
@@ -339,6 +343,22 @@ pub fn parse_plan(plan: &str) -> Result<Vec<Phase>> {
         return Err(bad("empty plan".to_string()));
     }
     Ok(out)
+}
+
+/// The solvers a plan phase can start from an earlier sequence (`*`, `+`): those whose
+/// capabilities say `starts_from`, as "ils, eacs and reopt".
+fn startable() -> String {
+    let mut names: Vec<&str> = super::registry()
+        .into_iter()
+        .filter(|i| i.caps.starts_from)
+        .map(|i| i.name)
+        .collect();
+    names.sort_by_key(|n| (n.len(), *n));
+    match names.split_last() {
+        Some((last, rest)) if !rest.is_empty() => format!("{} and {last}", rest.join(", ")),
+        Some((last, _)) => last.to_string(),
+        None => "no solver".to_string(),
+    }
 }
 
 /// Which settings of [`Auto`] apply to an instance (only with the default `plan`).
@@ -407,35 +427,26 @@ impl Auto {
             repeat,
             twin,
         } = run;
-        let info = super::find(name)?;
-        let params = Params::new(name, info.params, given)?;
-        let solver = (info.make)(&params);
-        let mut quiet = NoObserver;
-        let (instance, model) = match twin {
-            Some((i, m)) => (i, m),
-            None => (ctx.instance, ctx.model),
+        let (instance, on) = match twin {
+            Some((i, m)) => (i, Some((i, m))),
+            None => (ctx.instance, None),
         };
-        let seed = phase_seed(ctx.seed, repeat);
-        let mut sub = Context::new(instance, model, &params, seed, budget, &mut quiet);
-        let mut out = match start {
-            Some(o) => {
-                let seq = match twin {
-                    Some(_) => ctx.instance.reverse_sequence(&o.sequence),
-                    None => o.sequence.clone(),
-                };
-                let s = Solution::new(&Costs::open(model), &seq);
-                match name {
-                    "ils" => super::ils::from_params(&params).run(&mut sub, Some(s))?,
-                    "reopt" => super::reopt::from_params(&params).run(&mut sub, Some(s))?,
-                    _ => super::eacs::from_params(&params).run(&mut sub, Some(s))?,
-                }
-            }
-            None => solver.solve(&mut sub)?,
+        let seq = start.map(|o| match twin {
+            Some(_) => ctx.instance.reverse_sequence(&o.sequence),
+            None => o.sequence.clone(),
+        });
+        let sub = Sub {
+            name,
+            params: given,
+            budget,
+            seed: phase_seed(ctx.seed, repeat),
+            start: seq.as_ref(),
+            on,
         };
+        let mut out = sub_run(ctx, sub)?;
         if twin.is_some() {
             out.sequence = instance.reverse_sequence(&out.sequence);
         }
-        ctx.count(sub.evaluations());
         ctx.report(out.cost);
         if super::trace_enabled() {
             eprintln!(
@@ -522,10 +533,6 @@ impl Auto {
 
 impl Solver for Auto {
     fn solve(&self, ctx: &mut Context) -> Result<Outcome> {
-        // every plan is parsed, so a malformed one is refused on every instance
-        for p in self.plans() {
-            parse_plan(p)?;
-        }
         let case = self.case(ctx.model);
         let mut budget = ctx.budget;
         if budget.time_limit.is_none() && budget.max_evals.is_none() {

@@ -19,17 +19,15 @@
 //! is also charged the multipliers of the sets it must still leave. A root bound from [`crate::bound`] (Lagrangian
 //! arborescence) may close the gap at once.
 
-use super::{
-    Budget, Context, NoObserver, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo,
-};
+use super::{Budget, Caps, Context, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo};
 use crate::bound::cells::CellGraph;
-use crate::bound::closure::Closure;
 use crate::bound::qpath::{self, QPath};
 use crate::bound::sec::{self, SecBound};
 use crate::bound::{self, BoundOptions, assignment};
 use crate::cost::CostModel;
 use crate::error::{Error, Result};
 use crate::model::{Sequence, Visit};
+use crate::precedence::Closure;
 use rustc_hash::FxHashMap;
 
 /// Registry entry.
@@ -117,7 +115,12 @@ pub static INFO: SolverInfo = SolverInfo {
             help: "evaluations of an `ils` run that gives the first incumbent (0 = none)",
         },
     ],
-    make: |p: &Params| Box::new(from_params(p)),
+    caps: Caps {
+        exact: true,
+        warm_start: true,
+        ..Caps::NONE
+    },
+    make: |p: &Params| Ok(Box::new(from_params(p))),
 };
 
 /// Builds the solver from validated parameters.
@@ -174,14 +177,17 @@ pub const MAX_CELLS: usize = 1024;
 
 impl Solver for Beam {
     fn solve(&self, ctx: &mut Context) -> Result<Outcome> {
-        self.solve_from(ctx, None)
+        self.search_from(ctx, None)
+    }
+    fn solve_from(&self, ctx: &mut Context, start: Option<&Sequence>) -> Result<Outcome> {
+        self.search_from(ctx, start.cloned())
     }
 }
 
 impl Beam {
     /// The search with `incumbent` (a feasible sequence) as its first upper bound instead of
     /// the `ils` warm start: the result is never worse than it.
-    pub fn solve_from(&self, ctx: &mut Context, incumbent: Option<Sequence>) -> Result<Outcome> {
+    pub fn search_from(&self, ctx: &mut Context, incumbent: Option<Sequence>) -> Result<Outcome> {
         let n = ctx.model.n();
         let inc = incumbent.map(|seq| (ctx.model.evaluate(&seq), seq));
         match n.div_ceil(64) {
@@ -748,9 +754,6 @@ impl Beam {
         if self.warm_evals == 0 || ctx.model.n() < 3 {
             return Ok(None);
         }
-        let info = &super::ils::INFO;
-        let params = Params::new(info.name, info.params, &Default::default())?;
-        let solver = (info.make)(&params);
         let budget = Budget {
             max_evals: Some(match ctx.budget.max_evals {
                 Some(b) => (b / 4).min(self.warm_evals),
@@ -758,10 +761,8 @@ impl Beam {
             }),
             time_limit: ctx.budget.time_limit.map(|t| t.mul_f64(0.25)),
         };
-        let mut quiet = NoObserver;
-        let mut sub = ctx.sub(&params, budget, &mut quiet);
-        let out = solver.solve(&mut sub)?;
-        ctx.count(sub.evaluations());
+        let seed = ctx.seed;
+        let out = super::sub_run(ctx, super::Sub::new("ils", budget, seed))?;
         let cost = ctx.model.evaluate(&out.sequence);
         Ok(Some((cost, out.sequence)))
     }

@@ -14,12 +14,12 @@
 //! Every move costs O(1) to evaluate; a 2-opt costs the length of the reversed block to
 //! apply. Other instances (precedence, several tools, lifts, matrix costs) get `local-search`.
 
-use super::{Context, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo, outcome_of};
+use super::{Caps, Context, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo, outcome_of};
 use crate::cost::CostModel;
 use crate::engine::neighbours::Neighbours;
 use crate::error::Result;
 use crate::model::{Objective, Visit};
-use std::collections::{BTreeMap, VecDeque};
+use std::collections::VecDeque;
 
 /// Registry entry.
 pub static INFO: SolverInfo = SolverInfo {
@@ -40,11 +40,12 @@ pub static INFO: SolverInfo = SolverInfo {
             help: "longest block moved by an iterated-local-search kick",
         },
     ],
+    caps: Caps { ..Caps::NONE },
     make: |p: &Params| {
-        Box::new(Drawing {
+        Ok(Box::new(Drawing {
             k: p.int("k").max(1) as usize,
             kick_len: p.int("kick-len").max(2) as usize,
-        })
+        }))
     },
 };
 
@@ -62,7 +63,7 @@ impl Solver for Drawing {
         if !m.is_geometric() {
             return fallback(ctx);
         }
-        let start = super::greedy::geometric(m, &mut |k| ctx.count(k));
+        let start = crate::construct::greedy::geometric(m, &mut |k| ctx.count(k));
         if !flat(m) || start.len() < 4 {
             let out = outcome_of(m, start);
             ctx.report(out.cost);
@@ -124,20 +125,15 @@ fn flat(m: &CostModel) -> bool {
 }
 
 fn fallback(ctx: &mut Context) -> Result<Outcome> {
-    let info = &super::local_search::INFO;
-    let params = Params::new(info.name, info.params, &BTreeMap::new())?;
-    let solver = (info.make)(&params);
-    let budget = ctx.budget;
-    let used = ctx.evaluations();
     let budget = super::Budget {
-        time_limit: budget.time_limit,
-        max_evals: budget.max_evals.map(|e| e.saturating_sub(used)),
+        time_limit: ctx.budget.time_limit,
+        max_evals: ctx
+            .budget
+            .max_evals
+            .map(|e| e.saturating_sub(ctx.evaluations())),
     };
-    let mut obs = super::NoObserver;
-    let mut sub = ctx.sub(&params, budget, &mut obs);
-    let out = solver.solve(&mut sub)?;
-    let evals = sub.evaluations();
-    ctx.count(evals);
+    let seed = ctx.seed;
+    let out = super::sub_run(ctx, super::Sub::new("local-search", budget, seed))?;
     ctx.report(out.cost);
     Ok(out)
 }

@@ -23,7 +23,7 @@
 
 use super::aco::{COLONY, Pheromone};
 use super::start::{greedy_solution, outcome};
-use super::{Context, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo};
+use super::{Caps, Context, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo};
 use crate::engine::crossover::Crossover;
 use crate::engine::lk::Lk;
 use crate::engine::modes::mode_dp;
@@ -94,7 +94,12 @@ pub static INFO: SolverInfo = SolverInfo {
             help: "the ants' local search also runs Lin-Kernighan chains of feasible reversals (engine::lk); auto = when costs are symmetric (off by default: slower per ant and worse in auto on prob.100)",
         },
     ],
-    make: |p: &Params| Box::new(from_params(p)),
+    caps: Caps {
+        improves: true,
+        starts_from: true,
+        ..Caps::NONE
+    },
+    make: |p: &Params| Ok(Box::new(from_params(p))),
 };
 
 /// Builds the solver from validated parameters.
@@ -335,6 +340,10 @@ pub fn focused_descent(
 impl Solver for Eacs {
     fn solve(&self, ctx: &mut Context) -> Result<Outcome> {
         self.run(ctx, None)
+    }
+    fn solve_from(&self, ctx: &mut Context, start: Option<&Sequence>) -> Result<Outcome> {
+        let start = start.map(|seq| Solution::new(&Costs::open(ctx.model), seq));
+        self.run(ctx, start)
     }
 }
 

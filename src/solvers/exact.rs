@@ -9,7 +9,7 @@
 //! found again by recomputing costs within a tolerance, which failed ("broken DP
 //! back-pointer") once costs overflowed to infinity (∞ − ∞ is NaN).
 
-use super::{Context, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo};
+use super::{Caps, Context, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo};
 use crate::error::{Error, Result};
 use crate::model::Visit;
 use rustc_hash::FxHashMap;
@@ -32,11 +32,15 @@ pub static INFO: SolverInfo = SolverInfo {
             help: "refuse instances with more cells (the subset bitset holds at most 128)",
         },
     ],
+    caps: Caps {
+        exact: true,
+        ..Caps::NONE
+    },
     make: |p: &Params| {
-        Box::new(Exact {
+        Ok(Box::new(Exact {
             memory_mb: p.int("memory_mb"),
             max_cells: p.int("max_cells").min(128) as usize,
-        })
+        }))
     },
 };
 

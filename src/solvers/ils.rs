@@ -14,7 +14,7 @@
 //! best.
 
 use super::start::{greedy_solution, outcome};
-use super::{Context, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo};
+use super::{Caps, Context, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo};
 use crate::engine::crossover::Crossover;
 use crate::engine::lk::Lk;
 use crate::engine::moves::sop3_delta;
@@ -24,6 +24,7 @@ use crate::engine::shift::ShiftDp;
 use crate::engine::sop3x::{TwoWay, sop3_two_way};
 use crate::engine::{Costs, Solution};
 use crate::error::Result;
+use crate::model::Sequence;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -147,7 +148,12 @@ pub static INFO: SolverInfo = SolverInfo {
             help: "stop after this many kicks without a new best when no budget is set",
         },
     ],
-    make: |p: &Params| Box::new(from_params(p)),
+    caps: Caps {
+        improves: true,
+        starts_from: true,
+        ..Caps::NONE
+    },
+    make: |p: &Params| Ok(Box::new(from_params(p))),
 };
 
 /// Builds the solver from validated parameters.
@@ -371,6 +377,10 @@ struct Shuffle {
 impl Solver for Ils {
     fn solve(&self, ctx: &mut Context) -> Result<Outcome> {
         self.run(ctx, None)
+    }
+    fn solve_from(&self, ctx: &mut Context, start: Option<&Sequence>) -> Result<Outcome> {
+        let start = start.map(|seq| Solution::new(&Costs::open(ctx.model), seq));
+        self.run(ctx, start)
     }
 }
 

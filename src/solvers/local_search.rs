@@ -12,7 +12,7 @@
 //! without one), and one VND on the array form finishes.
 
 use super::start::{best_start, outcome};
-use super::{Context, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo};
+use super::{Caps, Context, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo};
 use crate::engine::large::{self, Large};
 use crate::engine::moves::{apply_segment, segment_delta, window};
 use crate::engine::search::Search;
@@ -69,10 +69,14 @@ pub static INFO: SolverInfo = SolverInfo {
             help: "longest block of SOP-3-exchange (0 = n up to 120 cells, 64 up to 5000, else 8)",
         },
     ],
+    caps: Caps {
+        improves: true,
+        ..Caps::NONE
+    },
     make: |p: &Params| {
         let kicks = p.int("kicks");
         let strength = p.int("strength").max(1) as usize;
-        Box::new(LocalSearch {
+        Ok(Box::new(LocalSearch {
             kicks,
             strength,
             k: p.int("k").max(1) as usize,
@@ -80,7 +84,7 @@ pub static INFO: SolverInfo = SolverInfo {
             vnd: p.bool("vnd"),
             two_level: p.switch("two-level"),
             kick_block: p.int("kick-block").max(1) as usize,
-        })
+        }))
     },
 };
 

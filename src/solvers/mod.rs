@@ -32,177 +32,67 @@ use crate::model::{Instance, Objective, Sequence};
 use std::collections::BTreeMap;
 
 pub use crate::params::{ParamKind, ParamSpec, Params, parse_kv};
-use std::time::{Duration, Instant};
-
-/// How much work a solver may do. Evaluation budgets make runs deterministic.
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
-pub struct Budget {
-    /// Wall-clock limit.
-    pub time_limit: Option<Duration>,
-    /// Limit on counted evaluations (move evaluations, arc lookups in construction).
-    pub max_evals: Option<u64>,
-}
-
-/// One point of an anytime trace.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Progress {
-    /// Evaluations so far.
-    pub evaluations: u64,
-    /// Seconds since the start.
-    pub elapsed_s: f64,
-    /// Best cost so far.
-    pub best: f64,
-}
-
-/// Receives progress when a solver finds a better solution.
-pub trait Observer {
-    /// Called on every improvement of the best cost.
-    fn improved(&mut self, p: Progress);
-}
-
-/// An observer that records every improvement.
-#[derive(Debug, Default, Clone)]
-pub struct Trace {
-    /// The recorded points.
-    pub points: Vec<Progress>,
-}
-
-impl Observer for Trace {
-    fn improved(&mut self, p: Progress) {
-        self.points.push(p);
-    }
-}
-
-/// An observer that ignores everything.
-pub struct NoObserver;
-
-impl Observer for NoObserver {
-    fn improved(&mut self, _p: Progress) {}
-}
-
-/// What a solver sees while it runs: the instance, its cost model, parameters, seed, budget.
-pub struct Context<'a> {
-    /// The instance.
-    pub instance: &'a Instance,
-    /// Arc costs and precedence.
-    pub model: &'a CostModel,
-    /// Validated parameters.
-    pub params: &'a Params,
-    /// Random seed.
-    pub seed: u64,
-    /// Budget.
-    pub budget: Budget,
-    observer: &'a mut dyn Observer,
-    start: Instant,
-    evaluations: u64,
-    best: f64,
-}
-
-impl<'a> Context<'a> {
-    /// Builds a context; the clock starts now.
-    pub fn new(
-        instance: &'a Instance,
-        model: &'a CostModel,
-        params: &'a Params,
-        seed: u64,
-        budget: Budget,
-        observer: &'a mut dyn Observer,
-    ) -> Self {
-        Context {
-            instance,
-            model,
-            params,
-            seed,
-            budget,
-            observer,
-            start: Instant::now(),
-            evaluations: 0,
-            best: f64::INFINITY,
-        }
-    }
-    /// A context for a sub-solver run inside this one (portfolio phases, warm starts): the same
-    /// instance, model and seed, its own parameters, budget and observer; its clock starts now.
-    /// The caller adds the sub-run's evaluations back with [`Context::count`].
-    pub fn sub<'b>(
-        &self,
-        params: &'b Params,
-        budget: Budget,
-        observer: &'b mut dyn Observer,
-    ) -> Context<'b>
-    where
-        'a: 'b,
-    {
-        Context::new(
-            self.instance,
-            self.model,
-            params,
-            self.seed,
-            budget,
-            observer,
-        )
-    }
-    /// Counts `k` evaluations.
-    #[inline]
-    pub fn count(&mut self, k: u64) {
-        self.evaluations += k;
-    }
-    /// Evaluations counted so far.
-    pub fn evaluations(&self) -> u64 {
-        self.evaluations
-    }
-    /// Seconds since the start.
-    pub fn elapsed(&self) -> f64 {
-        self.start.elapsed().as_secs_f64()
-    }
-    /// True when the budget is used up.
-    pub fn exhausted(&self) -> bool {
-        if let Some(m) = self.budget.max_evals
-            && self.evaluations >= m
-        {
-            return true;
-        }
-        if let Some(t) = self.budget.time_limit
-            && self.start.elapsed() >= t
-        {
-            return true;
-        }
-        false
-    }
-    /// Reports a solution cost; the observer hears of it when it improves the best.
-    pub fn report(&mut self, cost: f64) {
-        if cost < self.best - 1e-9 * cost.abs().max(1.0) {
-            self.best = cost;
-            let p = Progress {
-                evaluations: self.evaluations,
-                elapsed_s: self.elapsed(),
-                best: cost,
-            };
-            self.observer.improved(p);
-        }
-    }
-    /// Best cost reported so far.
-    pub fn best(&self) -> f64 {
-        self.best
-    }
-}
-
-/// What a solver returns.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Outcome {
-    /// The best sequence found.
-    pub sequence: Sequence,
-    /// Its cost by the solver's own evaluation.
-    pub cost: f64,
-    /// True when the solver proved the sequence optimal.
-    pub proven_optimal: bool,
-    /// A valid lower bound on the optimum, when the solver has one.
-    pub lower_bound: Option<f64>,
-}
+pub use crate::search::{
+    Budget, Context, NoObserver, Observer, Outcome, Progress, Trace, outcome_of,
+};
 
 /// A sequencing algorithm.
 pub trait Solver: Send + Sync {
     /// Runs the algorithm.
     fn solve(&self, ctx: &mut Context) -> Result<Outcome>;
+    /// Runs the algorithm from `start` when one is given: solvers whose [`Caps`] declare
+    /// `starts_from` search from it, those that declare `warm_start` take it as their first
+    /// incumbent; the others run [`Solver::solve`] and are never handed a start by
+    /// [`sub_run`]. Without a start this is [`Solver::solve`].
+    fn solve_from(&self, ctx: &mut Context, start: Option<&Sequence>) -> Result<Outcome> {
+        let _ = start;
+        self.solve(ctx)
+    }
+}
+
+/// The instances a solver needs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Needs {
+    /// Any instance, geometric or matrix.
+    Any,
+    /// Instances with geometry (cells with points).
+    Geometric,
+    /// Instances given by a cost matrix.
+    Matrix,
+}
+
+/// What a solver can do, declared in its registry entry; sub-runs, plans and tests read it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Caps {
+    /// Never ends worse than `greedy` and keeps to an evaluation budget up to one pass or
+    /// construction (the local-search family).
+    pub improves: bool,
+    /// Searches from a given sequence and returns one no worse ([`Solver::solve_from`]); a
+    /// plan phase may start it from an earlier sequence (`*`, `+`).
+    pub starts_from: bool,
+    /// Takes a given sequence as its first incumbent (an upper bound to prune with) instead of
+    /// its own warm start; the result is never worse.
+    pub warm_start: bool,
+    /// Proves its result optimal when it finishes within the budget and its limits.
+    pub exact: bool,
+    /// The instances it runs on.
+    pub needs: Needs,
+}
+
+impl Caps {
+    /// No capability, any instance: the base of every declaration
+    /// (`Caps { exact: true, ..Caps::NONE }`).
+    pub const NONE: Caps = Caps {
+        improves: false,
+        starts_from: false,
+        warm_start: false,
+        exact: false,
+        needs: Needs::Any,
+    };
+    /// True when a start sequence can be handed to the solver.
+    pub fn takes_start(&self) -> bool {
+        self.starts_from || self.warm_start
+    }
 }
 
 /// A registry entry.
@@ -213,8 +103,20 @@ pub struct SolverInfo {
     pub summary: &'static str,
     /// Parameters with defaults.
     pub params: &'static [ParamSpec],
-    /// Builds the solver from validated parameters.
-    pub make: fn(&Params) -> Box<dyn Solver>,
+    /// What it can do.
+    pub caps: Caps,
+    /// Builds the solver from validated parameters; fails when they do not make a solver
+    /// (for instance a malformed `auto` plan).
+    pub make: fn(&Params) -> Result<Box<dyn Solver>>,
+}
+
+impl SolverInfo {
+    /// Validates `given` against the declared parameters and builds the solver.
+    pub fn build(&self, given: &BTreeMap<String, String>) -> Result<(Params, Box<dyn Solver>)> {
+        let params = Params::new(self.name, self.params, given)?;
+        let solver = (self.make)(&params)?;
+        Ok((params, solver))
+    }
 }
 
 /// True when the environment asks the solvers for their diagnostic trace on standard error:
@@ -265,6 +167,59 @@ pub fn find(name: &str) -> Result<&'static SolverInfo> {
         })
 }
 
+/// A solver run inside another (a portfolio phase, a warm start, a window, a fallback): which
+/// solver, its parameters, its share of the budget, its seed, an optional start, and the
+/// instance it runs on when not the caller's.
+pub struct Sub<'s> {
+    /// Registry name.
+    pub name: &'s str,
+    /// Its parameters as given (validated against its declaration).
+    pub params: &'s BTreeMap<String, String>,
+    /// Its budget (a share of the caller's).
+    pub budget: Budget,
+    /// Its seed.
+    pub seed: u64,
+    /// The sequence it starts from (solvers whose [`Caps::takes_start`]).
+    pub start: Option<&'s Sequence>,
+    /// Another instance and its cost model (a backwards twin, a window); `None`: the caller's.
+    pub on: Option<(&'s Instance, &'s CostModel)>,
+}
+
+impl<'s> Sub<'s> {
+    /// A sub-run of `name` with its default parameters, on the caller's instance.
+    pub fn new(name: &'s str, budget: Budget, seed: u64) -> Self {
+        static NONE: BTreeMap<String, String> = BTreeMap::new();
+        Sub {
+            name,
+            params: &NONE,
+            budget,
+            seed,
+            start: None,
+            on: None,
+        }
+    }
+}
+
+/// Runs a sub-solver: builds it from the registry (refusing a start it cannot take), runs it
+/// in a context of its own (its clock starts now; no observer), and adds its evaluations to
+/// `ctx` when it succeeds. The caller decides whether to [`Context::report`] its cost.
+pub fn sub_run(ctx: &mut Context, sub: Sub) -> Result<Outcome> {
+    let info = find(sub.name)?;
+    let (params, solver) = info.build(sub.params)?;
+    if sub.start.is_some() && !info.caps.takes_start() {
+        return Err(Error::Solver {
+            solver: info.name.to_string(),
+            msg: "cannot start from a given sequence".to_string(),
+        });
+    }
+    let (instance, model) = sub.on.unwrap_or((ctx.instance, ctx.model));
+    let mut quiet = NoObserver;
+    let mut inner = Context::new(instance, model, &params, sub.seed, sub.budget, &mut quiet);
+    let out = solver.solve_from(&mut inner, sub.start)?;
+    ctx.count(inner.evaluations());
+    Ok(out)
+}
+
 /// The result of [`run`]: the solver's outcome and the independent checker's report.
 #[derive(Debug, Clone)]
 pub struct RunResult {
@@ -294,8 +249,7 @@ pub fn run(
     observer: &mut dyn Observer,
 ) -> Result<RunResult> {
     let info = find(name)?;
-    let params = Params::new(name, info.params, given)?;
-    let solver = (info.make)(&params);
+    let (params, solver) = info.build(given)?;
     let model = CostModel::new(inst, objective);
     if !model.acyclic() {
         return Err(Error::invalid(
@@ -340,13 +294,58 @@ pub fn run(
     })
 }
 
-/// A ready-made outcome for a sequence scored by the model.
-pub fn outcome_of(model: &CostModel, sequence: Sequence) -> Outcome {
-    let cost = model.evaluate(&sequence);
-    Outcome {
-        sequence,
-        cost,
-        proven_optimal: false,
-        lower_bound: None,
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::formats::{Format, parse_instance};
+
+    fn tiny() -> Instance {
+        // 5 nodes, node 1 first and node 5 last, 2 before 4
+        let text = "TYPE: SOP\nDIMENSION: 5\nEDGE_WEIGHT_SECTION\n5\n\
+                    0 4 1 9 9\n-1 0 3 2 8\n-1 1 0 -1 6\n-1 -1 1 0 1\n-1 -1 -1 -1 0\nEOF\n";
+        parse_instance("tiny.sop", text, Format::Sop).unwrap()
+    }
+
+    #[test]
+    fn building_auto_refuses_a_malformed_plan() {
+        let info = find("auto").unwrap();
+        let kv = |v: &str| BTreeMap::from([("plan".to_string(), v.to_string())]);
+        assert!(info.build(&kv("local-search:0.5,ils*:1")).is_ok());
+        let e = info.build(&kv("nosuch:1")).err().unwrap().to_string();
+        assert!(e.contains("nosuch"), "{e}");
+        let e = info.build(&kv("greedy*:1")).err().unwrap().to_string();
+        assert!(
+            e.contains("only ils, eacs and reopt can start from an earlier sequence"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn sub_runs_start_only_solvers_that_take_a_start() {
+        let inst = tiny();
+        let model = CostModel::new(&inst, inst.default_objective());
+        let params = Params::new("as-given", &[], &BTreeMap::new()).unwrap();
+        let mut obs = NoObserver;
+        let budget = Budget {
+            time_limit: None,
+            max_evals: Some(5_000),
+        };
+        let mut ctx = Context::new(&inst, &model, &params, 3, budget, &mut obs);
+        let start = sub_run(&mut ctx, Sub::new("as-given", budget, 3)).unwrap();
+        let used = ctx.evaluations();
+        for info in registry() {
+            let sub = Sub {
+                start: Some(&start.sequence),
+                ..Sub::new(info.name, budget, 3)
+            };
+            let out = sub_run(&mut ctx, sub);
+            if info.caps.takes_start() {
+                let out = out.unwrap_or_else(|e| panic!("{}: {e}", info.name));
+                assert!(out.cost <= start.cost, "{} worse than its start", info.name);
+                assert!(ctx.evaluations() >= used, "{}", info.name);
+            } else {
+                assert!(out.is_err(), "{} took a start it cannot use", info.name);
+            }
+        }
     }
 }

@@ -12,7 +12,7 @@
 
 use super::sa::{Anneal, SPECS};
 use super::start::outcome;
-use super::{Context, Outcome, Params, Solver, SolverInfo};
+use super::{Caps, Context, Outcome, Params, Solver, SolverInfo};
 use crate::engine::{Costs, Solution};
 use crate::error::Result;
 use crate::model::{StepKind, Visit};
@@ -24,10 +24,11 @@ pub static INFO: SolverInfo = SolverInfo {
     name: "process",
     summary: "process-based sequencing (paper 000): 4-level grouping, process-scheme group order, SA inside level-4 groups",
     params: SPECS,
+    caps: Caps { ..Caps::NONE },
     make: |p: &Params| {
-        Box::new(Process {
+        Ok(Box::new(Process {
             anneal: Anneal::from_params(p),
-        })
+        }))
     },
 };
 

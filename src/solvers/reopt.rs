@@ -26,10 +26,9 @@
 //! the gains lie), or covering the whole sequence again when every window was proven. After
 //! a gain the sequence is polished by the VND before the next window.
 
-use super::beam::Beam;
 use super::start::{greedy_solution, outcome};
 use super::{
-    Budget, Context, NoObserver, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo,
+    Budget, Caps, Context, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo, Sub,
 };
 use crate::cost::CostModel;
 use crate::engine::search::Search;
@@ -76,7 +75,12 @@ pub static INFO: SolverInfo = SolverInfo {
             help: "candidate neighbours per cell of the VND that polishes a gain",
         },
     ],
-    make: |p: &Params| Box::new(from_params(p)),
+    caps: Caps {
+        improves: true,
+        starts_from: true,
+        ..Caps::NONE
+    },
+    make: |p: &Params| Ok(Box::new(from_params(p))),
 };
 
 /// Builds the solver from validated parameters.
@@ -107,6 +111,10 @@ pub struct Reopt {
 impl Solver for Reopt {
     fn solve(&self, ctx: &mut Context) -> Result<Outcome> {
         self.run(ctx, None)
+    }
+    fn solve_from(&self, ctx: &mut Context, start: Option<&Sequence>) -> Result<Outcome> {
+        let start = start.map(|seq| Solution::new(&Costs::open(ctx.model), seq));
+        self.run(ctx, start)
     }
 }
 
@@ -213,20 +221,18 @@ impl Reopt {
             current.push(Visit::new(i + 1, s.mode[x as usize] as usize));
         }
         current.push(Visit::new(len + 1, 0));
-        let info = &super::beam::INFO;
-        let params = Params::new(info.name, info.params, &Default::default())?;
-        let beam: Beam = super::beam::from_params(&params);
         let budget = window_budget(
             ctx.budget,
             ctx.evaluations(),
             ctx.elapsed(),
             self.window_share,
         );
-        let mut quiet = NoObserver;
-        let mut sub_ctx = Context::new(&sub, &sm, &params, ctx.seed, budget, &mut quiet);
-        let out = beam.solve_from(&mut sub_ctx, Some(current.clone()));
-        ctx.count(sub_ctx.evaluations());
-        let out = out?;
+        let job = Sub {
+            start: Some(&current),
+            on: Some((&sub, &sm)),
+            ..Sub::new("beam", budget, ctx.seed)
+        };
+        let out = super::sub_run(ctx, job)?;
         // the window's share of `s`: the links from position lo − 1 to position hi
         let before = s.links(c, lo as isize - 1, hi as isize);
         let now = sm.evaluate(&current);

@@ -10,7 +10,7 @@
 //!   (mirror pairs left/right of the centre cut one after the other) to limit deformation.
 
 use super::start::outcome;
-use super::{Context, Outcome, ParamSpec, Params, Solver, SolverInfo};
+use super::{Caps, Context, Outcome, ParamSpec, Params, Solver, SolverInfo};
 use crate::engine::modes::mode_dp;
 use crate::engine::{Costs, Solution};
 use crate::error::Result;
@@ -24,7 +24,8 @@ pub static INFO: SolverInfo = SolverInfo {
     name: "rules",
     summary: "knowledge rules 1-5 of paper 002 (tool size, outer before inner, upper before lower, step order, symmetry)",
     params: &[] as &[ParamSpec],
-    make: |_p: &Params| Box::new(Rules),
+    caps: Caps { ..Caps::NONE },
+    make: |_p: &Params| Ok(Box::new(Rules)),
 };
 
 /// The rule-based solver.

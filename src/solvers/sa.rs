@@ -9,7 +9,7 @@
 //! blocks of positions (the `process` solver anneals inside its level-4 groups).
 
 use super::start::{greedy_start, outcome, true_cost};
-use super::{Context, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo};
+use super::{Caps, Context, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo};
 use crate::engine::moves::{
     apply_segment, reverse_delta_direct, reversible_segment, segment_delta, window,
 };
@@ -24,11 +24,15 @@ pub static INFO: SolverInfo = SolverInfo {
     name: "sa",
     summary: "simulated annealing (paper 000): Metropolis, chains of length L, geometric cooling, stagnation stop",
     params: SPECS,
+    caps: Caps {
+        improves: true,
+        ..Caps::NONE
+    },
     make: |p: &Params| {
-        Box::new(Sa {
+        Ok(Box::new(Sa {
             anneal: Anneal::from_params(p),
             polish: p.bool("polish"),
-        })
+        }))
     },
 };
 

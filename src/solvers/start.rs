@@ -1,6 +1,7 @@
 //! Shared pieces of the improvement solvers: start solutions and result reporting.
 
-use super::{Context, Outcome, greedy, outcome_of};
+use super::{Context, Outcome, outcome_of};
+use crate::construct::{edge, greedy, insertion};
 use crate::cost::CostModel;
 use crate::engine::{Costs, Solution};
 use crate::model::{Sequence, Visit};
@@ -34,8 +35,8 @@ pub fn greedy_solution(ctx: &mut Context, c: &Costs) -> Solution {
 /// strokes it is 0.91–0.93 × greedy's air from 10^4 cells on, and the nearest-neighbour walk
 /// costs seconds there).
 pub fn best_start(ctx: &mut Context, c: &Costs, k: usize) -> Solution {
-    if c.m.n() > EDGE_ONLY_CELLS && super::edge::applicable(c.m) {
-        let seq = super::edge::sequence(c.m, k, &mut |k| ctx.count(k));
+    if c.m.n() > EDGE_ONLY_CELLS && edge::applicable(c.m) {
+        let seq = edge::sequence(c.m, k, &mut |k| ctx.count(k));
         let s = Solution::new(c, &seq);
         ctx.report(s.cost + c.m.constant());
         return s;
@@ -47,15 +48,15 @@ pub fn best_start(ctx: &mut Context, c: &Costs, k: usize) -> Solution {
         && !ctx.exhausted()
     {
         let seed = ctx.seed;
-        let seq = super::insertion::sequence(c.m, k, seed, &mut |k| ctx.count(k));
+        let seq = insertion::sequence(c.m, k, seed, &mut |k| ctx.count(k));
         let t = Solution::new(c, &seq);
         if t.cost < s.cost {
             ctx.report(t.cost + c.m.constant());
             s = t;
         }
     }
-    if super::edge::applicable(c.m) && !ctx.exhausted() {
-        let seq = super::edge::sequence(c.m, k, &mut |k| ctx.count(k));
+    if edge::applicable(c.m) && !ctx.exhausted() {
+        let seq = edge::sequence(c.m, k, &mut |k| ctx.count(k));
         let t = Solution::new(c, &seq);
         if t.cost < s.cost {
             ctx.report(t.cost + c.m.constant());

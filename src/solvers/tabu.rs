@@ -7,7 +7,7 @@
 //! window, so an iteration costs O(n·K·k).
 
 use super::start::{greedy_start, outcome, random_start};
-use super::{Context, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo};
+use super::{Caps, Context, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo};
 use crate::engine::moves::{apply_segment, mode_delta, window};
 use crate::engine::search::Search;
 use crate::engine::{Costs, Solution};
@@ -51,14 +51,18 @@ pub static INFO: SolverInfo = SolverInfo {
             help: "candidate neighbours per cell",
         },
     ],
+    caps: Caps {
+        improves: true,
+        ..Caps::NONE
+    },
     make: |p: &Params| {
-        Box::new(Tabu {
+        Ok(Box::new(Tabu {
             tenure: p.int("tenure") as usize,
             iters: p.int("iters"),
             stall: p.int("stall").max(1),
             starts: p.int("starts").max(1) as usize,
             k: p.int("k").max(1) as usize,
-        })
+        }))
     },
 };
 

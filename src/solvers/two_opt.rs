@@ -1,7 +1,7 @@
 //! `two-opt`: greedy start, then 2-opt with mode flip to a local optimum.
 
 use super::start::{greedy_solution, outcome};
-use super::{Context, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo};
+use super::{Caps, Context, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo};
 use crate::engine::Costs;
 use crate::engine::search::Search;
 use crate::error::Result;
@@ -16,10 +16,14 @@ pub static INFO: SolverInfo = SolverInfo {
         kind: ParamKind::Int,
         help: "candidate neighbours per cell",
     }],
+    caps: Caps {
+        improves: true,
+        ..Caps::NONE
+    },
     make: |p: &Params| {
-        Box::new(TwoOpt {
+        Ok(Box::new(TwoOpt {
             k: p.int("k").max(1) as usize,
-        })
+        }))
     },
 };
 

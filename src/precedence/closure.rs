@@ -1,6 +1,6 @@
 //! Transitive closure of the precedence DAG as bitsets, and the arc-elimination rule it gives.
 
-use crate::precedence::{Dag, topological_order};
+use super::{Dag, topological_order};
 
 /// Ancestor and descendant bitsets of every cell (strict).
 #[derive(Debug, Clone)]

@@ -1,5 +1,9 @@
 //! The precedence DAG: adjacency, cycle detection, closure and reduction, topological orders.
 
+pub mod closure;
+
+pub use closure::Closure;
+
 use std::cmp::Reverse;
 use std::collections::BinaryHeap;
 
