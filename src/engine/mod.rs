@@ -8,6 +8,7 @@
 //! for SOP-3-exchange). [`neighbours`] builds K-nearest candidate lists, [`modes`] the
 //! layered shortest-path mode DP, [`search`] the variable neighbourhood descent.
 
+pub mod atsp;
 pub mod crossover;
 pub mod large;
 pub mod linked;

@@ -23,7 +23,10 @@
 //!    plan misses (PCGTSPLIB rbg174a: 1641, the proven optimum, on 13 of 13 seeds at 10 s,
 //!    against 1642–1643 with 10 %; notes/lab/sopq8.md). On larger dense instances
 //!    (rbg323a–rbg378a) the passes do not finish: there is no beam phase, and the default is
-//!    `large-dense-plan`: `ils` with longer kicks (see [`LARGE_DENSE_PLAN`]).
+//!    `large-dense-plan`: `ils` with longer kicks (see [`LARGE_DENSE_PLAN`]). Asymmetric
+//!    matrix instances with (almost) no precedence apart from a fixed start and end
+//!    ([`free_density`] at most `free-density`) get `free-plan`: the `atsp` solver
+//!    (see [`FREE_PLAN`]); this case is checked before the sparse one.
 //!
 //! Plan syntax: `solver[key=value;...]:share`, with `*` after the name to start from the
 //! best sequence so far, `+` to start from the sequence of the phase just before, and `~`
@@ -40,7 +43,8 @@ use super::{
     Budget, Caps, Context, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo, Sub, sub_run,
 };
 use crate::cost::CostModel;
-use crate::engine::{Costs, lk};
+use crate::engine::atsp::free_density;
+use crate::engine::{Costs, Solution, lk};
 use crate::error::{Error, Result};
 use crate::model::Instance;
 use crate::precedence::closure_density;
@@ -107,6 +111,18 @@ pub static INFO: SolverInfo = SolverInfo {
             help: "matrix instances with a precedence closure density (pairs ordered over n(n-1)/2) below this get sparse-plan",
         },
         ParamSpec {
+            name: "free-plan",
+            default: FREE_PLAN,
+            kind: ParamKind::Text,
+            help: "the phases used instead of the default plan on asymmetric matrix instances whose precedence, apart from cells ordered against every other (a fixed start and end), has a closure density of at most free-density; ignored when plan is given",
+        },
+        ParamSpec {
+            name: "free-density",
+            default: "0.001",
+            kind: ParamKind::Float,
+            help: "asymmetric matrix instances whose closure density among the cells not ordered against every other cell is at most this get free-plan",
+        },
+        ParamSpec {
             name: "dense-beam-share",
             default: "0.5",
             kind: ParamKind::Float,
@@ -133,21 +149,7 @@ pub static INFO: SolverInfo = SolverInfo {
     ],
     caps: Caps { ..Caps::NONE },
     make: |p: &Params| {
-        let auto = Auto {
-            seconds: p.float("seconds").max(0.001),
-            beam_share: p.float("beam-share").clamp(0.0, 1.0),
-            beam_max_cells: p.int("beam-max-cells") as usize,
-            plan: p.word("plan").to_string(),
-            symmetric_plan: p.word("symmetric-plan").to_string(),
-            symmetric_beam_share: p.float("symmetric-beam-share").clamp(0.0, 1.0),
-            symmetric_beam_plan: p.word("symmetric-beam-plan").to_string(),
-            sparse_plan: p.word("sparse-plan").to_string(),
-            dense_density: p.float("dense-density"),
-            dense_beam_share: p.float("dense-beam-share").clamp(0.0, 1.0),
-            dense_beam_max_cells: p.int("dense-beam-max-cells") as usize,
-            large_dense_plan: p.word("large-dense-plan").to_string(),
-            beam_min_seconds: p.float("beam-min-seconds").max(0.0),
-        };
+        let auto = Auto::from_params(p);
         // every plan is parsed, so a malformed one is refused when the solver is built
         for plan in auto.plans() {
             parse_plan(plan)?;
@@ -178,6 +180,11 @@ pub struct Auto {
     pub sparse_plan: String,
     /// Precedence closure density at and above which a matrix instance counts as dense.
     pub dense_density: f64,
+    /// Phases used instead of the default `plan` on asymmetric matrix instances with (almost)
+    /// no precedence.
+    pub free_plan: String,
+    /// Largest [`free_density`] that counts as (almost) no precedence.
+    pub free_density: f64,
     /// Share of the budget for the beam phase on dense matrix instances of at most
     /// `dense_beam_max_cells` cells.
     pub dense_beam_share: f64,
@@ -239,6 +246,16 @@ pub const SPARSE_PLAN: &str = "local-search:0.1,~eacs:0.5,ils[accept=0.01;shift-
 /// re-optimization by the exact tree search, [`super::reopt`]) and 15 and 15 with kicks of
 /// 60 and 80; seeds 109–116 gave 17 of 32 (notes/lab/sopq11.md).
 pub const LARGE_DENSE_PLAN: &str = "local-search:0.1,ils[max-seg=45]*:1";
+
+/// Default phases on asymmetric matrix instances with no precedence apart from a fixed start
+/// and end: the assignment's cycles patched into a path, then iterated Or-3opt
+/// ([`super::atsp`]). On random asymmetric matrices of 200–700 cells with integer costs in
+/// [0, 100] and [0, 1000] (notes/atsp.md) the default plan ended 1.4–27 × above the assignment
+/// bound, this one within a few percent of it. `free-density` (0.001) lets in instances with a
+/// handful of constraints: at inner closure densities of 0.0005–0.0006 `atsp` was at or below
+/// the default plan on 4 of 4 generated instances, at 0.002–0.003 on 3 of 4, at 0.04–0.1 on
+/// none (1 s each).
+pub const FREE_PLAN: &str = "atsp:1";
 
 /// Where a plan phase starts.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -371,6 +388,9 @@ pub enum Case {
     Symmetric,
     /// Asymmetric matrix costs with sparse precedence: `sparse-plan` and `beam-share`.
     Sparse,
+    /// Asymmetric matrix costs with (almost) no precedence apart from a fixed start and end
+    /// ([`free_density`] at most `free-density`): `free-plan` and `beam-share`.
+    Free,
     /// Asymmetric matrix costs with dense precedence, at most `dense-beam-max-cells` cells:
     /// `plan` and `dense-beam-share`.
     Dense,
@@ -417,6 +437,27 @@ struct Run<'p> {
 }
 
 impl Auto {
+    /// The portfolio with validated parameters `p` (of [`INFO`]).
+    pub fn from_params(p: &Params) -> Auto {
+        Auto {
+            seconds: p.float("seconds").max(0.001),
+            beam_share: p.float("beam-share").clamp(0.0, 1.0),
+            beam_max_cells: p.int("beam-max-cells") as usize,
+            plan: p.word("plan").to_string(),
+            symmetric_plan: p.word("symmetric-plan").to_string(),
+            symmetric_beam_share: p.float("symmetric-beam-share").clamp(0.0, 1.0),
+            symmetric_beam_plan: p.word("symmetric-beam-plan").to_string(),
+            sparse_plan: p.word("sparse-plan").to_string(),
+            dense_density: p.float("dense-density"),
+            free_plan: p.word("free-plan").to_string(),
+            free_density: p.float("free-density"),
+            dense_beam_share: p.float("dense-beam-share").clamp(0.0, 1.0),
+            dense_beam_max_cells: p.int("dense-beam-max-cells") as usize,
+            large_dense_plan: p.word("large-dense-plan").to_string(),
+            beam_min_seconds: p.float("beam-min-seconds").max(0.0),
+        }
+    }
+
     fn phase(&self, ctx: &mut Context, run: Run) -> Result<Outcome> {
         let Run {
             name,
@@ -481,6 +522,7 @@ impl Auto {
             (Case::Symmetric, false) => &self.symmetric_plan,
             (Case::Symmetric, true) => &self.symmetric_beam_plan,
             (Case::Sparse, _) => &self.sparse_plan,
+            (Case::Free, _) => &self.free_plan,
         }
     }
 
@@ -489,11 +531,12 @@ impl Auto {
         self.beam_share_when(self.case(m))
     }
 
-    /// Every plan: `plan`, `symmetric_plan`, `symmetric_beam_plan`, `sparse_plan` and
+    /// Every plan: `plan`, `free_plan`, `symmetric_plan`, `symmetric_beam_plan`, `sparse_plan` and
     /// `large_dense_plan`.
-    fn plans(&self) -> [&str; 5] {
+    fn plans(&self) -> [&str; 6] {
         [
             &self.plan,
+            &self.free_plan,
             &self.symmetric_plan,
             &self.symmetric_beam_plan,
             &self.sparse_plan,
@@ -513,7 +556,9 @@ impl Auto {
 
     /// Which settings apply to model `m`: the default ones when the user gave a `plan` or
     /// for geometric instances; else the symmetric ones when the matrix reads the same
-    /// backwards, the sparse ones when the precedence closure is sparser than
+    /// backwards, the free ones when [`free_density`] is at most `free_density` (no
+    /// precedence apart from a fixed start and end), the sparse ones when the precedence
+    /// closure is sparser than
     /// `dense_density`, else the dense ones up to `dense_beam_max_cells` cells and the large
     /// dense ones above.
     pub fn case(&self, m: &CostModel) -> Case {
@@ -521,6 +566,8 @@ impl Auto {
             Case::Default
         } else if lk::symmetric(&Costs::open(m)) {
             Case::Symmetric
+        } else if free_density(m) <= self.free_density {
+            Case::Free
         } else if closure_density(&m.dag) < self.dense_density {
             Case::Sparse
         } else if m.n() <= self.dense_beam_max_cells {

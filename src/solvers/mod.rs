@@ -6,6 +6,7 @@
 
 pub mod aco;
 pub mod as_given;
+pub mod atsp;
 pub mod auto;
 pub mod beam;
 pub mod docs;
@@ -134,6 +135,7 @@ pub fn registry() -> Vec<&'static SolverInfo> {
         &edge::INFO,
         &insertion::INFO,
         &ils::INFO,
+        &atsp::INFO,
         &exact::INFO,
         &beam::INFO,
         &reopt::INFO,

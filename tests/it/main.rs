@@ -13,6 +13,7 @@
 
 mod common;
 
+mod atsp_free;
 mod bad_instances;
 mod bounds;
 mod cli;

@@ -171,6 +171,8 @@ fn auto_picks_its_plan_by_symmetry_and_precedence_density() {
         beam_max_cells: 400,
         plan: plan.to_string(),
         symmetric_plan: SYMMETRIC_PLAN.to_string(),
+        free_plan: cellseq::solvers::auto::FREE_PLAN.to_string(),
+        free_density: 0.001,
         beam_min_seconds: 2.0,
         symmetric_beam_share: 0.3,
         symmetric_beam_plan: SYMMETRIC_BEAM_PLAN.to_string(),
