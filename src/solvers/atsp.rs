@@ -3,7 +3,7 @@
 //! search with block-swap kicks ([`crate::engine::atsp`]).
 
 use super::start::{greedy_solution, outcome};
-use super::{Context, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo};
+use super::{Caps, Context, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo};
 use crate::engine::atsp::cands::{Rank, candidates};
 use crate::engine::atsp::or3::Or3;
 use crate::engine::atsp::patch::{ApGraph, construct};
@@ -56,8 +56,9 @@ pub static INFO: SolverInfo = SolverInfo {
             help: "above this many cells no assignment is solved (O(n^3)): greedy start and nearest-cost candidates",
         },
     ],
+    caps: Caps { ..Caps::NONE },
     make: |p: &Params| {
-        Box::new(Atsp {
+        Ok(Box::new(Atsp {
             k: p.int("k").max(1) as usize,
             rank: if p.word("cand") == "raw" {
                 Rank::Raw
@@ -68,7 +69,7 @@ pub static INFO: SolverInfo = SolverInfo {
             ap_max_cells: p.int("ap-max-cells") as usize,
             far: p.word("kick") == "far",
             greedy_patch: p.word("patch") == "greedy",
-        })
+        }))
     },
 };
 

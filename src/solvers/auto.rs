@@ -44,7 +44,7 @@ use super::{
 };
 use crate::cost::CostModel;
 use crate::engine::atsp::free_density;
-use crate::engine::{Costs, Solution, lk};
+use crate::engine::{Costs, lk};
 use crate::error::{Error, Result};
 use crate::model::Instance;
 use crate::precedence::closure_density;
