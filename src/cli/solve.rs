@@ -85,6 +85,9 @@ pub struct GenerateArgs {
     /// Output instance file.
     #[arg(short, long)]
     out: PathBuf,
+    /// Allow the output to replace a file given as a parameter (e.g. `tools=PATH`).
+    #[arg(long)]
+    overwrite_input: bool,
 }
 
 /// Loads an instance, with the file named in any error.
@@ -366,6 +369,10 @@ pub fn solvers() -> Result<()> {
 
 pub fn generate(a: GenerateArgs) -> Result<()> {
     let params = parse_kv(&a.params)?;
+    // a parameter naming a file (tools=PATH) is an input: never written over silently
+    for v in params.values().map(Path::new).filter(|p| p.is_file()) {
+        formats::write::ensure_not_input(v, &a.out, a.overwrite_input)?;
+    }
     let inst = cellseq::generate::generate(&a.kind, &params, a.seed)?;
     formats::save_instance(&a.out, &inst)?;
     say!("wrote {} ({} cells)", a.out.display(), inst.n());
