@@ -429,13 +429,16 @@ pub fn same_cuts(
     match_cuts((la, &da), (lb, &db), tol, undirected_match)
 }
 
+/// Moves by `(line index, index in line)`, oriented, with their state.
+type Fetched = HashMap<(u32, u32), (Cut, Tag)>;
+
 /// The moves at `(line index, index in line)` of `want`, oriented, with their state.
 fn fetch(
     src: Lines,
     want: &[(u128, u32, u32)],
     tol: f64,
     undirected_match: bool,
-) -> Result<HashMap<(u32, u32), (Cut, Tag)>, String> {
+) -> Result<Fetched, String> {
     let mut lines: HashMap<u32, Vec<u32>> = HashMap::new();
     for x in want {
         lines.entry(x.1).or_default().push(x.2);
