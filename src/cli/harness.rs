@@ -159,11 +159,45 @@ pub fn merge(a: MergeArgs) -> Result<()> {
         }
     }
     let out = a.out.unwrap_or_else(|| a.dirs[0].clone());
+    refuse_foreign_results(&out, &a.dirs)?;
     let (rows, dups) = results::merge(&a.dirs, &out)?;
     say!(
         "merged {rows} trials ({dups} duplicates dropped) into {}",
         out.join("results.csv").display()
     );
+    Ok(())
+}
+
+/// Tables `merge` writes (and reads, with any suffix after the stem).
+const MERGED_TABLES: [&str; 5] = [
+    "results.csv",
+    "traces.csv",
+    "layers.csv",
+    "instances.csv",
+    "manifest.json",
+];
+
+/// Refuses a `merge --out` directory that holds results of its own without being one of the
+/// merged directories: its tables would be replaced by tables that do not hold its rows.
+/// One of the inputs (the default: the first) is fine: its rows are read first and kept.
+fn refuse_foreign_results(out: &Path, dirs: &[PathBuf]) -> Result<()> {
+    if dirs
+        .iter()
+        .any(|d| cellseq::formats::write::same_file(d, out))
+    {
+        return Ok(());
+    }
+    if let Some(t) = MERGED_TABLES
+        .iter()
+        .find(|t| std::fs::symlink_metadata(out.join(t)).is_ok())
+    {
+        bail!(
+            "{}: holds results of its own ({t}) and is not among the merged directories; its \
+             tables would be replaced without its rows: list it among the directories to merge \
+             it too, or choose another --out",
+            out.display()
+        );
+    }
     Ok(())
 }
 

@@ -86,6 +86,9 @@ pub struct GenerateArgs {
     /// (SOP-shaped matrix families).
     #[arg(short, long)]
     out: PathBuf,
+    /// Allow the output to replace a file given as a parameter (e.g. `tools=PATH`).
+    #[arg(long)]
+    overwrite_input: bool,
 }
 
 /// Loads an instance, with the file named in any error.
@@ -372,6 +375,10 @@ pub fn solvers(a: SolversArgs) -> Result<()> {
 
 pub fn generate(a: GenerateArgs) -> Result<()> {
     let params = parse_kv(&a.params)?;
+    // a parameter naming a file (tools=PATH) is an input: never written over silently
+    for v in params.values().map(Path::new).filter(|p| p.is_file()) {
+        formats::write::ensure_not_input(v, &a.out, a.overwrite_input)?;
+    }
     let inst = cellseq::generate::generate(&a.kind, &params, a.seed)?;
     let sop = a
         .out

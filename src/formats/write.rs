@@ -370,6 +370,39 @@ pub fn ensure_not_input(input: &Path, output: &Path, allow: bool) -> Result<()> 
     Ok(())
 }
 
+/// True when `a` and `b` are the same existing file or directory (by device and inode on
+/// Unix, by canonical path elsewhere).
+pub fn same_file(a: &Path, b: &Path) -> bool {
+    #[cfg(unix)]
+    return identity(a).is_some() && identity(a) == identity(b);
+    #[cfg(not(unix))]
+    match (std::fs::canonicalize(a), std::fs::canonicalize(b)) {
+        (Ok(a), Ok(b)) => a == b,
+        _ => false,
+    }
+}
+
+/// Refuses an output directory whose own name is a symbolic link (its parents may be links):
+/// results appended to a directory a link leads to could land anywhere the link was pointed,
+/// so the directory must be named as it is.
+pub fn ensure_not_link_dir(dir: &Path) -> Result<()> {
+    match std::fs::symlink_metadata(dir) {
+        Ok(m) if m.file_type().is_symlink() => {
+            let to = std::fs::read_link(dir)
+                .map(|t| t.display().to_string())
+                .unwrap_or_else(|_| "?".into());
+            Err(Error::invalid(
+                dir.display().to_string(),
+                format!(
+                    "is a symbolic link (to {to}); cellseq writes results only into a directory \
+                     named as it is: give the directory itself with --out, or remove the link"
+                ),
+            ))
+        }
+        _ => Ok(()),
+    }
+}
+
 #[cfg(all(test, unix))]
 mod tests {
     use super::*;

@@ -545,6 +545,7 @@ pub fn run_plan(plan: &Plan, opts: &RunOptions) -> Result<RunSummary> {
         )));
     }
     let out = &opts.out;
+    crate::formats::write::ensure_not_link_dir(out)?;
     std::fs::create_dir_all(out).map_err(|e| Error::io(out.display().to_string(), e))?;
     let files = OutFiles::new(out, opts.shard);
     files.refuse_links()?;

@@ -5,7 +5,7 @@
 
 use super::{Allowance, Timings, solve_group};
 use crate::error::Result;
-use crate::io::gcode::{self, Figures, Parsed, reverse, verify_with, write};
+use crate::io::gcode::{self, Figures, Parsed, Verification, Verifier, reverse, write};
 use crate::model::Objective;
 use crate::solvers;
 use std::time::Instant;
@@ -127,26 +127,97 @@ pub fn optimize(p: &Parsed, opts: &Options) -> Result<Optimized> {
 /// against the original and keeps the original order where the new one is not better. The
 /// allowance's time limit covers what is left of the whole command.
 pub fn optimize_within(p: &Parsed, opts: &Options, allowance: &Allowance) -> Result<Optimized> {
-    let l = &p.layout;
     let on = gcode::reversal_on(p, opts.reversible);
     let pl = gcode::plans(p, on);
     let gs = gcode::groups(p, opts.merge);
-    let total: usize = l.cells.len();
     let mut timings = Timings::default();
+    let t_solve = Instant::now();
+    let mut s = solve_groups(p, opts, allowance, &gs, &pl)?;
+    timings.solve_s = t_solve.elapsed().as_secs_f64();
+    let verifier = Verifier::new(p, on)?;
+    let (result, note) = write_verified(p, opts, &verifier, &gs, &mut s, &mut timings);
+    let given: Vec<usize> = (0..p.layout.cells.len()).collect();
+    let mut kept = match s.kept_groups {
+        0 => Kept::Nothing,
+        k => Kept::Groups(k),
+    };
+    if s.any_changed && s.order == given && s.rev.iter().all(Option::is_none) && result.is_some() {
+        // every changed group had to be reverted: the program is the input as it is
+        kept = Kept::Whole;
+    }
+    let (text, check) = match result {
+        Some(r) => r,
+        None => {
+            let r = write_original(p, &mut timings)?;
+            s.order = given;
+            s.rev.clear();
+            kept = Kept::Whole;
+            r
+        }
+    };
+    let mut reversed: Vec<bool> = s.rev.iter().map(Option::is_some).collect();
+    reversed.resize(s.order.len(), false);
+    Ok(Optimized {
+        kept,
+        reversible_cells: pl.iter().filter(|x| x.is_some()).count(),
+        reversal_on: on,
+        reversed,
+        order: s.order,
+        text,
+        before: check.before,
+        after: check.after,
+        cuts: check.cuts,
+        events: check.events,
+        groups: gs.len(),
+        inner_first_dropped: s.dropped,
+        timings,
+        note,
+    })
+}
+
+/// The groups' orders as the solver left them.
+struct Solved {
+    /// The new order (layout cell indices).
+    order: Vec<usize>,
+    /// Parallel to `order`: the reversal plan of a cell cut backwards.
+    rev: Vec<Option<reverse::Plan>>,
+    /// Per group, its positions in `order`.
+    spans: Vec<(usize, usize)>,
+    /// Groups where the solver's order was not better (or that were reverted since).
+    kept_groups: usize,
+    /// Groups where the inner-first rule was dropped.
+    dropped: usize,
+    /// True when any group's order or direction changed.
+    any_changed: bool,
+}
+
+/// Solves every group in its fixed order with its share of the allowance, each group starting
+/// where the previous one ended.
+fn solve_groups(
+    p: &Parsed,
+    opts: &Options,
+    allowance: &Allowance,
+    gs: &[Vec<usize>],
+    pl: &[Option<reverse::Plan>],
+) -> Result<Solved> {
+    let l = &p.layout;
+    let total: usize = l.cells.len();
     // keep time for writing and verifying: both are linear in the program, about twice a parse
     let reserve_s =
         0.02 * allowance.time_limit.unwrap_or(0.0) + 1e-6 * p.program.lines.len() as f64 * 4.0;
-    let t_solve = Instant::now();
-    let mut order = Vec::with_capacity(total);
-    let mut rev: Vec<Option<reverse::Plan>> = Vec::with_capacity(total);
+    let mut s = Solved {
+        order: Vec::with_capacity(total),
+        rev: Vec::with_capacity(total),
+        spans: Vec::with_capacity(gs.len()),
+        kept_groups: 0,
+        dropped: 0,
+        any_changed: false,
+    };
     let mut home = l.start.unwrap_or(l.cells[0].entry);
-    let mut dropped = 0;
-    let mut kept_groups = 0;
     let mut left = total;
-    let mut spans: Vec<(usize, usize)> = Vec::with_capacity(gs.len());
-    for g in &gs {
-        let (inst, d) = gcode::group_instance(p, g, home, opts.margin, &pl);
-        dropped += d as usize;
+    for g in gs {
+        let (inst, d) = gcode::group_instance(p, g, home, opts.margin, pl);
+        s.dropped += d as usize;
         let budget = allowance.share(g.len(), left, total, reserve_s);
         left -= g.len();
         let r = if g.len() == 1 {
@@ -166,54 +237,59 @@ pub fn optimize_within(p: &Parsed, opts: &Options, allowance: &Allowance) -> Res
             None => super::original_order(&inst),
         };
         if r.as_ref().is_some_and(|r| r.kept_original) {
-            kept_groups += 1;
+            s.kept_groups += 1;
         }
-        let from = order.len();
+        let from = s.order.len();
         for v in &seq {
-            order.push(g[v.cell]);
-            rev.push(if v.mode == 1 { pl[g[v.cell]] } else { None });
+            s.order.push(g[v.cell]);
+            s.rev.push(if v.mode == 1 { pl[g[v.cell]] } else { None });
         }
-        spans.push((from, order.len()));
+        s.spans.push((from, s.order.len()));
         if let Some(v) = seq.last() {
-            home = match rev.last().copied().flatten() {
+            home = match s.rev.last().copied().flatten() {
                 Some(x) => x.exit,
                 None => l.cells[g[v.cell]].exit,
             };
         }
     }
-    timings.solve_s = t_solve.elapsed().as_secs_f64();
-    let given: Vec<usize> = (0..total).collect();
-    let mut kept = if kept_groups > 0 {
-        Kept::Groups(kept_groups)
-    } else {
-        Kept::Nothing
-    };
+    s.any_changed = (0..gs.len()).any(|k| group_changed(&s, gs, k));
+    Ok(s)
+}
+
+/// True when group `k`'s order or direction differs from the program's.
+fn group_changed(s: &Solved, gs: &[Vec<usize>], k: usize) -> bool {
+    let (a, b) = s.spans[k];
+    s.order[a..b] != gs[k][..] || s.rev[a..b].iter().any(Option::is_some)
+}
+
+/// Writes and verifies the new program; while it fails the check or is worse than the input
+/// on any figure, reverts the changed groups one by one (at most 64 tries). Returns the
+/// program and its check, or none (with why) when no try passed.
+fn write_verified(
+    p: &Parsed,
+    opts: &Options,
+    verifier: &Verifier,
+    gs: &[Vec<usize>],
+    s: &mut Solved,
+    timings: &mut Timings,
+) -> (Option<(String, Verification)>, Option<String>) {
+    let given: Vec<usize> = (0..p.layout.cells.len()).collect();
     let mut note = None;
-    let mut result = None;
-    // the groups whose order changed, reverted one by one (at most 64 tries) while the
-    // program is worse than the input on any figure
-    let changed: Vec<usize> = (0..gs.len())
-        .filter(|&k| {
-            let (a, b) = spans[k];
-            order[a..b] != gs[k][..] || rev[a..b].iter().any(Option::is_some)
-        })
-        .collect();
-    let any_changed = !changed.is_empty();
+    let changed: Vec<usize> = (0..gs.len()).filter(|&k| group_changed(s, gs, k)).collect();
     let mut changed = changed.into_iter();
     for attempt in 0..=64 {
         let t = Instant::now();
-        let written = write::write_checked(&p.program, &p.layout, &order, &rev, opts.merge);
+        let written = write::write_checked(&p.program, &p.layout, &s.order, &s.rev, opts.merge);
         timings.write_s += t.elapsed().as_secs_f64();
         match written {
             Ok(text) => {
                 let t = Instant::now();
-                let verified = verify_with(p, "<optimized>", &text, on);
+                let verified = verifier.check("<optimized>", &text);
                 timings.verify_s += t.elapsed().as_secs_f64();
                 match verified {
                     // never worse than the input on air, lifts and time, each one
-                    Ok(check) if check.after.not_worse_than(&check.before) || order == given => {
-                        result = Some((text, check));
-                        break;
+                    Ok(check) if check.after.not_worse_than(&check.before) || s.order == given => {
+                        return (Some((text, check)), note);
                     }
                     Ok(check) => {
                         note.get_or_insert(format!(
@@ -234,50 +310,24 @@ pub fn optimize_within(p: &Parsed, opts: &Options, allowance: &Allowance) -> Res
         let Some(k) = changed.next().filter(|_| attempt < 64) else {
             break;
         };
-        let (a, b) = spans[k];
-        order[a..b].copy_from_slice(&gs[k]);
-        rev[a..b].iter_mut().for_each(|r| *r = None);
-        kept_groups += 1;
-        kept = Kept::Groups(kept_groups);
+        let (a, b) = s.spans[k];
+        s.order[a..b].copy_from_slice(&gs[k]);
+        s.rev[a..b].iter_mut().for_each(|r| *r = None);
+        s.kept_groups += 1;
     }
-    if any_changed && order == given && rev.iter().all(Option::is_none) && result.is_some() {
-        // every changed group had to be reverted: the program is the input as it is
-        kept = Kept::Whole;
-    }
-    let (text, check) = match result {
-        Some(r) => r,
-        None => {
-            // the input's own order: every cell next to its original neighbours, so the
-            // program is written as it is
-            let t = Instant::now();
-            let text = write::write_checked(&p.program, &p.layout, &given, &[], false)
-                .map_err(|m| crate::Error::invalid(&p.file, m))?;
-            timings.write_s += t.elapsed().as_secs_f64();
-            let t = Instant::now();
-            let check = verify_with(p, "<optimized>", &text, false)?;
-            timings.verify_s += t.elapsed().as_secs_f64();
-            order = given;
-            rev.clear();
-            kept = Kept::Whole;
-            (text, check)
-        }
-    };
-    let mut reversed: Vec<bool> = rev.iter().map(Option::is_some).collect();
-    reversed.resize(order.len(), false);
-    Ok(Optimized {
-        kept,
-        reversible_cells: pl.iter().filter(|x| x.is_some()).count(),
-        reversal_on: on,
-        reversed,
-        order,
-        text,
-        before: check.before,
-        after: check.after,
-        cuts: check.cuts,
-        events: check.events,
-        groups: gs.len(),
-        inner_first_dropped: dropped,
-        timings,
-        note,
-    })
+    (None, note)
+}
+
+/// The input's own order: every cell next to its original neighbours, so the program is
+/// written as it is; checked in the original direction.
+fn write_original(p: &Parsed, timings: &mut Timings) -> Result<(String, Verification)> {
+    let given: Vec<usize> = (0..p.layout.cells.len()).collect();
+    let t = Instant::now();
+    let text = write::write_checked(&p.program, &p.layout, &given, &[], false)
+        .map_err(|m| crate::Error::invalid(&p.file, m))?;
+    timings.write_s += t.elapsed().as_secs_f64();
+    let t = Instant::now();
+    let check = Verifier::new(p, false)?.check("<optimized>", &text)?;
+    timings.verify_s += t.elapsed().as_secs_f64();
+    Ok((text, check))
 }

@@ -626,6 +626,14 @@ impl Solver for Auto {
             None
         };
         for (i, ph) in plan.iter().enumerate() {
+            // past the time limit, a later phase would only overrun it (its construction alone
+            // can take seconds on large instances): stop with the best so far
+            let late = budget
+                .time_limit
+                .is_some_and(|t| ctx.elapsed() >= t.as_secs_f64());
+            if late && best.is_some() {
+                break;
+            }
             let b = share(budget, ctx.evaluations(), ctx.elapsed(), ph.share);
             let start = match ph.start {
                 Start::Fresh => None,

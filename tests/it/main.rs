@@ -41,5 +41,6 @@ mod records;
 mod report_outputs;
 mod rs274;
 mod safe_writes;
+mod safety_outputs;
 mod svg;
 mod two_level;

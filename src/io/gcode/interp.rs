@@ -451,6 +451,34 @@ pub fn interpret(src: &str) -> Result<Program, (usize, String)> {
     })
 }
 
+/// Interprets a program like [`interpret`] without keeping it: `f` gets each line's index,
+/// record and normalized text in order, and the records are dropped after the call (memory
+/// stays constant; the verifier checks a rewritten program this way). The lines are read
+/// twice: once for M6 and Z words (which decide how lines are read), once to execute them.
+/// Returns `(has_z, has_m6)` as in [`Program`]. Errors: `(line, message)`.
+pub fn interpret_each(
+    src: &str,
+    mut f: impl FnMut(usize, &LineInfo, &str),
+) -> Result<(bool, bool), (usize, String)> {
+    let mut has_m6 = false;
+    let mut has_z = false;
+    for (i, l) in src.lines().enumerate() {
+        let l = super::lex::normalize(l).map_err(|e| (i + 1, e))?;
+        let w = tokenize(&l).map_err(|e| (i + 1, e))?;
+        has_m6 |= w.has_m(6.0);
+        has_z |= w.has('Z');
+    }
+    let mut st = State::default();
+    let mut pos: Pos = [Some(0.0); 3];
+    for (i, l) in src.lines().enumerate() {
+        let l = super::lex::normalize(l).map_err(|e| (i + 1, e))?;
+        let w = tokenize(&l).map_err(|e| (i + 1, e))?;
+        let info = step(i + 1, w, &mut st, &mut pos, has_m6).map_err(|e| (i + 1, e))?;
+        f(i, &info, &l);
+    }
+    Ok((has_z, has_m6))
+}
+
 fn close(a: f64, b: f64) -> bool {
     (a - b).abs() < 1e-6
 }

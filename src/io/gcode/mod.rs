@@ -297,16 +297,58 @@ pub fn verify_with(
     new_text: &str,
     undirected: bool,
 ) -> Result<Verification> {
-    let np = interp::interpret(new_text).map_err(|(l, m)| Error::parse(new_file, l, m))?;
-    let eq = verify::equivalent(&orig.program, &np, TOLERANCE, undirected)
-        .map_err(|m| Error::invalid(new_file, format!("not equivalent to {}: {m}", orig.file)))?;
-    let safe = safe_height(orig);
-    Ok(Verification {
-        cuts: eq.cuts,
-        events: eq.events,
-        before: verify::figures(&orig.program, safe),
-        after: verify::figures(&np, safe),
-    })
+    Verifier::new(orig, undirected)?.check(new_file, new_text)
+}
+
+/// The check of [`verify_with`] with the original's [`verify::Digest`] made once, for
+/// checking several candidate programs against one original. A candidate text is
+/// interpreted line by line and never held, so checking a program costs the memory of its
+/// digest (32 bytes per cutting move), not of its interpreted lines.
+#[derive(Debug, Clone)]
+pub struct Verifier<'a> {
+    orig: &'a Parsed,
+    undirected: bool,
+    digest: verify::Digest,
+}
+
+impl<'a> Verifier<'a> {
+    /// Sums up the original; `undirected` as in [`verify_with`].
+    pub fn new(orig: &'a Parsed, undirected: bool) -> Result<Self> {
+        let lines = verify::Lines::Program(&orig.program);
+        let digest = verify::Digest::of(lines, TOLERANCE, undirected, safe_height(orig))
+            .map_err(|(l, m)| Error::parse(&orig.file, l, m))?;
+        Ok(Verifier {
+            orig,
+            undirected,
+            digest,
+        })
+    }
+
+    /// Interprets `new_text` line by line and checks it against the original.
+    pub fn check(&self, new_file: &str, new_text: &str) -> Result<Verification> {
+        let lines = verify::Lines::Text(new_text);
+        let safe = safe_height(self.orig);
+        let digest = verify::Digest::of(lines, TOLERANCE, self.undirected, safe)
+            .map_err(|(l, m)| Error::parse(new_file, l, m))?;
+        let eq = verify::compare(
+            (verify::Lines::Program(&self.orig.program), &self.digest),
+            (lines, &digest),
+            TOLERANCE,
+            self.undirected,
+        )
+        .map_err(|m| {
+            Error::invalid(
+                new_file,
+                format!("not equivalent to {}: {m}", self.orig.file),
+            )
+        })?;
+        Ok(Verification {
+            cuts: eq.cuts,
+            events: eq.events,
+            before: self.digest.figures,
+            after: digest.figures,
+        })
+    }
 }
 
 /// `verify-gcode`: parses both files and compares them.

@@ -1,7 +1,14 @@
 //! Equivalence check between two programs and their travel figures.
+//!
+//! A program is summed up in one pass as a [`Digest`] (hashes of its state-tagged cutting
+//! moves and events, sorted, its motions before the first cut, its rapids across, its
+//! figures); two digests are compared, and the lines are read again only to pair moves that
+//! fell on both sides of a grid line and to describe a difference. A program text can be
+//! checked without ever holding its interpreted lines ([`Lines::Text`]).
 
-use super::interp::{Cut, CutKind, LineInfo, Motion, Program, Tag};
+use super::interp::{Cut, CutKind, LineInfo, Motion, Program, State, Tag};
 use serde::Serialize;
+use std::collections::{BTreeMap, HashMap};
 use std::hash::{Hash, Hasher};
 
 /// Straight moves shorter than this (mm) are not compared: they cut nothing.
@@ -42,10 +49,32 @@ impl Figures {
 
 /// Measures a program; `safe` is the safe height for counting lifts (`None` for 2-D programs).
 pub fn figures(p: &Program, safe: Option<f64>) -> Figures {
-    let mut f = Figures::default();
-    let mut cut_time = 0.0;
-    let mut cutting = false;
-    for li in &p.lines {
+    let mut m = Measure::new(safe);
+    p.lines.iter().for_each(|li| m.add(li));
+    m.finish()
+}
+
+/// [`figures`] one line at a time.
+#[derive(Debug, Clone, Copy)]
+struct Measure {
+    f: Figures,
+    safe: Option<f64>,
+    cut_time: f64,
+    cutting: bool,
+}
+
+impl Measure {
+    fn new(safe: Option<f64>) -> Self {
+        Measure {
+            f: Figures::default(),
+            safe,
+            cut_time: 0.0,
+            cutting: false,
+        }
+    }
+
+    fn add(&mut self, li: &LineInfo) {
+        let f = &mut self.f;
         f.air_length += li.rapid_len;
         if li.tool_change {
             f.tool_changes += 1;
@@ -55,10 +84,10 @@ pub fn figures(p: &Program, safe: Option<f64>) -> Figures {
             let len = c.length();
             f.cut_length += len;
             if c.feed > 0.0 {
-                cut_time += len / c.feed * 60.0;
+                self.cut_time += len / c.feed * 60.0;
             }
         }
-        match safe {
+        match self.safe {
             Some(s) => {
                 if let (Some(a), Some(b)) = (li.pos_before[2], li.pos_after[2])
                     && a < s - 1e-6
@@ -71,18 +100,23 @@ pub fn figures(p: &Program, safe: Option<f64>) -> Figures {
                 }
             }
             None => match li.motion {
-                Motion::Feed => cutting = true,
-                Motion::Rapid | Motion::Home if cutting => {
+                Motion::Feed => self.cutting = true,
+                Motion::Rapid | Motion::Home if self.cutting => {
                     f.lifts += 1;
-                    cutting = false;
+                    self.cutting = false;
                 }
                 _ => {}
             },
         }
     }
-    f.est_time_s =
-        cut_time + f.air_length / RAPID_MM_MIN * 60.0 + f.tool_changes as f64 * TOOL_CHANGE_S;
-    f
+
+    fn finish(self) -> Figures {
+        let mut f = self.f;
+        f.est_time_s = self.cut_time
+            + f.air_length / RAPID_MM_MIN * 60.0
+            + f.tool_changes as f64 * TOOL_CHANGE_S;
+        f
+    }
 }
 
 fn key(c: &Cut, tol: f64) -> Vec<i64> {
@@ -208,6 +242,133 @@ fn tag(li: &LineInfo) -> Tag {
     li.after.tag()
 }
 
+/// The lines of a program for the checks: a program held in memory, or a program text that
+/// is interpreted line by line and never held (how `optimize` checks its output, so a program
+/// of 10^6 moves is not held twice).
+#[derive(Debug, Clone, Copy)]
+pub enum Lines<'a> {
+    /// An interpreted program.
+    Program(&'a Program),
+    /// A program text, interpreted on each pass.
+    Text(&'a str),
+}
+
+impl Lines<'_> {
+    /// Calls `f(index, line, text)` for every line in order; returns the program's `has_z`.
+    /// Errors: the interpreter's `(line, message)`.
+    fn each(&self, mut f: impl FnMut(usize, &LineInfo, &str)) -> Result<bool, (usize, String)> {
+        match self {
+            Lines::Program(p) => {
+                for (i, li) in p.lines.iter().enumerate() {
+                    f(i, li, &p.text[i]);
+                }
+                Ok(p.has_z)
+            }
+            Lines::Text(t) => super::interp::interpret_each(t, f).map(|(z, _)| z),
+        }
+    }
+
+    /// [`Lines::each`] for a program already read once (a second pass cannot fail unless the
+    /// interpreter is not deterministic, which is then reported as a mismatch).
+    fn again(&self, f: impl FnMut(usize, &LineInfo, &str)) -> Result<(), String> {
+        self.each(f)
+            .map(|_| ())
+            .map_err(|(l, m)| format!("line {l} read differently on a second pass: {m}"))
+    }
+}
+
+/// Everything the checks compare, gathered in one pass over a program, in compact form
+/// (hashes of state-tagged moves and events, sorted; 32 bytes per cutting move): what is
+/// kept of a program instead of its interpreted lines.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Digest {
+    /// Hash of each cutting move with its state, line index and index within the line; sorted.
+    cuts: Vec<(u128, u32, u32)>,
+    /// Events the output must have as many of (hash, line number); sorted.
+    exact: Vec<(u128, usize)>,
+    /// Events the output may have fewer of (tool changes, moves to machine positions); sorted.
+    fewer: Vec<(u128, usize)>,
+    /// Motions and tool changes before the first cut, in order.
+    lead_in: Vec<u128>,
+    /// Per tool, the lowest height of a rapid across in X/Y.
+    low: BTreeMap<u32, f64>,
+    /// Rapids across in X/Y: line number, tool, height.
+    rapids: Vec<(usize, u32, f64)>,
+    /// True when any motion line carries Z.
+    has_z: bool,
+    /// Travel figures.
+    pub figures: Figures,
+}
+
+impl Digest {
+    /// One pass over `src`. Moves are keyed on the `tol` grid, direction-free with
+    /// `undirected_match` (see [`undirected`]); `safe` as in [`figures`].
+    pub fn of(
+        src: Lines,
+        tol: f64,
+        undirected_match: bool,
+        safe: Option<f64>,
+    ) -> Result<Digest, (usize, String)> {
+        let q = |v: Option<f64>| v.map(|x| (x / tol).round() as i64);
+        let mut m = Measure::new(safe);
+        let mut d = Digest {
+            cuts: Vec::new(),
+            exact: Vec::new(),
+            fewer: Vec::new(),
+            lead_in: Vec::new(),
+            low: BTreeMap::new(),
+            rapids: Vec::new(),
+            has_z: false,
+            figures: Figures::default(),
+        };
+        let mut cut_seen = false;
+        d.has_z = src.each(|i, li, text| {
+            m.add(li);
+            let t = tag(li);
+            for (j, c) in li.cuts.iter().enumerate() {
+                if matches!(c.kind, CutKind::Line) && c.length() <= ZERO_MOVE {
+                    continue;
+                }
+                let c = oriented(c, tol, undirected_match);
+                d.cuts
+                    .push((hash128(&(key(&c, tol), c.partial, t)), i as u32, j as u32));
+            }
+            for (e, h) in events(li, text) {
+                if e {
+                    d.exact.push((h, li.line));
+                } else {
+                    d.fewer.push((h, li.line));
+                }
+            }
+            cut_seen |= !li.cuts.is_empty();
+            if !cut_seen && (li.motion != Motion::None || li.tool_change) {
+                let p = li.pos_after.map(q);
+                d.lead_in
+                    .push(hash128(&(li.motion as u8, li.tool_change, p)));
+            }
+            if let Some(z) = li.xy_rapid_z {
+                let e = d.low.entry(li.before.tool).or_insert(z);
+                *e = f64::min(*e, z);
+                d.rapids.push((li.line, li.before.tool, z));
+            }
+        })?;
+        d.cuts.sort_unstable();
+        d.exact.sort_unstable();
+        d.fewer.sort_unstable();
+        d.figures = m.finish();
+        Ok(d)
+    }
+}
+
+/// The move as it is compared: direction-free with `undirected_match`.
+fn oriented(c: &Cut, tol: f64, undirected_match: bool) -> Cut {
+    if undirected_match {
+        undirected(c, tol)
+    } else {
+        *c
+    }
+}
+
 /// What two programs were found to share by [`equivalent`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Equivalence {
@@ -232,9 +393,24 @@ pub fn equivalent(
     tol: f64,
     undirected_match: bool,
 ) -> Result<Equivalence, String> {
-    let cuts = same_cuts(a, b, tol, undirected_match)?;
-    let events = same_events(a, b)?;
-    no_new_motion(a, b, tol)?;
+    let (la, lb) = (Lines::Program(a), Lines::Program(b));
+    let da = Digest::of(la, tol, undirected_match, None).map_err(|(_, m)| m)?;
+    let db = Digest::of(lb, tol, undirected_match, None).map_err(|(_, m)| m)?;
+    compare((la, &da), (lb, &db), tol, undirected_match)
+}
+
+/// [`equivalent`] on digests made with the same `tol` and `undirected_match`; the lines are
+/// read again only to pair moves that fell on both sides of a grid line and to describe a
+/// difference.
+pub fn compare(
+    a: (Lines, &Digest),
+    b: (Lines, &Digest),
+    tol: f64,
+    undirected_match: bool,
+) -> Result<Equivalence, String> {
+    let cuts = match_cuts(a, b, tol, undirected_match)?;
+    let events = same_events(a.1, b.1)?;
+    no_new_motion(a.1, b.1, tol)?;
     Ok(Equivalence { cuts, events })
 }
 
@@ -247,29 +423,47 @@ pub fn same_cuts(
     tol: f64,
     undirected_match: bool,
 ) -> Result<usize, String> {
-    let cut = |c: &Cut| {
-        if undirected_match {
-            undirected(c, tol)
-        } else {
-            *c
-        }
-    };
-    let collect = |p: &Program| {
-        let mut v: Vec<(u128, u32, u32)> = Vec::new();
-        for (i, li) in p.lines.iter().enumerate() {
-            let t = tag(li);
-            for (j, c) in li.cuts.iter().enumerate() {
-                if matches!(c.kind, CutKind::Line) && c.length() <= ZERO_MOVE {
-                    continue;
+    let (la, lb) = (Lines::Program(a), Lines::Program(b));
+    let da = Digest::of(la, tol, undirected_match, None).map_err(|(_, m)| m)?;
+    let db = Digest::of(lb, tol, undirected_match, None).map_err(|(_, m)| m)?;
+    match_cuts((la, &da), (lb, &db), tol, undirected_match)
+}
+
+/// Moves by `(line index, index in line)`, oriented, with their state.
+type Fetched = HashMap<(u32, u32), (Cut, Tag)>;
+
+/// The moves at `(line index, index in line)` of `want`, oriented, with their state.
+fn fetch(
+    src: Lines,
+    want: &[(u128, u32, u32)],
+    tol: f64,
+    undirected_match: bool,
+) -> Result<Fetched, String> {
+    let mut lines: HashMap<u32, Vec<u32>> = HashMap::new();
+    for x in want {
+        lines.entry(x.1).or_default().push(x.2);
+    }
+    let mut out = HashMap::new();
+    src.again(|i, li, _| {
+        if let Some(js) = lines.get(&(i as u32)) {
+            for &j in js {
+                if let Some(c) = li.cuts.get(j as usize) {
+                    out.insert((i as u32, j), (oriented(c, tol, undirected_match), tag(li)));
                 }
-                let c = cut(c);
-                v.push((hash128(&(key(&c, tol), c.partial, t)), i as u32, j as u32));
             }
         }
-        v.sort_unstable();
-        v
-    };
-    let (ka, kb) = (collect(a), collect(b));
+    })?;
+    Ok(out)
+}
+
+/// [`same_cuts`] on digests: returns how many moves were matched.
+fn match_cuts(
+    (a, da): (Lines, &Digest),
+    (b, db): (Lines, &Digest),
+    tol: f64,
+    undirected_match: bool,
+) -> Result<usize, String> {
+    let (ka, kb) = (&da.cuts, &db.cuts);
     // pair equal hashes; what is left (values that fell on both sides of a grid line) is
     // paired by the tolerance test itself
     let (mut ua, mut ub) = (Vec::new(), Vec::new());
@@ -295,17 +489,26 @@ pub fn same_cuts(
             (None, None) => break,
         }
     }
+    if ua.is_empty() && ub.is_empty() {
+        return Ok(ka.len());
+    }
     if ua.len() == ub.len() && ua.len() <= 10_000 {
-        let get = |p: &Program, x: &(u128, u32, u32)| {
-            let li = &p.lines[x.1 as usize];
-            (cut(&li.cuts[x.2 as usize]), tag(li))
-        };
+        let (ma, mb) = (
+            fetch(a, &ua, tol, undirected_match)?,
+            fetch(b, &ub, tol, undirected_match)?,
+        );
+        let get =
+            |m: &HashMap<(u32, u32), (Cut, Tag)>, x: &(u128, u32, u32)| m.get(&(x.1, x.2)).copied();
         let mut taken = vec![false; ub.len()];
         let all = ua.iter().all(|x| {
-            let (ca, ta) = get(a, x);
+            let Some((ca, ta)) = get(&ma, x) else {
+                return false;
+            };
             let hit = ub.iter().enumerate().position(|(k, y)| {
-                let (cb, tb) = get(b, y);
-                !taken[k] && ta == tb && ca.partial == cb.partial && same(&ca, &cb, tol)
+                !taken[k]
+                    && get(&mb, y).is_some_and(|(cb, tb)| {
+                        ta == tb && ca.partial == cb.partial && same(&ca, &cb, tol)
+                    })
             });
             hit.map(|k| taken[k] = true).is_some()
         });
@@ -313,17 +516,17 @@ pub fn same_cuts(
             return Ok(ka.len());
         }
     }
-    Err(mismatch(a, b, &ka, &kb, &cut))
+    Err(mismatch((a, da), (b, db), tol, undirected_match))
 }
 
 /// Describes the first cutting move of one program that the other lacks.
 fn mismatch(
-    a: &Program,
-    b: &Program,
-    ka: &[(u128, u32, u32)],
-    kb: &[(u128, u32, u32)],
-    cut: &dyn Fn(&Cut) -> Cut,
+    (a, da): (Lines, &Digest),
+    (b, db): (Lines, &Digest),
+    tol: f64,
+    undirected_match: bool,
 ) -> String {
+    let (ka, kb) = (&da.cuts, &db.cuts);
     let (mut i, mut j) = (0, 0);
     let mut lone: Option<(bool, (u128, u32, u32))> = None;
     while i < ka.len() || j < kb.len() {
@@ -356,32 +559,44 @@ fn mismatch(
         return format!("cutting moves differ ({counts})");
     };
     let (p, q) = if in_a { (a, b) } else { (b, a) };
-    let li = &p.lines[x.1 as usize];
-    let c = cut(&li.cuts[x.2 as usize]);
+    // the lone move, its line number and state
+    let mut found: Option<(usize, Cut, State)> = None;
+    let read = p.again(|i, li, _| {
+        if i as u32 == x.1
+            && let Some(c) = li.cuts.get(x.2 as usize)
+        {
+            found = Some((li.line, oriented(c, tol, undirected_match), li.after));
+        }
+    });
+    let Some((line, c, st)) = found.filter(|_| read.is_ok()) else {
+        return format!("cutting moves differ ({counts})");
+    };
     let (which, other) = if in_a {
         ("the original's", "the output")
     } else {
         ("the output's", "the original")
     };
     // the same move in another state?
-    let twin = q.lines.iter().find_map(|l2| {
-        l2.cuts
-            .iter()
-            .find(|c2| same(&cut(c2), &c, 1e-3))
-            .map(|_| l2)
+    let mut twin: Option<(usize, State)> = None;
+    let _ = q.again(|_, l2, _| {
+        if twin.is_none()
+            && l2
+                .cuts
+                .iter()
+                .any(|c2| same(&oriented(c2, tol, undirected_match), &c, 1e-3))
+        {
+            twin = Some((l2.line, l2.after));
+        }
     });
     match twin {
-        Some(l2) => format!(
-            "{counts}; {which} line {} cuts {} with {}, {other} (line {}) with {}",
-            li.line,
+        Some((line2, st2)) => format!(
+            "{counts}; {which} line {line} cuts {} with {}, {other} (line {line2}) with {}",
             describe(&c),
-            state_words(&li.after, &l2.after),
-            l2.line,
-            state_words(&l2.after, &li.after),
+            state_words(&st, &st2),
+            state_words(&st2, &st),
         ),
         None => format!(
-            "{counts}; {which} line {} cuts {}, which {other} never cuts",
-            li.line,
+            "{counts}; {which} line {line} cuts {}, which {other} never cuts",
             describe(&c)
         ),
     }
@@ -491,25 +706,9 @@ fn events(li: &LineInfo, text: &str) -> Vec<(bool, u128)> {
 }
 
 /// Same events with the same state (see [`equivalent`]); returns how many were compared.
-fn same_events(a: &Program, b: &Program) -> Result<usize, String> {
-    let collect = |p: &Program| {
-        let mut exact: Vec<(u128, usize)> = Vec::new();
-        let mut fewer: Vec<(u128, usize)> = Vec::new();
-        for (i, li) in p.lines.iter().enumerate() {
-            for (e, h) in events(li, &p.text[i]) {
-                if e {
-                    exact.push((h, li.line));
-                } else {
-                    fewer.push((h, li.line));
-                }
-            }
-        }
-        exact.sort_unstable();
-        fewer.sort_unstable();
-        (exact, fewer)
-    };
-    let ((ea, fa), (eb, fb)) = (collect(a), collect(b));
-    for (x, y) in ea.iter().zip(&eb) {
+fn same_events(a: &Digest, b: &Digest) -> Result<usize, String> {
+    let (ea, fa, eb, fb) = (&a.exact, &a.fewer, &b.exact, &b.fewer);
+    for (x, y) in ea.iter().zip(eb) {
         if x.0 != y.0 {
             return Err(format!(
                 "events differ (dwell, pause, user M code, coordinate-system change or \
@@ -528,7 +727,7 @@ fn same_events(a: &Program, b: &Program) -> Result<usize, String> {
     }
     // fb must be a sub-multiset of fa
     let mut i = 0;
-    for y in &fb {
+    for y in fb {
         while i < fa.len() && fa[i].0 < y.0 {
             i += 1;
         }
@@ -544,31 +743,11 @@ fn same_events(a: &Program, b: &Program) -> Result<usize, String> {
     Ok(ea.len() + fb.len())
 }
 
-/// The motions (rapid targets, moves to machine positions) and tool changes before the first
-/// cut, and per tool the lowest height of a rapid across in X/Y.
-fn motion_profile(p: &Program, tol: f64) -> (Vec<u128>, std::collections::HashMap<u32, f64>) {
-    let q = |v: Option<f64>| v.map(|x| (x / tol).round() as i64);
-    let mut before = Vec::new();
-    let mut cut = false;
-    let mut low = std::collections::HashMap::new();
-    for li in &p.lines {
-        cut |= !li.cuts.is_empty();
-        if !cut && (li.motion != Motion::None || li.tool_change) {
-            let t = li.pos_after.map(q);
-            before.push(hash128(&(li.motion as u8, li.tool_change, t)));
-        }
-        if let Some(z) = li.xy_rapid_z {
-            let e = low.entry(li.before.tool).or_insert(z);
-            *e = f64::min(*e, z);
-        }
-    }
-    (before, low)
-}
-
-/// The no-new-motion rule of [`equivalent`].
-fn no_new_motion(a: &Program, b: &Program, tol: f64) -> Result<(), String> {
-    let (pa, low) = motion_profile(a, tol);
-    let (pb, _) = motion_profile(b, tol);
+/// The no-new-motion rule of [`equivalent`]: the original's motions and tool changes before
+/// its first cut come first, and no rapid across in X/Y runs lower than the original's lowest
+/// with that tool.
+fn no_new_motion(a: &Digest, b: &Digest, tol: f64) -> Result<(), String> {
+    let (pa, pb) = (&a.lead_in, &b.lead_in);
     if pb.len() < pa.len() || pb[..pa.len()] != pa[..] {
         return Err(
             "the motions and tool changes before the first cut are not the original's".into(),
@@ -577,18 +756,74 @@ fn no_new_motion(a: &Program, b: &Program, tol: f64) -> Result<(), String> {
     if !a.has_z {
         return Ok(());
     }
-    let floor = low.values().copied().fold(f64::INFINITY, f64::min);
-    for li in &b.lines {
-        if let Some(z) = li.xy_rapid_z {
-            let min = low.get(&li.before.tool).copied().unwrap_or(floor);
-            if z < min - tol {
-                return Err(format!(
-                    "line {}: a rapid across at Z{z:.4} mm, lower than the original ever \
-                     rapids across with tool {} (Z{min:.4} mm)",
-                    li.line, li.before.tool
-                ));
-            }
+    let floor = a.low.values().copied().fold(f64::INFINITY, f64::min);
+    for &(line, tool, z) in &b.rapids {
+        let min = a.low.get(&tool).copied().unwrap_or(floor);
+        if z < min - tol {
+            return Err(format!(
+                "line {line}: a rapid across at Z{z:.4} mm, lower than the original ever \
+                 rapids across with tool {tool} (Z{min:.4} mm)"
+            ));
         }
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every G-code fixture: the digest of a text read line by line is the digest of the same
+    /// text interpreted and held, in both direction rules, and a program matches itself.
+    #[test]
+    fn streamed_digest_equals_the_held_programs() {
+        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/gcode");
+        let mut files: Vec<_> = ["", "real"]
+            .iter()
+            .flat_map(|d| std::fs::read_dir(dir.join(d)).unwrap())
+            .map(|e| e.unwrap().path())
+            .filter(|p| p.is_file() && p.extension().is_some_and(|x| x != "md"))
+            .collect();
+        files.sort();
+        let mut checked = 0;
+        for f in &files {
+            let text = std::fs::read_to_string(f).unwrap();
+            let Ok(p) = super::super::interp::interpret(&text) else {
+                continue;
+            };
+            for und in [false, true] {
+                let held = Digest::of(Lines::Program(&p), 1e-3, und, Some(1.0)).unwrap();
+                let streamed = Digest::of(Lines::Text(&text), 1e-3, und, Some(1.0)).unwrap();
+                assert_eq!(held, streamed, "{}", f.display());
+                let eq = compare(
+                    (Lines::Program(&p), &held),
+                    (Lines::Text(&text), &streamed),
+                    1e-3,
+                    und,
+                )
+                .unwrap();
+                assert_eq!(eq.cuts, held.cuts.len());
+            }
+            checked += 1;
+        }
+        assert!(checked >= 20, "only {checked} fixtures read");
+    }
+
+    /// A changed move in a streamed text is found and described with its line.
+    #[test]
+    fn streamed_mismatch_names_the_line() {
+        let a = "G21 G90\nG0 X0 Y0 Z5\nG1 Z-1 F100\nG1 X10\nG1 Y10\nG0 Z5\nM2\n";
+        let b = a.replace("G1 Y10", "G1 Y10.5");
+        let p = super::super::interp::interpret(a).unwrap();
+        let da = Digest::of(Lines::Program(&p), 1e-3, false, None).unwrap();
+        let db = Digest::of(Lines::Text(&b), 1e-3, false, None).unwrap();
+        let e = compare(
+            (Lines::Program(&p), &da),
+            (Lines::Text(&b), &db),
+            1e-3,
+            false,
+        )
+        .unwrap_err();
+        assert!(e.contains("line 5"), "{e}");
+    }
 }
