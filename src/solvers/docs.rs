@@ -101,6 +101,24 @@ window moves with modes (a cell moved inside a 5-position window while the modes
 are re-chosen); `window-repair=true` runs them in every repair as well.",
     ),
     (
+        "atsp",
+        "For asymmetric costs with little or no precedence (an asymmetric TSP as an open path).
+
+- **Start**: the better of `greedy` and the assignment problem's solution (a dummy node \
+closes the path) whose cycles are patched into one path (`patch=greedy`: the cheapest join of \
+any two cycles first; `karp`: into the largest cycle); arcs no feasible order can use are left \
+out, and a patched path that breaks the precedence is repaired by a topological sort that \
+follows it. Above `ap-max-cells` no assignment is solved.
+- **Search**: iterated Or-3opt (two adjacent blocks swap places, no reversal) on candidate \
+lists ranked by the assignment's reduced costs (`cand=reduced`, ties by raw cost; `k` per \
+cell), precedence checked on every move; kicks swap two blocks across a third (`kick=far`) \
+or two adjacent blocks (`near`), of up to `kick-len` cells; equal-or-better results are \
+accepted.
+- `auto` runs it (`free-plan`) on asymmetric matrix instances whose closure density, apart \
+from cells ordered against every other (a fixed start and end), is at most `free-density`; \
+notes/atsp.md has the measurements.",
+    ),
+    (
         "exact",
         "Held–Karp dynamic programming over precedence-closed subsets of cells, with modes: the \
 optimum, proven. The number of precedence-closed subsets decides its memory; an instance \
