@@ -499,15 +499,15 @@ mod tests {
     #[test]
     fn errors_name_the_line() {
         let cases = [
-            (SMALL.replace("0 0 -1 4", "0 0 -2 4"), "line 11"),
+            (SMALL.replace("0 0 -1 4", "0 0 -2 4"), "t.pcgtsp:11:"),
             (SMALL.replace("0 7 8.25 0\n", ""), "needs 16"),
-            (SMALL.replace("GROUPS: 3", "GROUPS: 9"), "line 4"),
+            (SMALL.replace("GROUPS: 3", "GROUPS: 9"), "t.pcgtsp:4:"),
             (
                 SMALL.replace("DIMENSION: 4", "DIMENSION: 99999999"),
                 "limit",
             ),
-            (SMALL.replace("3 3 4 -1", "3 3 4"), "line 17"),
-            (SMALL.replace("0 0 0.5 1", "0 0 x 1"), "line 8"),
+            (SMALL.replace("3 3 4 -1", "3 3 4"), "t.pcgtsp:17:"),
+            (SMALL.replace("0 0 0.5 1", "0 0 x 1"), "t.pcgtsp:8:"),
             (SMALL.replace("\n1\nEOF", "\n3\nEOF"), "single-node"),
             (SMALL.replace("2 2 -1", "2 1 -1"), "two groups"),
         ];
