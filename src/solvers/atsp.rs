@@ -199,7 +199,11 @@ mod tests {
             cells: (0..n)
                 .map(|i| Cell::new(i.to_string(), "", vec![Mode::default()]))
                 .collect(),
-            precedence: if seed % 3 == 0 { vec![(2, 1)] } else { vec![] },
+            precedence: if seed.is_multiple_of(3) {
+                vec![(2, 1)]
+            } else {
+                vec![]
+            },
             matrix: Some(CostMatrix { size: n, costs }),
             first: ends.then_some(0),
             last: ends.then_some(n - 1),

@@ -1,7 +1,6 @@
 //! `docs/solvers.md` is generated from the solver registry; this test fails when the committed
 //! file is not what `cellseq solvers --markdown` prints now, and says how to regenerate it.
 
-
 const REGENERATE: &str = "cargo run --release -- solvers --markdown > docs/solvers.md";
 
 #[test]
