@@ -2,7 +2,7 @@
 //!
 //! To add a solver: write a module here with a type implementing [`Solver`], give it a
 //! [`SolverInfo`] (name, summary, parameters with defaults, constructor) and list it in
-//! [`registry`]. The conformance tests in `tests/conformance.rs` then cover it automatically.
+//! [`registry`]. The conformance tests in `tests/it/conformance.rs` then cover it automatically.
 
 pub mod aco;
 pub mod as_given;
