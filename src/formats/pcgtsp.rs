@@ -27,7 +27,7 @@
 //! [`super::tsplib::max_nodes`], and the number of matrix entries the file really holds);
 //! every error names the file and the line.
 
-use super::tsplib::{FORBIDDEN_ARC, MAX_NODES_ENV, max_nodes};
+use super::tsplib::{FORBIDDEN_ARC, MAX_NODES_ENV, group_number, max_nodes, parse_list as list};
 use crate::error::{Error, Result};
 use crate::model::{Cell, CostMatrix, Instance, Metadata, Mode};
 use std::collections::BTreeSet;
@@ -425,47 +425,6 @@ fn instance_name(p: &Parts, file: &str) -> String {
     } else {
         stem.to_string()
     }
-}
-
-/// "a b c ... -1" → the numbers before the terminating -1.
-fn list(file: &str, ln: usize, line: &str) -> Result<Vec<i64>> {
-    let mut out = Vec::new();
-    let mut ended = false;
-    for t in line.split_whitespace() {
-        if ended {
-            return Err(Error::parse(
-                file,
-                ln,
-                format!("token '{t}' after the terminating -1"),
-            ));
-        }
-        let v: i64 = t
-            .parse()
-            .map_err(|_| Error::parse(file, ln, format!("expected an integer, found '{t}'")))?;
-        if v == -1 {
-            ended = true;
-        } else {
-            out.push(v);
-        }
-    }
-    if !ended {
-        return Err(Error::parse(file, ln, "list is not terminated by -1"));
-    }
-    if out.is_empty() {
-        return Err(Error::parse(file, ln, "empty list"));
-    }
-    Ok(out)
-}
-
-fn group_number(file: &str, ln: usize, g: i64, ngroups: usize) -> Result<usize> {
-    if g < 1 || g as usize > ngroups {
-        return Err(Error::parse(
-            file,
-            ln,
-            format!("group {g} out of range 1..{ngroups}"),
-        ));
-    }
-    Ok(g as usize - 1)
 }
 
 #[cfg(test)]

@@ -602,7 +602,7 @@ fn pcglns_start(file: &str, lines: Vec<(usize, &str)>, groups: &[Vec<usize>]) ->
 }
 
 /// Parses "a b c ... -1" into the numbers before the terminating -1.
-fn parse_list(file: &str, ln: usize, line: &str) -> Result<Vec<i64>> {
+pub(crate) fn parse_list(file: &str, ln: usize, line: &str) -> Result<Vec<i64>> {
     let mut out = Vec::new();
     let mut ended = false;
     for t in line.split_whitespace() {
@@ -631,7 +631,8 @@ fn parse_list(file: &str, ln: usize, line: &str) -> Result<Vec<i64>> {
     Ok(out)
 }
 
-fn group_number(file: &str, ln: usize, g: i64, ngroups: usize) -> Result<usize> {
+/// Group number `g` (1-based) of `ngroups` as an index.
+pub(crate) fn group_number(file: &str, ln: usize, g: i64, ngroups: usize) -> Result<usize> {
     if g < 1 || g as usize > ngroups {
         return Err(Error::parse(
             file,
