@@ -27,7 +27,10 @@
 //! [`super::tsplib::max_nodes`], and the number of matrix entries the file really holds);
 //! every error names the file and the line.
 
-use super::tsplib::{FORBIDDEN_ARC, MAX_NODES_ENV, group_number, max_nodes, parse_list as list};
+use super::tsplib::{
+    FORBIDDEN_ARC, MAX_NODES_ENV, add_to_group, group_number, groups_complete, max_nodes,
+    parse_list as list,
+};
 use crate::error::{Error, Result};
 use crate::model::{Cell, CostMatrix, Instance, Metadata, Mode};
 use std::collections::BTreeSet;
@@ -250,38 +253,9 @@ pub fn parse_pcgtsp(file: &str, text: &str) -> Result<Instance> {
                 format!("group {} has no nodes", g + 1),
             ));
         }
-        for &v in &nums[1..] {
-            if v < 1 || v as usize > dim {
-                return Err(Error::parse(
-                    file,
-                    ln,
-                    format!("node {v} out of range 1..{dim}"),
-                ));
-            }
-            let v = v as usize - 1;
-            if group_of[v] != usize::MAX {
-                return Err(Error::parse(
-                    file,
-                    ln,
-                    format!("node {} is in two groups", v + 1),
-                ));
-            }
-            group_of[v] = g;
-            groups[g].push(v);
-        }
+        add_to_group(file, ln, g, &nums[1..], &mut group_of, &mut groups)?;
     }
-    if let Some(g) = groups.iter().position(|g| g.is_empty()) {
-        return Err(Error::invalid(
-            file,
-            format!("group {} has no nodes", g + 1),
-        ));
-    }
-    if let Some(v) = group_of.iter().position(|&g| g == usize::MAX) {
-        return Err(Error::invalid(
-            file,
-            format!("node {} belongs to no group", v + 1),
-        ));
-    }
+    groups_complete(file, &groups, &group_of)?;
     let mut new_index = vec![0usize; dim];
     for (k, &v) in groups.iter().flatten().enumerate() {
         new_index[v] = k;

@@ -469,38 +469,9 @@ fn pcglns_groups(
             ));
         }
         seen_group[g] = true;
-        for &v in &nums[1..] {
-            if v < 1 || v as usize > dim {
-                return Err(Error::parse(
-                    file,
-                    ln,
-                    format!("node {v} out of range 1..{dim}"),
-                ));
-            }
-            let v = v as usize - 1;
-            if group_of[v] != usize::MAX {
-                return Err(Error::parse(
-                    file,
-                    ln,
-                    format!("node {} is in two groups", v + 1),
-                ));
-            }
-            group_of[v] = g;
-            groups[g].push(v);
-        }
+        add_to_group(file, ln, g, &nums[1..], &mut group_of, &mut groups)?;
     }
-    if let Some(g) = groups.iter().position(|g| g.is_empty()) {
-        return Err(Error::invalid(
-            file,
-            format!("group {} has no nodes", g + 1),
-        ));
-    }
-    if let Some(v) = group_of.iter().position(|&g| g == usize::MAX) {
-        return Err(Error::invalid(
-            file,
-            format!("node {} belongs to no group", v + 1),
-        ));
-    }
+    groups_complete(file, &groups, &group_of)?;
     Ok((group_of, groups))
 }
 
@@ -599,6 +570,56 @@ fn pcglns_start(file: &str, lines: Vec<(usize, &str)>, groups: &[Vec<usize>]) ->
         ));
     }
     Ok(start)
+}
+
+/// Puts the 1-based `nodes` of one NODE_GROUP_SECTION line into group `g` (0-based), refusing
+/// a node out of range or already in a group.
+pub(crate) fn add_to_group(
+    file: &str,
+    ln: usize,
+    g: usize,
+    nodes: &[i64],
+    group_of: &mut [usize],
+    groups: &mut [Vec<usize>],
+) -> Result<()> {
+    let dim = group_of.len();
+    for &v in nodes {
+        if v < 1 || v as usize > dim {
+            return Err(Error::parse(
+                file,
+                ln,
+                format!("node {v} out of range 1..{dim}"),
+            ));
+        }
+        let v = v as usize - 1;
+        if group_of[v] != usize::MAX {
+            return Err(Error::parse(
+                file,
+                ln,
+                format!("node {} is in two groups", v + 1),
+            ));
+        }
+        group_of[v] = g;
+        groups[g].push(v);
+    }
+    Ok(())
+}
+
+/// Refuses a group without nodes and a node in no group (`usize::MAX` in `group_of`).
+pub(crate) fn groups_complete(file: &str, groups: &[Vec<usize>], group_of: &[usize]) -> Result<()> {
+    if let Some(g) = groups.iter().position(|g| g.is_empty()) {
+        return Err(Error::invalid(
+            file,
+            format!("group {} has no nodes", g + 1),
+        ));
+    }
+    if let Some(v) = group_of.iter().position(|&g| g == usize::MAX) {
+        return Err(Error::invalid(
+            file,
+            format!("node {} belongs to no group", v + 1),
+        ));
+    }
+    Ok(())
 }
 
 /// Parses "a b c ... -1" into the numbers before the terminating -1.
