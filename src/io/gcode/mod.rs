@@ -195,14 +195,14 @@ pub fn group_instance(
 fn with_leads(l: &Layout, cells: &[usize], margin: f64) -> (Vec<(usize, usize)>, bool) {
     let (mut edges, mut dropped) = cells::precedence(l, cells, margin);
     let mut extra = Vec::new();
+    // a group is one run, so it has at most one leading and one trailing cell: O(n) edges
+    let others = |i: usize| (0..cells.len()).filter(move |&j| j != i);
     for (i, &c) in cells.iter().enumerate() {
-        for j in 0..cells.len() {
-            if j != i && l.cells[c].lead {
-                extra.push((i, j));
-            }
-            if j != i && l.cells[c].trail {
-                extra.push((j, i));
-            }
+        if l.cells[c].lead {
+            extra.extend(others(i).map(|j| (i, j)));
+        }
+        if l.cells[c].trail {
+            extra.extend(others(i).map(|j| (j, i)));
         }
     }
     if extra.is_empty() {
