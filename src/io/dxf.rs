@@ -304,8 +304,10 @@ fn spline_points(s: &dxf::entities::Spline, tol: f64) -> Option<Vec<[f64; 2]>> {
     if t1.is_nan() || t0.is_nan() || t1 <= t0 {
         return None;
     }
-    let eval = |t: f64| -> [f64; 2] {
-        let mut span = p;
+    // samples come in increasing t, so the knot span only moves forward: it is carried over
+    // from the previous sample (the same span a scan from the start finds, in O(1) amortized)
+    let mut span = p;
+    let mut eval = |t: f64| -> [f64; 2] {
         while span + 1 < cps.len() && k[span + 1] <= t {
             span += 1;
         }
