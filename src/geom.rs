@@ -1,4 +1,7 @@
-//! Small 3-D point type used by every geometric part of the model.
+//! Small 3-D point type used by every geometric part of the model, and planar queries
+//! ([`polygon`]).
+
+pub mod polygon;
 
 use serde::{Deserialize, Serialize};
 

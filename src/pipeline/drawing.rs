@@ -9,10 +9,13 @@
 use super::{Allowance, solve_group};
 use crate::error::{Error, Result};
 use crate::geom::Point3;
-use crate::io::drawing::{Drawing, PenUp, Stroke, dist, pen_up};
+use crate::geom::polygon::PolygonIndex;
+use crate::io::drawing::{Drawing, PenUp, Stroke, pen_up};
 use crate::io::dxf::{self, Post};
 use crate::io::svg;
 use crate::model::{Cell, Instance, Machine, Metadata, Mode, Objective, StepKind, Tool, Visit};
+use rstar::RTree;
+use rstar::primitives::{GeomWithData, Rectangle};
 
 /// The registry solver drawings get by default ([`crate::solvers::drawing`]).
 pub const DRAWING_SOLVER: &str = "drawing";
@@ -118,38 +121,11 @@ fn bbox(s: &Stroke) -> [f64; 4] {
     b
 }
 
-fn seg_dist(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
-    let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
-    let l2 = dx * dx + dy * dy;
-    let t = if l2 > 0.0 {
-        (((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / l2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    dist(p, [a[0] + t * dx, a[1] + t * dy])
-}
-
-/// Point in polygon (even-odd) or within `tol` of its boundary.
-fn inside(p: [f64; 2], poly: &[[f64; 2]], tol: f64) -> bool {
-    let n = poly.len();
-    let mut c = false;
-    for i in 0..n {
-        let (a, b) = (poly[i], poly[(i + 1) % n]);
-        if seg_dist(p, a, b) <= tol {
-            return true;
-        }
-        if (a[1] > p[1]) != (b[1] > p[1]) {
-            let x = a[0] + (p[1] - a[1]) / (b[1] - a[1]) * (b[0] - a[0]);
-            if p[0] < x {
-                c = !c;
-            }
-        }
-    }
-    c
-}
-
 /// Cut-mode precedence within a scope (local indices): a stroke whose points all lie inside a
-/// closed stroke with a larger bounding box (with tolerance) comes before it.
+/// closed stroke with a larger bounding box (with tolerance) comes before it. Candidate pairs
+/// come from an R-tree of the closed strokes' boxes (those holding the inner stroke's first
+/// point), and each closed stroke is indexed once for its point tests
+/// ([`PolygonIndex`]), so neither many strokes nor long ones cost a product of sizes.
 pub fn containment(d: &Drawing, scope: &[usize], tol: f64) -> Vec<(usize, usize)> {
     let boxes: Vec<[f64; 4]> = scope.iter().map(|&i| bbox(&d.strokes[i])).collect();
     let area = |b: &[f64; 4]| (b[2] - b[0]).max(0.0) * (b[3] - b[1]).max(0.0);
@@ -157,14 +133,43 @@ pub fn containment(d: &Drawing, scope: &[usize], tol: f64) -> Vec<(usize, usize)
         .filter(|&k| d.strokes[scope[k]].closed && d.strokes[scope[k]].points.len() >= 3)
         .collect();
     outers.sort_by(|&a, &b| area(&boxes[a]).total_cmp(&area(&boxes[b])));
+    // rank[b]: position of b in `outers`, the order its edges are listed in
+    let mut rank = vec![usize::MAX; scope.len()];
+    for (r, &b) in outers.iter().enumerate() {
+        rank[b] = r;
+    }
+    let tree = RTree::bulk_load(
+        outers
+            .iter()
+            .map(|&b| {
+                let bb = boxes[b];
+                GeomWithData::new(
+                    Rectangle::from_corners([bb[0] - tol, bb[1] - tol], [bb[2] + tol, bb[3] + tol]),
+                    b,
+                )
+            })
+            .collect(),
+    );
+    let mut index: Vec<Option<PolygonIndex>> = vec![None; scope.len()];
     let mut edges = Vec::new();
+    let mut candidates = Vec::new();
     for a in 0..scope.len() {
         let ba = boxes[a];
         let aa = area(&ba);
         let sa = &d.strokes[scope[a]];
-        for &b in &outers {
+        let Some(&first) = sa.points.first() else {
+            continue;
+        };
+        candidates.clear();
+        candidates.extend(
+            tree.locate_all_at_point(first)
+                .map(|r| r.data)
+                .filter(|&b| b != a),
+        );
+        candidates.sort_unstable_by_key(|&b| rank[b]);
+        for &b in &candidates {
             let bb = boxes[b];
-            if b == a || area(&bb) <= aa + tol * tol {
+            if area(&bb) <= aa + tol * tol {
                 continue;
             }
             if ba[0] < bb[0] - tol
@@ -174,8 +179,9 @@ pub fn containment(d: &Drawing, scope: &[usize], tol: f64) -> Vec<(usize, usize)
             {
                 continue;
             }
-            let poly = &d.strokes[scope[b]].points;
-            if sa.points.iter().all(|&p| inside(p, poly, tol)) {
+            let poly =
+                index[b].get_or_insert_with(|| PolygonIndex::new(&d.strokes[scope[b]].points, tol));
+            if sa.points.iter().all(|&p| poly.contains(p)) {
                 edges.push((a, b));
             }
         }
