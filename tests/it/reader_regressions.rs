@@ -90,3 +90,38 @@ fn sane_rejections_stay_clean() {
         "ngc",
     );
 }
+
+/// A stand-in for issue 26's "2-entity temple drawing" (25.6 s; the file itself was never
+/// published): one closed polyline of 100 000 vertices around one cubic spline of 20 000
+/// control points. Flattening the spline rescanned its knots from the start for every sample,
+/// and the containment test visited every polygon edge for every point: 131 s for
+/// `-o x.ngc` before, about 2 s after. The CPU cap (30 s) is the test.
+#[test]
+fn dxf_of_two_long_entities_reads_and_sequences_within_the_cpu_cap() {
+    let mut e = String::from("  0\nLWPOLYLINE\n  8\n0\n 90\n100000\n 70\n1\n");
+    for k in 0..100_000 {
+        let a = k as f64 * std::f64::consts::TAU / 100_000.0;
+        let r = 100.0 + 5.0 * (41.0 * a).sin();
+        e += &format!(" 10\n{:.4}\n 20\n{:.4}\n", r * a.cos(), r * a.sin());
+    }
+    let m = 20_000usize;
+    e += &format!(
+        "  0\nSPLINE\n  8\n0\n 70\n8\n 71\n3\n 72\n{}\n 73\n{m}\n",
+        m + 4
+    );
+    e.extend((0..m + 4).map(|k| format!(" 40\n{}\n", k.saturating_sub(3).min(m - 3))));
+    e.extend((0..m).map(|k| {
+        let a = k as f64 * std::f64::consts::TAU / m as f64;
+        format!(
+            " 10\n{:.4}\n 20\n{:.4}\n 30\n0\n",
+            50.0 * (2.0 * a).cos(),
+            50.0 * (3.0 * a).sin()
+        )
+    }));
+    let d = tempfile::tempdir().unwrap();
+    let input = d.path().join("two.dxf");
+    std::fs::write(&input, dxf(&e)).unwrap();
+    let out = limited(&input, &d.path().join("out.ngc"));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(0), "exit {:?}: {err}", out.status);
+}
