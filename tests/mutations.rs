@@ -408,13 +408,19 @@ fn text(d: &[u8]) -> std::borrow::Cow<'_, str> {
     String::from_utf8_lossy(d)
 }
 
-/// Parses, validates and, when valid, solves: validation must leave nothing a solver fails on.
+/// Parses, validates and, when valid, solves: a refusal names the file, and validation must
+/// leave nothing a solver fails on.
 fn instance_case(file: &str, d: &[u8], format: Format) {
-    let Ok(inst) = formats::parse_instance(file, &text(d), format) else {
-        return;
+    let refused = |e: cellseq::Error| {
+        let m = e.to_string();
+        assert!(m.contains(file), "the error does not name the file: {m}");
     };
-    if cellseq::validate::validate(&inst, file).is_err() {
-        return;
+    let inst = match formats::parse_instance(file, &text(d), format) {
+        Ok(inst) => inst,
+        Err(e) => return refused(e),
+    };
+    if let Err(e) = cellseq::validate::validate(&inst, file) {
+        return refused(e);
     }
     solve_all(&inst);
 }
@@ -452,6 +458,13 @@ fn pcglns_reader_survives_mutations() {
     let s = seeds(&["instances/pcgtsplib", "fuzz/seeds"], &[".pcglns"]);
     let s: Vec<_> = s.into_iter().filter(|(_, b)| b.len() <= 20_000).collect();
     run("pcglns", &s, &|f, d| instance_case(f, d, Format::Pcglns));
+}
+
+#[test]
+fn pcgtsp_reader_survives_mutations() {
+    // both real files (the larger is 51 kB): the only PCGTSP seeds there are
+    let s = seeds(&["tests/fixtures/pcgtsp", "fuzz/seeds"], &[".pcgtsp"]);
+    run("pcgtsp", &s, &|f, d| instance_case(f, d, Format::Pcgtsp));
 }
 
 #[test]

@@ -1,6 +1,7 @@
 //! The PCGTSP reader on real PCGTSPLIB files (`tests/fixtures/pcgtsp/`, see SOURCES.md):
 //! dispatch by extension and by `TYPE:`, agreement with the integer PCGLNS version of the same
-//! instance, solving, and mutated copies that must give an error, never a panic.
+//! instance, and solving. Mutated copies (an error naming the file, never a panic) are run by
+//! `tests/mutations.rs` `pcgtsp_reader_survives_mutations` with the other readers.
 
 use cellseq::formats::{self, Format};
 use cellseq::model::Objective;
@@ -67,63 +68,5 @@ fn solvers_solve_it_and_the_checker_agrees() {
         let rep = cellseq::check(&inst, &r.outcome.sequence, Objective::Matrix).unwrap();
         assert!((rep.cost - r.outcome.cost).abs() < 1e-6 * rep.cost.max(1.0));
         assert!(rep.cost > 0.0);
-    }
-}
-
-/// Seeded mutations (truncation, byte changes, deleted and repeated lines): the reader and
-/// the validator return, with an error naming the file when they refuse.
-#[test]
-fn mutated_files_are_refused_cleanly() {
-    let orig = std::fs::read(fixture("ESC07.pcgtsp")).unwrap();
-    let mut state = 0x9e37_79b9_7f4a_7c15u64;
-    let mut next = move || {
-        state ^= state << 13;
-        state ^= state >> 7;
-        state ^= state << 17;
-        state
-    };
-    let subs: &[&[u8]] = &[
-        b"-1",
-        b"-2",
-        b"1e400",
-        b"NaN",
-        b" ",
-        b"\n",
-        b"x",
-        b"99999999",
-        b"0",
-    ];
-    for case in 0..400 {
-        let mut d = orig.clone();
-        match case % 4 {
-            0 => d.truncate(next() as usize % d.len()),
-            1 => {
-                let at = next() as usize % d.len();
-                let s = subs[next() as usize % subs.len()];
-                let end = (at + 1 + next() as usize % 4).min(d.len());
-                d.splice(at..end, s.iter().copied());
-            }
-            2 => {
-                let text = String::from_utf8_lossy(&d).to_string();
-                let mut lines: Vec<&str> = text.lines().collect();
-                let k = next() as usize % lines.len();
-                lines.remove(k);
-                d = lines.join("\n").into_bytes();
-            }
-            _ => {
-                let text = String::from_utf8_lossy(&d).to_string();
-                let mut lines: Vec<&str> = text.lines().collect();
-                let k = next() as usize % lines.len();
-                lines.insert(k, lines[k]);
-                d = lines.join("\n").into_bytes();
-            }
-        }
-        let text = String::from_utf8_lossy(&d);
-        match formats::parse_instance("m.pcgtsp", &text, Format::Pcgtsp) {
-            Ok(inst) => {
-                let _ = cellseq::validate::validate(&inst, "m.pcgtsp");
-            }
-            Err(e) => assert!(e.to_string().contains("m.pcgtsp"), "{e}"),
-        }
     }
 }
