@@ -35,7 +35,9 @@ pub struct SolveArgs {
     /// Random seed.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
-    /// Wall-clock limit in seconds.
+    /// Wall-clock limit of the solver in seconds. Reading the file and the lower bound after
+    /// the solve are not counted, so solvers are compared at equal search time (`optimize`'s
+    /// limit, by contrast, covers its whole command).
     #[arg(long, value_name = "SECONDS")]
     pub time_limit: Option<f64>,
     /// Evaluation budget (deterministic runs): an integer, `200_000_000` or `2e8`.
