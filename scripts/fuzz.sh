@@ -13,7 +13,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 secs=${1:-120}
 shift || true
-all=(sop pcglns json_instance json_solution gcode svg dxf plan)
+all=(sop pcglns pcgtsp json_instance json_solution gcode svg dxf plan)
 targets=("$@")
 [ ${#targets[@]} -eq 0 ] && targets=("${all[@]}")
 parallel=${FUZZ_PARALLEL:-1}
@@ -30,6 +30,7 @@ seed() {
 }
 seed sop "instances/tsplib-sop fuzz/seeds" '\.sop$'
 seed pcglns "instances/pcgtsplib fuzz/seeds" '\.pcglns$'
+seed pcgtsp "tests/fixtures/pcgtsp fuzz/seeds" '\.pcgtsp$'
 seed json_instance "instances/generated fuzz/seeds/json" '\.json$'
 seed json_solution "results/reference fuzz/seeds/solution" '\.json$'
 seed gcode "tests/fixtures fuzz/seeds" '\.(ngc|nc|gcode|gco|tap)$'
