@@ -4,13 +4,18 @@
 
 use serde::Serialize;
 
-/// An Inkscape layer (index 0 is the document root, outside any layer).
+/// A layer: an Inkscape layer, or (SVG) any other group that is a child of the root, which is
+/// how plotter tools such as vpype read a file's layers. Index 0 is the document root, outside
+/// any group.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Layer {
     /// `inkscape:label` (or id).
     pub label: String,
     /// Element id.
     pub id: Option<String>,
+    /// Written as an Inkscape layer (`inkscape:groupmode="layer"`); otherwise as a plain group
+    /// with its id, as the original has it.
+    pub inkscape: bool,
 }
 
 /// Stroke style kept on output.

@@ -187,10 +187,12 @@ pub fn read(file: &str, bytes: &[u8], opts: ReadOptions) -> Result<Drawing> {
         layers: std::iter::once(Layer {
             label: String::new(),
             id: None,
+            inkscape: false,
         })
         .chain(layers.iter().map(|l| Layer {
             label: l.clone(),
             id: None,
+            inkscape: true,
         }))
         .collect(),
         styles: vec![Style {

@@ -43,4 +43,5 @@ mod rs274;
 mod safe_writes;
 mod safety_outputs;
 mod svg;
+mod svg_layers;
 mod two_level;
