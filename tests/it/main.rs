@@ -21,6 +21,7 @@ mod conformance;
 mod core;
 mod docs_solvers;
 mod dxf;
+mod dxf_arcs;
 mod edge;
 mod engine_props;
 mod figure_fonts;

@@ -141,6 +141,7 @@ pub fn read(file: &str, text: &str, opts: ReadOptions) -> Result<Drawing> {
             flip_y: false,
             kept: Vec::new(),
             namespaces,
+            arcs: Default::default(),
         },
     };
     let inh = Inherit {
