@@ -394,6 +394,132 @@ fn spline_points(s: &dxf::entities::Spline, tol: f64) -> Option<Vec<[f64; 2]>> {
     Some(pts)
 }
 
+/// Where an entity's points go: its transform (inserts), its layer and its handle (for
+/// messages).
+struct Source<'a> {
+    tf: Affine,
+    layer: &'a str,
+    handle: &'a str,
+}
+
+/// Adds one piece of an entity (its own coordinates) in page coordinates, with the chords
+/// that lie on arcs (`runs`) recorded when the transform keeps circles circles.
+fn add_piece(
+    ctx: &mut Ctx,
+    src: &Source,
+    pts: Vec<[f64; 2]>,
+    closed: bool,
+    runs: &[Run],
+) -> Result<()> {
+    if pts.is_empty() {
+        // a polyline without vertices draws nothing
+        return Ok(());
+    }
+    ctx.points += pts.len();
+    if ctx.points > MAX_POINTS {
+        return Err(Error::invalid(
+            ctx.file,
+            format!(
+                "the drawing expands to more than {MAX_POINTS} points (entity {})",
+                src.handle
+            ),
+        ));
+    }
+    let li = layer_index(ctx, src.layer);
+    let tf = src.tf;
+    let pts: Vec<[f64; 2]> = pts
+        .into_iter()
+        .map(|p| {
+            let q = tf * kurbo::Point::new(p[0], p[1]);
+            [q.x, q.y]
+        })
+        .collect();
+    if !pts.iter().flatten().all(|v| v.is_finite()) {
+        return Err(Error::invalid(
+            ctx.file,
+            format!("entity {}: non-finite coordinate", src.handle),
+        ));
+    }
+    if let Some((scale, mirror)) = similarity(tf) {
+        let n = pts.len();
+        for r in runs {
+            let c = tf * kurbo::Point::new(r.center[0], r.center[1]);
+            let arc = ArcOf {
+                center: [c.x, c.y],
+                radius: r.radius * scale,
+                ccw: r.ccw != mirror,
+            };
+            for k in r.first..r.first + r.count {
+                ctx.arcs.push((pts[k % n], pts[(k + 1) % n], arc));
+            }
+        }
+    }
+    ctx.pieces.push(Piece {
+        layer: li,
+        pts,
+        closed,
+    });
+    Ok(())
+}
+
+/// A CIRCLE's points (closed) and its one run of arc chords.
+fn circle(c: &dxf::entities::Circle, tol: f64) -> (Vec<[f64; 2]>, Run) {
+    let center = [c.center.x, c.center.y];
+    let mut p = arc_points(center, c.radius, 0.0, 2.0 * std::f64::consts::PI, tol);
+    p.pop();
+    let run = Run {
+        first: 0,
+        count: p.len(),
+        center,
+        radius: c.radius,
+        ccw: true,
+    };
+    (p, run)
+}
+
+/// An ARC's points (open, counter-clockwise) and its one run of arc chords.
+fn arc(a: &dxf::entities::Arc, tol: f64) -> (Vec<[f64; 2]>, Run) {
+    let deg = std::f64::consts::PI / 180.0;
+    let s = a.start_angle * deg;
+    let t = s + sweep_of(s, a.end_angle * deg);
+    let center = [a.center.x, a.center.y];
+    let p = arc_points(center, a.radius, s, t - s, tol);
+    let run = Run {
+        first: 0,
+        count: p.len() - 1,
+        center,
+        radius: a.radius,
+        ccw: true,
+    };
+    (p, run)
+}
+
+/// An ELLIPSE's points (flattened) and whether it is closed (a full turn).
+fn ellipse(el: &dxf::entities::Ellipse, tol: f64) -> (Vec<[f64; 2]>, bool) {
+    let (mx, my) = (el.major_axis.x, el.major_axis.y);
+    let r = (mx * mx + my * my).sqrt();
+    let rot = my.atan2(mx);
+    let s = el.start_parameter;
+    let t = s + sweep_of(s, el.end_parameter);
+    let full = (t - s - 2.0 * std::f64::consts::PI).abs() < 1e-9;
+    let unit = arc_points([0.0, 0.0], 1.0, s, t - s, tol / r.max(1e-9));
+    let m = Affine::translate((el.center.x, el.center.y))
+        * Affine::rotate(rot)
+        * Affine::scale_non_uniform(r, r * el.minor_axis_ratio);
+    let mut p: Vec<[f64; 2]> = unit
+        .into_iter()
+        .map(|q| {
+            let q = m * kurbo::Point::new(q[0], q[1]);
+            [q.x, q.y]
+        })
+        .collect();
+    if full {
+        p.pop();
+    }
+    (p, full)
+}
+
+/// Reads one entity (a block's entities through [`insert`]) into pieces.
 fn entity(
     ctx: &mut Ctx,
     e: &dxf::entities::Entity,
@@ -407,112 +533,34 @@ fn entity(
     };
     let tol = ctx.opts.tolerance;
     let handle = format!("{:X}", e.common.handle.0);
-    let add = |ctx: &mut Ctx, pts: Vec<[f64; 2]>, closed: bool, runs: &[Run]| -> Result<()> {
-        if pts.is_empty() {
-            // a polyline without vertices draws nothing
-            return Ok(());
-        }
-        ctx.points += pts.len();
-        if ctx.points > MAX_POINTS {
-            return Err(Error::invalid(
-                ctx.file,
-                format!("the drawing expands to more than {MAX_POINTS} points (entity {handle})"),
-            ));
-        }
-        let li = layer_index(ctx, &layer_name);
-        let pts: Vec<[f64; 2]> = pts
-            .into_iter()
-            .map(|p| {
-                let q = tf * kurbo::Point::new(p[0], p[1]);
-                [q.x, q.y]
-            })
-            .collect();
-        if !pts.iter().flatten().all(|v| v.is_finite()) {
-            return Err(Error::invalid(
-                ctx.file,
-                format!("entity {handle}: non-finite coordinate"),
-            ));
-        }
-        if let Some((scale, mirror)) = similarity(tf) {
-            let n = pts.len();
-            for r in runs {
-                let c = tf * kurbo::Point::new(r.center[0], r.center[1]);
-                let arc = ArcOf {
-                    center: [c.x, c.y],
-                    radius: r.radius * scale,
-                    ccw: r.ccw != mirror,
-                };
-                for k in r.first..r.first + r.count {
-                    ctx.arcs.push((pts[k % n], pts[(k + 1) % n], arc));
-                }
-            }
-        }
-        ctx.pieces.push(Piece {
-            layer: li,
-            pts,
-            closed,
-        });
-        Ok(())
+    let src = Source {
+        tf,
+        layer: &layer_name,
+        handle: &handle,
     };
-    let deg = std::f64::consts::PI / 180.0;
     match &e.specific {
-        EntityType::Line(l) => add(ctx, vec![[l.p1.x, l.p1.y], [l.p2.x, l.p2.y]], false, &[])?,
+        EntityType::Line(l) => {
+            let p = vec![[l.p1.x, l.p1.y], [l.p2.x, l.p2.y]];
+            add_piece(ctx, &src, p, false, &[])
+        }
         EntityType::Circle(c) => {
-            let center = [c.center.x, c.center.y];
-            let mut p = arc_points(center, c.radius, 0.0, 2.0 * std::f64::consts::PI, tol);
-            p.pop();
-            let run = Run {
-                first: 0,
-                count: p.len(),
-                center,
-                radius: c.radius,
-                ccw: true,
-            };
-            add(ctx, p, true, &[run])?
+            let (p, run) = circle(c, tol);
+            add_piece(ctx, &src, p, true, &[run])
         }
         EntityType::Arc(a) => {
-            let s = a.start_angle * deg;
-            let t = s + sweep_of(s, a.end_angle * deg);
-            let center = [a.center.x, a.center.y];
-            let p = arc_points(center, a.radius, s, t - s, tol);
-            let run = Run {
-                first: 0,
-                count: p.len() - 1,
-                center,
-                radius: a.radius,
-                ccw: true,
-            };
-            add(ctx, p, false, &[run])?
+            let (p, run) = arc(a, tol);
+            add_piece(ctx, &src, p, false, &[run])
         }
         EntityType::Ellipse(el) => {
-            let (mx, my) = (el.major_axis.x, el.major_axis.y);
-            let r = (mx * mx + my * my).sqrt();
-            let rot = my.atan2(mx);
-            let s = el.start_parameter;
-            let t = s + sweep_of(s, el.end_parameter);
-            let full = (t - s - 2.0 * std::f64::consts::PI).abs() < 1e-9;
-            let unit = arc_points([0.0, 0.0], 1.0, s, t - s, tol / r.max(1e-9));
-            let m = Affine::translate((el.center.x, el.center.y))
-                * Affine::rotate(rot)
-                * Affine::scale_non_uniform(r, r * el.minor_axis_ratio);
-            let mut p: Vec<[f64; 2]> = unit
-                .into_iter()
-                .map(|q| {
-                    let q = m * kurbo::Point::new(q[0], q[1]);
-                    [q.x, q.y]
-                })
-                .collect();
-            if full {
-                p.pop();
-            }
-            add(ctx, p, full, &[])?
+            let (p, full) = ellipse(el, tol);
+            add_piece(ctx, &src, p, full, &[])
         }
         EntityType::LwPolyline(pl) => {
             let v: Vec<([f64; 2], f64)> =
                 pl.vertices.iter().map(|v| ([v.x, v.y], v.bulge)).collect();
             let closed = pl.is_closed();
             let (p, runs) = bulged(&v, closed, tol);
-            add(ctx, p, closed, &runs)?
+            add_piece(ctx, &src, p, closed, &runs)
         }
         EntityType::Polyline(pl) => {
             let v: Vec<([f64; 2], f64)> = pl
@@ -521,72 +569,74 @@ fn entity(
                 .collect();
             let closed = pl.is_closed();
             let (p, runs) = bulged(&v, closed, tol);
-            add(ctx, p, closed, &runs)?
+            add_piece(ctx, &src, p, closed, &runs)
         }
         EntityType::Spline(s) => match spline_points(s, tol) {
-            Some(p) => {
-                let closed = s.is_closed();
-                add(ctx, p, closed, &[])?
-            }
-            None => {
-                return unsupported(
-                    ctx,
-                    &handle,
-                    "SPLINE with inconsistent knots/control points",
-                );
-            }
-        },
-        EntityType::Insert(ins) => {
-            if depth > 16 {
-                return Err(Error::invalid(
-                    ctx.file,
-                    format!("INSERT (handle {handle}): blocks nested deeper than 16 (recursive?)"),
-                ));
-            }
-            let Some(b) = ctx.blocks.get(&ins.name).copied() else {
-                return Err(Error::invalid(
-                    ctx.file,
-                    format!("INSERT (handle {handle}): unknown block '{}'", ins.name),
-                ));
-            };
-            let (cols, rows) = (
-                ins.column_count.max(1) as usize,
-                ins.row_count.max(1) as usize,
-            );
-            if cols * rows > 100_000 {
-                return Err(Error::invalid(
-                    ctx.file,
-                    format!("INSERT (handle {handle}): array too large"),
-                ));
-            }
-            let bl = if layer_name == "0" {
-                block_layer.map(str::to_string)
-            } else {
-                Some(layer_name.clone())
-            };
-            for r in 0..rows {
-                for c in 0..cols {
-                    let t = tf
-                        * Affine::translate((ins.location.x, ins.location.y))
-                        * Affine::rotate(ins.rotation * deg)
-                        * Affine::translate((
-                            c as f64 * ins.column_spacing,
-                            r as f64 * ins.row_spacing,
-                        ))
-                        * Affine::scale_non_uniform(ins.x_scale_factor, ins.y_scale_factor)
-                        * Affine::translate((-b.base_point.x, -b.base_point.y));
-                    for be in &b.entities {
-                        entity(ctx, be, t, bl.as_deref(), depth + 1)?;
-                    }
-                }
-            }
-        }
-        other => {
-            return unsupported(
+            Some(p) => add_piece(ctx, &src, p, s.is_closed(), &[]),
+            None => unsupported(
                 ctx,
                 &handle,
-                &format!("{} is not supported", entity_name(other)),
-            );
+                "SPLINE with inconsistent knots/control points",
+            ),
+        },
+        EntityType::Insert(ins) => insert(ctx, ins, &src, block_layer, depth),
+        other => unsupported(
+            ctx,
+            &handle,
+            &format!("{} is not supported", entity_name(other)),
+        ),
+    }
+}
+
+/// An INSERT: the block's entities under the insert's transform, once per array cell, on the
+/// insert's layer where they are on layer 0.
+fn insert(
+    ctx: &mut Ctx,
+    ins: &dxf::entities::Insert,
+    src: &Source,
+    block_layer: Option<&str>,
+    depth: usize,
+) -> Result<()> {
+    let handle = src.handle;
+    if depth > 16 {
+        return Err(Error::invalid(
+            ctx.file,
+            format!("INSERT (handle {handle}): blocks nested deeper than 16 (recursive?)"),
+        ));
+    }
+    let Some(b) = ctx.blocks.get(&ins.name).copied() else {
+        return Err(Error::invalid(
+            ctx.file,
+            format!("INSERT (handle {handle}): unknown block '{}'", ins.name),
+        ));
+    };
+    let (cols, rows) = (
+        ins.column_count.max(1) as usize,
+        ins.row_count.max(1) as usize,
+    );
+    if cols * rows > 100_000 {
+        return Err(Error::invalid(
+            ctx.file,
+            format!("INSERT (handle {handle}): array too large"),
+        ));
+    }
+    let bl = if src.layer == "0" {
+        block_layer.map(str::to_string)
+    } else {
+        Some(src.layer.to_string())
+    };
+    let deg = std::f64::consts::PI / 180.0;
+    for r in 0..rows {
+        for c in 0..cols {
+            let t = src.tf
+                * Affine::translate((ins.location.x, ins.location.y))
+                * Affine::rotate(ins.rotation * deg)
+                * Affine::translate((c as f64 * ins.column_spacing, r as f64 * ins.row_spacing))
+                * Affine::scale_non_uniform(ins.x_scale_factor, ins.y_scale_factor)
+                * Affine::translate((-b.base_point.x, -b.base_point.y));
+            for be in &b.entities {
+                entity(ctx, be, t, bl.as_deref(), depth + 1)?;
+            }
         }
     }
     Ok(())
