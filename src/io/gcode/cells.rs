@@ -123,11 +123,7 @@ type CutRange = (usize, usize, bool);
 /// [`Split::Z`] a cut runs from the first feed (or plunging rapid) below the safe height to the
 /// motion back at or above it, a canned cycle is a cell of its own; under [`Split::Flat`] a
 /// cut is a run of feed moves up to the next rapid, tool change, program end or spindle stop.
-fn cut_ranges(
-    p: &Program,
-    split: Split,
-    safe: f64,
-) -> Result<Vec<CutRange>, (usize, String)> {
+fn cut_ranges(p: &Program, split: Split, safe: f64) -> Result<Vec<CutRange>, (usize, String)> {
     let n = p.lines.len();
     let mut ranges: Vec<CutRange> = Vec::new();
     let mut open: Option<usize> = None;
