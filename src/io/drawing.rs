@@ -3,14 +3,20 @@
 //! units, with millimetres per unit, plus the pen-up figures of a stroke order.
 
 use serde::Serialize;
+use std::collections::HashMap;
 
-/// An Inkscape layer (index 0 is the document root, outside any layer).
+/// A layer: an Inkscape layer, or (SVG) any other group that is a child of the root, which is
+/// how plotter tools such as vpype read a file's layers. Index 0 is the document root, outside
+/// any group.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Layer {
     /// `inkscape:label` (or id).
     pub label: String,
     /// Element id.
     pub id: Option<String>,
+    /// Written as an Inkscape layer (`inkscape:groupmode="layer"`); otherwise as a plain group
+    /// with its id, as the original has it.
+    pub inkscape: bool,
 }
 
 /// Stroke style kept on output.
@@ -141,6 +147,36 @@ pub struct Drawing {
     pub kept: Vec<Kept>,
     /// Namespace declarations of the root (prefix, URI) that kept elements may use.
     pub namespaces: Vec<(String, String)>,
+    /// The arcs that chords of the strokes lie on (DXF ARC, CIRCLE, bulges), by chord
+    /// ([`chord_key`]); `None` where two different arcs share a chord. A G-code post writes
+    /// runs of such chords as G2/G3 ([`Drawing::arc_of`]); everything else sees the chords.
+    pub arcs: HashMap<ChordKey, Option<ArcOf>>,
+}
+
+/// A chord's endpoints as [`round6`] holds them, the lower point first: bits of x, y, x, y.
+pub type ChordKey = [u64; 4];
+
+/// The arc a chord of a stroke lies on.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ArcOf {
+    /// Centre (user units).
+    pub center: [f64; 2],
+    /// Radius (user units).
+    pub radius: f64,
+    /// Counter-clockwise when drawn from the key's first point to its second (in
+    /// [`Drawing::arc_of`]: from `a` to `b`).
+    pub ccw: bool,
+}
+
+/// The key of the chord a–b and whether it is drawn from its second point to its first.
+pub fn chord_key(a: [f64; 2], b: [f64; 2]) -> (ChordKey, bool) {
+    let (a, b) = ([round6(a[0]), round6(a[1])], [round6(b[0]), round6(b[1])]);
+    let bits = |p: [f64; 2], q: [f64; 2]| [p[0], p[1], q[0], q[1]].map(f64::to_bits);
+    if (a[0], a[1]) <= (b[0], b[1]) {
+        (bits(a, b), false)
+    } else {
+        (bits(b, a), true)
+    }
 }
 
 /// An element that is not sequenced and is written back as it was.
@@ -156,6 +192,36 @@ pub struct Kept {
 }
 
 impl Drawing {
+    /// The arc under the chord drawn from `a` to `b` (its `ccw` for that direction), if the
+    /// chord lies on exactly one arc of the file.
+    pub fn arc_of(&self, a: [f64; 2], b: [f64; 2]) -> Option<ArcOf> {
+        let (k, swapped) = chord_key(a, b);
+        let arc = (*self.arcs.get(&k)?)?;
+        Some(ArcOf {
+            ccw: arc.ccw != swapped,
+            ..arc
+        })
+    }
+    /// Records that the chord drawn from `a` to `b` lies on `arc` (its `ccw` for that
+    /// direction); a chord claimed by two different arcs gets none.
+    pub fn add_arc(&mut self, a: [f64; 2], b: [f64; 2], arc: ArcOf) {
+        let (k, swapped) = chord_key(a, b);
+        if k[..2] == k[2..] {
+            return;
+        }
+        let arc = ArcOf {
+            ccw: arc.ccw != swapped,
+            ..arc
+        };
+        self.arcs
+            .entry(k)
+            .and_modify(|e| {
+                if *e != Some(arc) {
+                    *e = None;
+                }
+            })
+            .or_insert(Some(arc));
+    }
     /// The index of style `s`, added when new.
     pub fn style_index(&mut self, s: Style) -> usize {
         match self.styles.iter().position(|x| *x == s) {

@@ -116,27 +116,16 @@ fn ends_run(p: &Program, i: usize) -> bool {
 
 const EPS: f64 = 1e-6;
 
-/// Splits a program. Errors: `(line, message)`.
-pub fn split(p: &Program) -> Result<Layout, (usize, String)> {
-    // no rapid across at a known height (a single helix, a wave): nothing to lift between, the
-    // program is split like a 2-D one
-    let z_split = if p.has_z {
-        find_safe(p).unwrap_or(Split::Flat)
-    } else {
-        Split::Flat
-    };
-    let split = match z_split {
-        // every cut at or above the travel height (a pen or a silkscreen pass at Z0 with
-        // rapids at Z0): the Z rule would make each move a cell; cells are runs of feed moves
-        Split::Z { safe, .. } if !cuts_below(p, safe) => Split::Flat,
-        s => s,
-    };
-    let safe = match split {
-        Split::Z { safe, .. } => safe,
-        Split::Flat => f64::INFINITY,
-    };
+/// A cut's lines: start, end (exclusive), and whether it is a canned cycle.
+type CutRange = (usize, usize, bool);
+
+/// The line ranges `(start, end, canned cycle)` of the cuts, by the split's rule: under
+/// [`Split::Z`] a cut runs from the first feed (or plunging rapid) below the safe height to the
+/// motion back at or above it, a canned cycle is a cell of its own; under [`Split::Flat`] a
+/// cut is a run of feed moves up to the next rapid, tool change, program end or spindle stop.
+fn cut_ranges(p: &Program, split: Split, safe: f64) -> Result<Vec<CutRange>, (usize, String)> {
     let n = p.lines.len();
-    let mut ranges: Vec<(usize, usize, bool)> = Vec::new();
+    let mut ranges: Vec<CutRange> = Vec::new();
     let mut open: Option<usize> = None;
     for (i, li) in p.lines.iter().enumerate() {
         let zafter = li.pos_after[2];
@@ -206,6 +195,82 @@ pub fn split(p: &Program) -> Result<Layout, (usize, String)> {
         }
         ranges.push((s, e, false));
     }
+    Ok(ranges)
+}
+
+/// What the moves of a cell cover: the box of its cuts, their length, the deepest point, the
+/// XY polyline from `entry` (for closed contours) and whether every arc is in G17.
+struct Geometry {
+    bbox: [f64; 4],
+    cut_length: f64,
+    depth: f64,
+    pts: Vec<[f64; 2]>,
+    planar: bool,
+}
+
+fn geometry(p: &Program, s: usize, e: usize, entry: [f64; 3]) -> Geometry {
+    let mut bbox = [
+        f64::INFINITY,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        f64::NEG_INFINITY,
+    ];
+    let mut cut_length = 0.0;
+    let mut depth = f64::INFINITY;
+    let mut pts: Vec<[f64; 2]> = vec![[entry[0], entry[1]]];
+    let mut planar = true;
+    for li in &p.lines[s..e] {
+        if li.motion == Motion::Rapid
+            && let Some(t) = known(&li.pos_after)
+        {
+            pts.push([t[0], t[1]]);
+            depth = depth.min(t[2]);
+        }
+        for c in &li.cuts {
+            let b = c.bbox();
+            bbox = [
+                bbox[0].min(b[0]),
+                bbox[1].min(b[1]),
+                bbox[2].max(b[2]),
+                bbox[3].max(b[3]),
+            ];
+            cut_length += c.length();
+            depth = depth.min(c.to[2]).min(c.from[2]);
+            if matches!(c.kind, CutKind::Arc { plane, .. } if plane != 17) {
+                planar = false;
+            }
+            c.polyline(&mut pts);
+        }
+    }
+    Geometry {
+        bbox,
+        cut_length,
+        depth,
+        pts,
+        planar,
+    }
+}
+
+/// Splits a program. Errors: `(line, message)`.
+pub fn split(p: &Program) -> Result<Layout, (usize, String)> {
+    // no rapid across at a known height (a single helix, a wave): nothing to lift between, the
+    // program is split like a 2-D one
+    let z_split = if p.has_z {
+        find_safe(p).unwrap_or(Split::Flat)
+    } else {
+        Split::Flat
+    };
+    let split = match z_split {
+        // every cut at or above the travel height (a pen or a silkscreen pass at Z0 with
+        // rapids at Z0): the Z rule would make each move a cell; cells are runs of feed moves
+        Split::Z { safe, .. } if !cuts_below(p, safe) => Split::Flat,
+        s => s,
+    };
+    let safe = match split {
+        Split::Z { safe, .. } => safe,
+        Split::Flat => f64::INFINITY,
+    };
+    let mut ranges = cut_ranges(p, split, safe)?;
     ranges.retain(|r| r.1 > r.0);
     if ranges.is_empty() {
         return Err((0, "no cutting moves found".into()));
@@ -295,39 +360,13 @@ pub fn split(p: &Program) -> Result<Layout, (usize, String)> {
         {
             entry = [t[0], t[1], before[2]];
         }
-        let mut bbox = [
-            f64::INFINITY,
-            f64::INFINITY,
-            f64::NEG_INFINITY,
-            f64::NEG_INFINITY,
-        ];
-        let mut cut_length = 0.0;
-        let mut depth = f64::INFINITY;
-        let mut pts: Vec<[f64; 2]> = vec![[entry[0], entry[1]]];
-        let mut planar = true;
-        for li in &p.lines[s..e] {
-            if li.motion == Motion::Rapid
-                && let Some(t) = known(&li.pos_after)
-            {
-                pts.push([t[0], t[1]]);
-                depth = depth.min(t[2]);
-            }
-            for c in &li.cuts {
-                let b = c.bbox();
-                bbox = [
-                    bbox[0].min(b[0]),
-                    bbox[1].min(b[1]),
-                    bbox[2].max(b[2]),
-                    bbox[3].max(b[3]),
-                ];
-                cut_length += c.length();
-                depth = depth.min(c.to[2]).min(c.from[2]);
-                if matches!(c.kind, CutKind::Arc { plane, .. } if plane != 17) {
-                    planar = false;
-                }
-                c.polyline(&mut pts);
-            }
-        }
+        let Geometry {
+            mut bbox,
+            cut_length,
+            depth,
+            pts,
+            planar,
+        } = geometry(p, s, e, entry);
         if cycle {
             entry = p.lines[s].cuts[0].from;
         }

@@ -653,6 +653,16 @@ fn state_words(s: &super::interp::State, o: &super::interp::State) -> String {
     }
 }
 
+/// A word's value as an event key holds it: in millionths (truncated).
+fn micro(x: f64) -> i64 {
+    (x * 1e6) as i64
+}
+
+/// A line's words as an event key holds them: letter and value in millionths ([`micro`]).
+fn quantized(w: &crate::io::gcode::lex::Words) -> Vec<(char, i64)> {
+    w.words.iter().map(|&(c, x)| (c, micro(x))).collect()
+}
+
 /// The events of a line: `(exact, key)`; `exact` false for those the output may have fewer
 /// of (tool changes and moves to machine positions, dropped when tool blocks are merged).
 fn events(li: &LineInfo, text: &str) -> Vec<(bool, u128)> {
@@ -667,20 +677,10 @@ fn events(li: &LineInfo, text: &str) -> Vec<(bool, u128)> {
         v.push((false, hash128(&("tool", li.after.tool, t))));
     }
     if li.motion == Motion::Home {
-        let words: Vec<(char, i64)> = w
-            .words
-            .iter()
-            .map(|&(c, x)| (c, (x * 1e6) as i64))
-            .collect();
-        v.push((false, hash128(&("home", words, t))));
+        v.push((false, hash128(&("home", quantized(w), t))));
     }
     if li.setup {
-        let words: Vec<(char, i64)> = w
-            .words
-            .iter()
-            .map(|&(c, x)| (c, (x * 1e6) as i64))
-            .collect();
-        v.push((true, hash128(&("setup", words, t))));
+        v.push((true, hash128(&("setup", quantized(w), t))));
     }
     if li.dwell {
         v.push((
@@ -688,7 +688,7 @@ fn events(li: &LineInfo, text: &str) -> Vec<(bool, u128)> {
             // at its height (at the bottom of a hole, or where the spindle comes up to speed)
             hash128(&(
                 "dwell",
-                w.get('P').map(|x| (x * 1e6) as i64),
+                w.get('P').map(micro),
                 li.pos_before[2].map(|z| (z * 1e3).round() as i64),
                 t,
             )),

@@ -73,16 +73,10 @@ pub fn write(d: &Drawing, strokes: &[Stroke]) -> String {
     for k in &d.kept {
         kept_of[k.layer.min(d.layers.len() - 1)].push(&k.xml);
     }
-    let open_layer = |o: &mut String, layer: usize, kept_of: &mut Vec<Vec<&str>>| {
-        if layer == 0 {
-            o.push_str("<g>\n");
-        } else {
-            let _ = writeln!(
-                o,
-                "<g inkscape:groupmode=\"layer\" inkscape:label=\"{}\">",
-                esc(&d.layers[layer].label)
-            );
-        }
+    let mut opened = vec![false; d.layers.len()];
+    let mut open_layer = |o: &mut String, layer: usize, kept_of: &mut Vec<Vec<&str>>| {
+        open_group(o, &d.layers[layer], layer == 0, opened[layer]);
+        opened[layer] = true;
         for x in std::mem::take(&mut kept_of[layer]) {
             o.push_str(x);
             o.push('\n');
@@ -137,6 +131,31 @@ pub fn write(d: &Drawing, strokes: &[Stroke]) -> String {
     }
     o.push_str("</svg>\n");
     o
+}
+
+/// Opens the group of a layer as the original has it: an Inkscape layer with its label, a
+/// plain group with its id (the root's own elements in an unnamed group). The id is written
+/// only on the layer's first group, so ids stay unique when a layer's strokes are split
+/// (`--no-scopes`); a later group of a plain layer carries its name as `inkscape:label`, which
+/// the reader takes as the layer's label.
+fn open_group(o: &mut String, l: &Layer, root: bool, again: bool) {
+    let id = match (&l.id, again) {
+        (Some(id), false) => format!(" id=\"{}\"", esc(id)),
+        _ => String::new(),
+    };
+    if root {
+        o.push_str("<g>\n");
+    } else if l.inkscape {
+        let _ = writeln!(
+            o,
+            "<g inkscape:groupmode=\"layer\"{id} inkscape:label=\"{}\">",
+            esc(&l.label)
+        );
+    } else if l.label.is_empty() || (!id.is_empty() && l.id.as_deref() == Some(&l.label)) {
+        let _ = writeln!(o, "<g{id}>");
+    } else {
+        let _ = writeln!(o, "<g{id} inkscape:label=\"{}\">", esc(&l.label));
+    }
 }
 
 type SegKey = (u32, [u64; 4]);

@@ -132,6 +132,7 @@ pub fn read(file: &str, text: &str, opts: ReadOptions) -> Result<Drawing> {
             layers: vec![Layer {
                 label: String::new(),
                 id: None,
+                inkscape: false,
             }],
             styles: Vec::new(),
             strokes: Vec::new(),
@@ -140,6 +141,7 @@ pub fn read(file: &str, text: &str, opts: ReadOptions) -> Result<Drawing> {
             flip_y: false,
             kept: Vec::new(),
             namespaces,
+            arcs: Default::default(),
         },
     };
     let inh = Inherit {
@@ -332,7 +334,13 @@ fn visit(ctx: &mut Ctx, n: Node, inh: &Inherit) -> Result<Option<Inherit>> {
         }
         "g" | "a" => {
             let mut inh = presentation(ctx, n, inh)?;
-            if n.attribute((INKSCAPE_NS, "groupmode")) == Some("layer") {
+            // an Inkscape layer, or any group that is a child of the root (the layers
+            // plotter tools such as vpype read); the writer keeps them as they are
+            let inkscape = n.attribute((INKSCAPE_NS, "groupmode")) == Some("layer");
+            let top = n
+                .parent_element()
+                .is_some_and(|p| p.parent_element().is_none());
+            if inkscape || (name == "g" && top) {
                 let label = n
                     .attribute((INKSCAPE_NS, "label"))
                     .or(n.attribute("id"))
@@ -341,6 +349,7 @@ fn visit(ctx: &mut Ctx, n: Node, inh: &Inherit) -> Result<Option<Inherit>> {
                 ctx.out.layers.push(Layer {
                     label,
                     id: n.attribute("id").map(str::to_string),
+                    inkscape,
                 });
                 inh.layer = ctx.out.layers.len() - 1;
             }

@@ -2,16 +2,20 @@
 //! and POLYLINE (with bulges), SPLINE (flattened), INSERT (blocks, nested, with scale, rotation,
 //! arrays). Loose pieces are chained into contours per layer (endpoints within a tolerance are
 //! snapped together). The result is a [`crate::io::drawing::Drawing`] (one layer per DXF layer, y up), so
-//! sequencing, the SVG preview and verification are shared with SVG; [`write_gcode`] is a
-//! simple configurable post.
+//! sequencing, the SVG preview and verification are shared with SVG; [`write_gcode`] (in
+//! [`post`]) is a simple configurable post. The chords of ARC, CIRCLE and bulge arcs are
+//! recorded with their arc ([`crate::io::drawing::Drawing::arcs`]) so the post writes them as
+//! G2/G3.
 
 use crate::error::{Error, Result};
-use crate::io::drawing::{self as svg, Drawing, Layer, Stroke, Style};
-use crate::io::gcode::interp::{self, CutKind};
+use crate::io::drawing::{ArcOf, Drawing, Layer, Stroke, Style};
 use dxf::entities::EntityType;
 use kurbo::Affine;
 use std::collections::HashMap;
-use std::fmt::Write as _;
+
+pub mod post;
+
+pub use post::{Post, verify_gcode, write_gcode};
 
 /// Reader options.
 #[derive(Debug, Clone, Copy)]
@@ -101,6 +105,32 @@ struct Ctx<'a> {
     skipped: Vec<String>,
     /// Points produced so far (bounded: nested arrays of inserts can explode).
     points: usize,
+    /// Chords that lie on an arc: (from, to, the arc for that direction), page coordinates.
+    arcs: Vec<([f64; 2], [f64; 2], ArcOf)>,
+}
+
+/// Chords `first .. first + count` of a piece (chord k joins point k to point k + 1, the
+/// last wrapping to the first) lie on the circle (`center`, `radius`), counter-clockwise or
+/// not, in the entity's coordinates.
+#[derive(Debug, Clone, Copy)]
+struct Run {
+    first: usize,
+    count: usize,
+    center: [f64; 2],
+    radius: f64,
+    ccw: bool,
+}
+
+/// Scale and mirroring of a transform that maps circles to circles (rotation, uniform scale,
+/// translation, reflection); `None` for one that does not (arcs become ellipses: chords only).
+fn similarity(tf: Affine) -> Option<(f64, bool)> {
+    let [a, b, c, d, _, _] = tf.as_coeffs();
+    let det = a * d - b * c;
+    let s = det.abs().sqrt();
+    let eps = 1e-9 * s.max(1e-300);
+    let rotation = (a - d).abs() <= eps && (b + c).abs() <= eps;
+    let mirror = (a + d).abs() <= eps && (b - c).abs() <= eps;
+    (s > 0.0 && s.is_finite() && (rotation || mirror)).then_some((s, det < 0.0))
 }
 
 /// Most points a drawing may expand to (inserts and flattening included).
@@ -170,6 +200,7 @@ pub fn read(file: &str, bytes: &[u8], opts: ReadOptions) -> Result<Drawing> {
         pieces: Vec::new(),
         skipped: Vec::new(),
         points: 0,
+        arcs: Vec::new(),
     };
     for e in dwg.entities() {
         entity(&mut ctx, e, Affine::IDENTITY, None, 0)?;
@@ -178,6 +209,7 @@ pub fn read(file: &str, bytes: &[u8], opts: ReadOptions) -> Result<Drawing> {
         layers,
         pieces,
         skipped,
+        arcs,
         ..
     } = ctx;
     let mut d = Drawing {
@@ -187,10 +219,12 @@ pub fn read(file: &str, bytes: &[u8], opts: ReadOptions) -> Result<Drawing> {
         layers: std::iter::once(Layer {
             label: String::new(),
             id: None,
+            inkscape: false,
         })
         .chain(layers.iter().map(|l| Layer {
             label: l.clone(),
             id: None,
+            inkscape: true,
         }))
         .collect(),
         styles: vec![Style {
@@ -203,7 +237,11 @@ pub fn read(file: &str, bytes: &[u8], opts: ReadOptions) -> Result<Drawing> {
         flip_y: true,
         kept: Vec::new(),
         namespaces: Vec::new(),
+        arcs: Default::default(),
     };
+    for (a, b, arc) in arcs {
+        d.add_arc(a, b, arc);
+    }
     for (li, _) in layers.iter().enumerate() {
         let mine: Vec<&Piece> = pieces.iter().filter(|p| p.layer == li).collect();
         for s in chain(&mine, opts.join) {
@@ -248,9 +286,11 @@ fn arc_points(c: [f64; 2], r: f64, a0: f64, sweep: f64, tol: f64) -> Vec<[f64; 2
         .collect()
 }
 
-/// Points of a polyline with bulges (vertex i's bulge curves segment i → i+1).
-fn bulged(v: &[([f64; 2], f64)], closed: bool, tol: f64) -> Vec<[f64; 2]> {
+/// Points of a polyline with bulges (vertex i's bulge curves segment i → i+1), and the runs of
+/// chords that lie on the bulges' arcs.
+fn bulged(v: &[([f64; 2], f64)], closed: bool, tol: f64) -> (Vec<[f64; 2]>, Vec<Run>) {
     let mut out = Vec::new();
+    let mut runs = Vec::new();
     let n = v.len();
     let segs = if closed { n } else { n.saturating_sub(1) };
     if n > 0 {
@@ -275,12 +315,19 @@ fn bulged(v: &[([f64; 2], f64)], closed: bool, tol: f64) -> Vec<[f64; 2]> {
         let a0 = (p[1] - c[1]).atan2(p[0] - c[0]);
         let mut pts = arc_points(c, r, a0, theta, tol);
         *pts.last_mut().expect("arc has points") = q;
+        runs.push(Run {
+            first: out.len() - 1,
+            count: pts.len() - 1,
+            center: c,
+            radius: r,
+            ccw: theta > 0.0,
+        });
         out.extend(pts.into_iter().skip(1));
     }
     if closed && out.len() > 1 {
         out.pop(); // back at the start
     }
-    out
+    (out, runs)
 }
 
 /// De Boor evaluation of a (rational) B-spline, sampled finely enough for `tol`.
@@ -349,6 +396,132 @@ fn spline_points(s: &dxf::entities::Spline, tol: f64) -> Option<Vec<[f64; 2]>> {
     Some(pts)
 }
 
+/// Where an entity's points go: its transform (inserts), its layer and its handle (for
+/// messages).
+struct Source<'a> {
+    tf: Affine,
+    layer: &'a str,
+    handle: &'a str,
+}
+
+/// Adds one piece of an entity (its own coordinates) in page coordinates, with the chords
+/// that lie on arcs (`runs`) recorded when the transform keeps circles circles.
+fn add_piece(
+    ctx: &mut Ctx,
+    src: &Source,
+    pts: Vec<[f64; 2]>,
+    closed: bool,
+    runs: &[Run],
+) -> Result<()> {
+    if pts.is_empty() {
+        // a polyline without vertices draws nothing
+        return Ok(());
+    }
+    ctx.points += pts.len();
+    if ctx.points > MAX_POINTS {
+        return Err(Error::invalid(
+            ctx.file,
+            format!(
+                "the drawing expands to more than {MAX_POINTS} points (entity {})",
+                src.handle
+            ),
+        ));
+    }
+    let li = layer_index(ctx, src.layer);
+    let tf = src.tf;
+    let pts: Vec<[f64; 2]> = pts
+        .into_iter()
+        .map(|p| {
+            let q = tf * kurbo::Point::new(p[0], p[1]);
+            [q.x, q.y]
+        })
+        .collect();
+    if !pts.iter().flatten().all(|v| v.is_finite()) {
+        return Err(Error::invalid(
+            ctx.file,
+            format!("entity {}: non-finite coordinate", src.handle),
+        ));
+    }
+    if let Some((scale, mirror)) = similarity(tf) {
+        let n = pts.len();
+        for r in runs {
+            let c = tf * kurbo::Point::new(r.center[0], r.center[1]);
+            let arc = ArcOf {
+                center: [c.x, c.y],
+                radius: r.radius * scale,
+                ccw: r.ccw != mirror,
+            };
+            for k in r.first..r.first + r.count {
+                ctx.arcs.push((pts[k % n], pts[(k + 1) % n], arc));
+            }
+        }
+    }
+    ctx.pieces.push(Piece {
+        layer: li,
+        pts,
+        closed,
+    });
+    Ok(())
+}
+
+/// A CIRCLE's points (closed) and its one run of arc chords.
+fn circle(c: &dxf::entities::Circle, tol: f64) -> (Vec<[f64; 2]>, Run) {
+    let center = [c.center.x, c.center.y];
+    let mut p = arc_points(center, c.radius, 0.0, 2.0 * std::f64::consts::PI, tol);
+    p.pop();
+    let run = Run {
+        first: 0,
+        count: p.len(),
+        center,
+        radius: c.radius,
+        ccw: true,
+    };
+    (p, run)
+}
+
+/// An ARC's points (open, counter-clockwise) and its one run of arc chords.
+fn arc(a: &dxf::entities::Arc, tol: f64) -> (Vec<[f64; 2]>, Run) {
+    let deg = std::f64::consts::PI / 180.0;
+    let s = a.start_angle * deg;
+    let t = s + sweep_of(s, a.end_angle * deg);
+    let center = [a.center.x, a.center.y];
+    let p = arc_points(center, a.radius, s, t - s, tol);
+    let run = Run {
+        first: 0,
+        count: p.len() - 1,
+        center,
+        radius: a.radius,
+        ccw: true,
+    };
+    (p, run)
+}
+
+/// An ELLIPSE's points (flattened) and whether it is closed (a full turn).
+fn ellipse(el: &dxf::entities::Ellipse, tol: f64) -> (Vec<[f64; 2]>, bool) {
+    let (mx, my) = (el.major_axis.x, el.major_axis.y);
+    let r = (mx * mx + my * my).sqrt();
+    let rot = my.atan2(mx);
+    let s = el.start_parameter;
+    let t = s + sweep_of(s, el.end_parameter);
+    let full = (t - s - 2.0 * std::f64::consts::PI).abs() < 1e-9;
+    let unit = arc_points([0.0, 0.0], 1.0, s, t - s, tol / r.max(1e-9));
+    let m = Affine::translate((el.center.x, el.center.y))
+        * Affine::rotate(rot)
+        * Affine::scale_non_uniform(r, r * el.minor_axis_ratio);
+    let mut p: Vec<[f64; 2]> = unit
+        .into_iter()
+        .map(|q| {
+            let q = m * kurbo::Point::new(q[0], q[1]);
+            [q.x, q.y]
+        })
+        .collect();
+    if full {
+        p.pop();
+    }
+    (p, full)
+}
+
+/// Reads one entity (a block's entities through [`insert`]) into pieces.
 fn entity(
     ctx: &mut Ctx,
     e: &dxf::entities::Entity,
@@ -362,90 +535,34 @@ fn entity(
     };
     let tol = ctx.opts.tolerance;
     let handle = format!("{:X}", e.common.handle.0);
-    let add = |ctx: &mut Ctx, pts: Vec<[f64; 2]>, closed: bool| -> Result<()> {
-        if pts.is_empty() {
-            // a polyline without vertices draws nothing
-            return Ok(());
-        }
-        ctx.points += pts.len();
-        if ctx.points > MAX_POINTS {
-            return Err(Error::invalid(
-                ctx.file,
-                format!("the drawing expands to more than {MAX_POINTS} points (entity {handle})"),
-            ));
-        }
-        let li = layer_index(ctx, &layer_name);
-        let pts: Vec<[f64; 2]> = pts
-            .into_iter()
-            .map(|p| {
-                let q = tf * kurbo::Point::new(p[0], p[1]);
-                [q.x, q.y]
-            })
-            .collect();
-        if !pts.iter().flatten().all(|v| v.is_finite()) {
-            return Err(Error::invalid(
-                ctx.file,
-                format!("entity {handle}: non-finite coordinate"),
-            ));
-        }
-        ctx.pieces.push(Piece {
-            layer: li,
-            pts,
-            closed,
-        });
-        Ok(())
+    let src = Source {
+        tf,
+        layer: &layer_name,
+        handle: &handle,
     };
-    let deg = std::f64::consts::PI / 180.0;
     match &e.specific {
-        EntityType::Line(l) => add(ctx, vec![[l.p1.x, l.p1.y], [l.p2.x, l.p2.y]], false)?,
+        EntityType::Line(l) => {
+            let p = vec![[l.p1.x, l.p1.y], [l.p2.x, l.p2.y]];
+            add_piece(ctx, &src, p, false, &[])
+        }
         EntityType::Circle(c) => {
-            let mut p = arc_points(
-                [c.center.x, c.center.y],
-                c.radius,
-                0.0,
-                2.0 * std::f64::consts::PI,
-                tol,
-            );
-            p.pop();
-            add(ctx, p, true)?
+            let (p, run) = circle(c, tol);
+            add_piece(ctx, &src, p, true, &[run])
         }
         EntityType::Arc(a) => {
-            let s = a.start_angle * deg;
-            let t = s + sweep_of(s, a.end_angle * deg);
-            add(
-                ctx,
-                arc_points([a.center.x, a.center.y], a.radius, s, t - s, tol),
-                false,
-            )?
+            let (p, run) = arc(a, tol);
+            add_piece(ctx, &src, p, false, &[run])
         }
         EntityType::Ellipse(el) => {
-            let (mx, my) = (el.major_axis.x, el.major_axis.y);
-            let r = (mx * mx + my * my).sqrt();
-            let rot = my.atan2(mx);
-            let s = el.start_parameter;
-            let t = s + sweep_of(s, el.end_parameter);
-            let full = (t - s - 2.0 * std::f64::consts::PI).abs() < 1e-9;
-            let unit = arc_points([0.0, 0.0], 1.0, s, t - s, tol / r.max(1e-9));
-            let m = Affine::translate((el.center.x, el.center.y))
-                * Affine::rotate(rot)
-                * Affine::scale_non_uniform(r, r * el.minor_axis_ratio);
-            let mut p: Vec<[f64; 2]> = unit
-                .into_iter()
-                .map(|q| {
-                    let q = m * kurbo::Point::new(q[0], q[1]);
-                    [q.x, q.y]
-                })
-                .collect();
-            if full {
-                p.pop();
-            }
-            add(ctx, p, full)?
+            let (p, full) = ellipse(el, tol);
+            add_piece(ctx, &src, p, full, &[])
         }
         EntityType::LwPolyline(pl) => {
             let v: Vec<([f64; 2], f64)> =
                 pl.vertices.iter().map(|v| ([v.x, v.y], v.bulge)).collect();
             let closed = pl.is_closed();
-            add(ctx, bulged(&v, closed, tol), closed)?
+            let (p, runs) = bulged(&v, closed, tol);
+            add_piece(ctx, &src, p, closed, &runs)
         }
         EntityType::Polyline(pl) => {
             let v: Vec<([f64; 2], f64)> = pl
@@ -453,72 +570,75 @@ fn entity(
                 .map(|v| ([v.location.x, v.location.y], v.bulge))
                 .collect();
             let closed = pl.is_closed();
-            add(ctx, bulged(&v, closed, tol), closed)?
+            let (p, runs) = bulged(&v, closed, tol);
+            add_piece(ctx, &src, p, closed, &runs)
         }
         EntityType::Spline(s) => match spline_points(s, tol) {
-            Some(p) => {
-                let closed = s.is_closed();
-                add(ctx, p, closed)?
-            }
-            None => {
-                return unsupported(
-                    ctx,
-                    &handle,
-                    "SPLINE with inconsistent knots/control points",
-                );
-            }
-        },
-        EntityType::Insert(ins) => {
-            if depth > 16 {
-                return Err(Error::invalid(
-                    ctx.file,
-                    format!("INSERT (handle {handle}): blocks nested deeper than 16 (recursive?)"),
-                ));
-            }
-            let Some(b) = ctx.blocks.get(&ins.name).copied() else {
-                return Err(Error::invalid(
-                    ctx.file,
-                    format!("INSERT (handle {handle}): unknown block '{}'", ins.name),
-                ));
-            };
-            let (cols, rows) = (
-                ins.column_count.max(1) as usize,
-                ins.row_count.max(1) as usize,
-            );
-            if cols * rows > 100_000 {
-                return Err(Error::invalid(
-                    ctx.file,
-                    format!("INSERT (handle {handle}): array too large"),
-                ));
-            }
-            let bl = if layer_name == "0" {
-                block_layer.map(str::to_string)
-            } else {
-                Some(layer_name.clone())
-            };
-            for r in 0..rows {
-                for c in 0..cols {
-                    let t = tf
-                        * Affine::translate((ins.location.x, ins.location.y))
-                        * Affine::rotate(ins.rotation * deg)
-                        * Affine::translate((
-                            c as f64 * ins.column_spacing,
-                            r as f64 * ins.row_spacing,
-                        ))
-                        * Affine::scale_non_uniform(ins.x_scale_factor, ins.y_scale_factor)
-                        * Affine::translate((-b.base_point.x, -b.base_point.y));
-                    for be in &b.entities {
-                        entity(ctx, be, t, bl.as_deref(), depth + 1)?;
-                    }
-                }
-            }
-        }
-        other => {
-            return unsupported(
+            Some(p) => add_piece(ctx, &src, p, s.is_closed(), &[]),
+            None => unsupported(
                 ctx,
                 &handle,
-                &format!("{} is not supported", entity_name(other)),
-            );
+                "SPLINE with inconsistent knots/control points",
+            ),
+        },
+        EntityType::Insert(ins) => insert(ctx, ins, &src, block_layer, depth),
+        other => unsupported(
+            ctx,
+            &handle,
+            &format!("{} is not supported", entity_name(other)),
+        ),
+    }
+}
+
+/// An INSERT: the block's entities under the insert's transform, once per array cell, on the
+/// insert's layer where they are on layer 0.
+fn insert(
+    ctx: &mut Ctx,
+    ins: &dxf::entities::Insert,
+    src: &Source,
+    block_layer: Option<&str>,
+    depth: usize,
+) -> Result<()> {
+    let handle = src.handle;
+    if depth > 16 {
+        return Err(Error::invalid(
+            ctx.file,
+            format!("INSERT (handle {handle}): blocks nested deeper than 16 (recursive?)"),
+        ));
+    }
+    let Some(b) = ctx.blocks.get(&ins.name).copied() else {
+        return Err(Error::invalid(
+            ctx.file,
+            format!("INSERT (handle {handle}): unknown block '{}'", ins.name),
+        ));
+    };
+    let (cols, rows) = (
+        ins.column_count.max(1) as usize,
+        ins.row_count.max(1) as usize,
+    );
+    if cols * rows > 100_000 {
+        return Err(Error::invalid(
+            ctx.file,
+            format!("INSERT (handle {handle}): array too large"),
+        ));
+    }
+    let bl = if src.layer == "0" {
+        block_layer.map(str::to_string)
+    } else {
+        Some(src.layer.to_string())
+    };
+    let deg = std::f64::consts::PI / 180.0;
+    for r in 0..rows {
+        for c in 0..cols {
+            let t = src.tf
+                * Affine::translate((ins.location.x, ins.location.y))
+                * Affine::rotate(ins.rotation * deg)
+                * Affine::translate((c as f64 * ins.column_spacing, r as f64 * ins.row_spacing))
+                * Affine::scale_non_uniform(ins.x_scale_factor, ins.y_scale_factor)
+                * Affine::translate((-b.base_point.x, -b.base_point.y));
+            for be in &b.entities {
+                entity(ctx, be, t, bl.as_deref(), depth + 1)?;
+            }
         }
     }
     Ok(())
@@ -631,166 +751,4 @@ fn chain(pieces: &[&Piece], tol: f64) -> Vec<(Vec<[f64; 2]>, bool)> {
         out.push((pts, closed));
     }
     out
-}
-
-/// Parameters of the G-code post.
-#[derive(Debug, Clone, Copy)]
-pub struct Post {
-    /// Safe (travel) height, mm.
-    pub safe_height: f64,
-    /// Cutting depth (Z = -depth), mm.
-    pub depth: f64,
-    /// Cutting feed, mm/min.
-    pub feed: f64,
-    /// Plunge feed, mm/min.
-    pub plunge_feed: f64,
-    /// Spindle speed (`M3 S…` before the first cut, `M5` at the end); 0 writes no spindle
-    /// words (the operator's spindle state is left alone).
-    pub spindle: f64,
-    /// Laser power: a laser post (`M4 S…`, power scaled with speed on GRBL-style controllers,
-    /// off on rapids; `M5` at the end) with no Z moves at all; 0 = not a laser post.
-    pub laser_power: f64,
-}
-
-impl Default for Post {
-    fn default() -> Self {
-        Post {
-            safe_height: 5.0,
-            depth: 1.0,
-            feed: 1000.0,
-            plunge_feed: 300.0,
-            spindle: 0.0,
-            laser_power: 0.0,
-        }
-    }
-}
-
-/// Writes strokes (drawing units, converted to mm) as G-code: per stroke a rapid at the safe
-/// height, a plunge, the feed moves, a retract; with a laser power, per stroke a rapid and
-/// the feed moves (no Z words).
-pub fn write_gcode(d: &Drawing, strokes: &[Stroke], post: &Post) -> String {
-    let laser = post.laser_power > 0.0;
-    let k = d.mm_per_unit;
-    let f = |v: f64| svg::num(v * k);
-    let mut o = String::new();
-    let _ = writeln!(
-        o,
-        "(cellseq: {} strokes from {})",
-        strokes.len(),
-        d.file.replace(['(', ')'], "")
-    );
-    o.push_str("G21 G90 G17 G94\n");
-    if laser {
-        let _ = writeln!(o, "M4 S{}", svg::num(post.laser_power));
-    } else {
-        let _ = writeln!(o, "G0 Z{}", svg::num(post.safe_height));
-        if post.spindle > 0.0 {
-            let _ = writeln!(o, "M3 S{}", svg::num(post.spindle));
-        }
-    }
-    let mut layer = usize::MAX;
-    for s in strokes {
-        if s.layer != layer {
-            let _ = writeln!(
-                o,
-                "(layer {})",
-                d.layers[s.layer].label.replace(['(', ')'], "")
-            );
-            layer = s.layer;
-        }
-        let p0 = s.points[0];
-        let _ = writeln!(o, "G0 X{} Y{}", f(p0[0]), f(p0[1]));
-        if !laser {
-            let _ = writeln!(
-                o,
-                "G1 Z{} F{}",
-                svg::num(-post.depth),
-                svg::num(post.plunge_feed)
-            );
-        }
-        if s.is_dot() {
-            let _ = writeln!(o, "G1 X{} Y{} F{}", f(p0[0]), f(p0[1]), svg::num(post.feed));
-        }
-        for (i, p) in s.points[1..].iter().enumerate() {
-            if i == 0 {
-                let _ = writeln!(o, "G1 X{} Y{} F{}", f(p[0]), f(p[1]), svg::num(post.feed));
-            } else {
-                let _ = writeln!(o, "X{} Y{}", f(p[0]), f(p[1]));
-            }
-        }
-        if s.closed && s.points.len() > 1 {
-            let _ = writeln!(o, "X{} Y{}", f(p0[0]), f(p0[1]));
-        }
-        if !laser {
-            let _ = writeln!(o, "G0 Z{}", svg::num(post.safe_height));
-        }
-    }
-    if post.spindle > 0.0 || laser {
-        o.push_str("M5\n");
-    }
-    o.push_str("M2\n");
-    o
-}
-
-/// Checks that a G-code text written by [`write_gcode`] cuts exactly the drawing's segments
-/// (direction-insensitive multiset, mm, 6-decimal rounding) at the cutting depth; dots are
-/// the zero-length feed move after the plunge. Returns the number of segments.
-pub fn verify_gcode(d: &Drawing, name: &str, text: &str, post: &Post) -> Result<usize> {
-    let prog = interp::interpret(text).map_err(|(l, m)| Error::parse(name, l, m))?;
-    let r = |v: f64| svg::num(v).parse::<f64>().unwrap_or(v);
-    let norm = |a: [f64; 2], b: [f64; 2]| {
-        let (a, b) = if (a[0], a[1]) <= (b[0], b[1]) {
-            (a, b)
-        } else {
-            (b, a)
-        };
-        [
-            a[0].to_bits(),
-            a[1].to_bits(),
-            b[0].to_bits(),
-            b[1].to_bits(),
-        ]
-    };
-    let mut got = Vec::new();
-    for li in &prog.lines {
-        for c in &li.cuts {
-            if !matches!(c.kind, CutKind::Line) {
-                return Err(Error::invalid(
-                    name,
-                    format!("line {}: unexpected arc", li.line),
-                ));
-            }
-            if (c.from[2] - c.to[2]).abs() > 1e-9 {
-                continue; // plunge
-            }
-            if post.laser_power <= 0.0 && (c.from[2] + post.depth).abs() > 1e-6 {
-                return Err(Error::invalid(
-                    name,
-                    format!("line {}: feed move off the cutting depth", li.line),
-                ));
-            }
-            got.push(norm([r(c.from[0]), r(c.from[1])], [r(c.to[0]), r(c.to[1])]));
-        }
-    }
-    let k = d.mm_per_unit;
-    let mut want = Vec::new();
-    for s in &d.strokes {
-        for (a, b) in s.segments() {
-            want.push(norm([r(a[0] * k), r(a[1] * k)], [r(b[0] * k), r(b[1] * k)]));
-        }
-    }
-    got.sort_unstable();
-    want.sort_unstable();
-    if got != want {
-        return Err(Error::invalid(
-            name,
-            format!(
-                "not equivalent to {}: {} cutting segments vs {}",
-                d.file,
-                got.len(),
-                want.len()
-            ),
-        ));
-    }
-    Ok(want.len())
 }
