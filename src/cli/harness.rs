@@ -1,9 +1,10 @@
 //! `check`, `run`, `merge`, `report`: the research harness (see `cellseq::harness`).
 
-use anyhow::{Result, bail};
+use anyhow::{Context as _, Result, bail};
 use cellseq::harness::plan::{Limits, Plan};
 use cellseq::harness::run::{RunOptions, run_plan};
 use cellseq::harness::{report, results};
+use cellseq::solvers::auto::portfolio;
 use clap::Args;
 use std::path::{Path, PathBuf};
 
@@ -30,7 +31,7 @@ impl LimitArgs {
 
 #[derive(Args, Debug)]
 pub struct CheckArgs {
-    /// Experiment plan (TOML).
+    /// Experiment plan (TOML), or a portfolio file of the `auto` solver (one with `[[rule]]`).
     plan: PathBuf,
     /// Shards the plan will run as (for the time-per-shard estimate).
     #[arg(long, default_value_t = 1)]
@@ -99,6 +100,9 @@ pub fn check(a: CheckArgs) -> Result<()> {
     if a.shards == 0 || a.threads == Some(0) {
         bail!("--shards and --threads must be at least 1");
     }
+    if portfolio::is_portfolio_file(&a.plan) {
+        return check_portfolio(&a.plan);
+    }
     let plan = Plan::load_with(&a.plan, a.limits.limits())?;
     say!(
         "ok: {} instances x {} solvers x {} replicates = {} trials (reference {})",
@@ -113,6 +117,21 @@ pub fn check(a: CheckArgs) -> Result<()> {
         cellseq::harness::run::calibrate()
     })?;
     say!("{e}");
+    Ok(())
+}
+
+/// `check` on a portfolio file of the `auto` solver: validated as `solve` and `run` would.
+fn check_portfolio(path: &Path) -> Result<()> {
+    let text = path
+        .to_str()
+        .with_context(|| format!("{}: the path is not UTF-8", path.display()))?;
+    let p = portfolio::Portfolio::load(text)?;
+    let names: Vec<&str> = p.rules.iter().map(|r| r.name.as_str()).collect();
+    say!(
+        "ok: portfolio with {} rules ({})",
+        names.len(),
+        names.join(", ")
+    );
     Ok(())
 }
 

@@ -57,7 +57,7 @@ enum Command {
     VerifyGcode(gcode::VerifyArgs),
     /// Draw an instance (and a solution's air moves) to an SVG or PNG picture.
     Plot(plot::PlotArgs),
-    /// Validate an experiment plan without running it.
+    /// Validate an experiment plan (or an `auto` portfolio file) without running it.
     Check(harness::CheckArgs),
     /// Run (or resume) an experiment plan.
     Run(harness::RunArgs),

@@ -58,6 +58,14 @@ pub struct SolveArgs {
     /// Skip the lower bound computed after solving (`lower_bound`, `certified_gap_percent`).
     #[arg(long)]
     pub no_bound: bool,
+    /// Portfolio file of the `auto` solver (TOML, docs/portfolio.md); the same as
+    /// `--param portfolio=FILE`.
+    #[arg(long, value_name = "FILE")]
+    pub portfolio: Option<PathBuf>,
+    /// Print the instance's features and the portfolio rule `auto` chooses, with its plan,
+    /// before solving (with `--json`: an `explain` object).
+    #[arg(long)]
+    pub explain: bool,
 }
 
 #[derive(Args, Debug)]
@@ -157,9 +165,40 @@ pub fn solve(a: SolveArgs) -> Result<()> {
     if let Some(out) = &a.out {
         formats::write::ensure_not_input(&a.file, out, a.overwrite_input)?;
     }
+    let mut params = parse_kv(&a.params)?;
+    if let Some(p) = &a.portfolio {
+        if a.solver != solvers::auto::INFO.name {
+            bail!("--portfolio applies to the auto solver, not '{}'", a.solver);
+        }
+        if params.contains_key("portfolio") {
+            bail!("give the portfolio once: --portfolio or --param portfolio=FILE");
+        }
+        let p = p
+            .to_str()
+            .with_context(|| format!("--portfolio {}: the path is not UTF-8", p.display()))?;
+        params.insert("portfolio".to_string(), p.to_string());
+    }
+    if a.explain && a.solver != solvers::auto::INFO.name {
+        bail!(
+            "--explain describes the auto solver's choice; '{}' has none",
+            a.solver
+        );
+    }
+    // the solver and its parameters (an auto portfolio file) are checked before the instance
+    // is read
+    solvers::find(&a.solver)?.build(&params)?;
     let inst = load(&a.file)?;
     let objective = objective_of(&inst, a.objective.as_deref())?;
-    let params = parse_kv(&a.params)?;
+    let explained = if a.explain {
+        Some(solvers::auto::explain(&inst, objective, &params)?)
+    } else {
+        None
+    };
+    if let (Some(e), false) = (&explained, a.json) {
+        for l in &e.lines {
+            say!("{l}");
+        }
+    }
     if let Some(t) = a.time_limit
         && !(t.is_finite() && t > 0.0)
     {
@@ -188,10 +227,11 @@ pub fn solve(a: SolveArgs) -> Result<()> {
             .with_context(|| format!("writing {}", out.display()))?;
     }
     if a.json {
-        say!(
-            "{}",
-            serde_json::to_string(&result_json(&inst, &a.solver, a.seed, &r, bk))?
-        );
+        let mut v = result_json(&inst, &a.solver, a.seed, &r, bk);
+        if let (Some(e), Some(o)) = (&explained, v.as_object_mut()) {
+            o.insert("explain".to_string(), serde_json::to_value(e)?);
+        }
+        say!("{}", serde_json::to_string(&v)?);
     } else {
         print_report(&inst, &a.solver, &r, bk);
     }

@@ -499,7 +499,14 @@ fn generated_instances(
 
 /// The plan's solver configurations in order (`*` = every registered solver; a parameter grid
 /// = one configuration per combination), every id once.
-fn plan_solvers(file: &str, specs: &[SolverSpec], max_trials: u64) -> Result<Vec<SolverRef>> {
+/// An `auto` portfolio file given by a relative path is read from the plan's directory
+/// `base`, like the plan's instance patterns.
+fn plan_solvers(
+    file: &str,
+    specs: &[SolverSpec],
+    base: &Path,
+    max_trials: u64,
+) -> Result<Vec<SolverRef>> {
     let bad = |m: String| Error::invalid(file, m);
     if specs.is_empty() {
         return Err(bad("no [[solvers]]".into()));
@@ -521,15 +528,25 @@ fn plan_solvers(file: &str, specs: &[SolverSpec], max_trials: u64) -> Result<Vec
             continue;
         }
         let info = solvers::find(&spec.name).map_err(|e| bad(format!("{what}: {e}")))?;
-        for params in expand_grid(file, &what, &spec.params, max_trials)? {
-            // building the solver validates what its parameters mean (an `auto` plan)
-            info.build(&params)
-                .map_err(|e| bad(format!("{what}: {e}")))?;
+        for mut params in expand_grid(file, &what, &spec.params, max_trials)? {
+            // the id keeps the parameters as written, so seeds do not depend on where the
+            // plan lies
             let id = if params.is_empty() {
                 info.name.to_string()
             } else {
                 format!("{}[{}]", info.name, params_suffix(&params))
             };
+            if info.name == solvers::auto::INFO.name
+                && let Some(p) = params.get_mut("portfolio")
+                && p != solvers::auto::portfolio::BUILT_IN_NAME
+                && Path::new(p.as_str()).is_relative()
+            {
+                *p = base.join(p.as_str()).to_string_lossy().into_owned();
+            }
+            // building the solver validates what its parameters mean (an `auto` plan or
+            // portfolio file)
+            info.build(&params)
+                .map_err(|e| bad(format!("{what}: {e}")))?;
             solvers_out.push(SolverRef {
                 id,
                 name: info.name.to_string(),
@@ -610,7 +627,7 @@ impl Plan {
         };
         let caps = (max_trials, max_files);
         let instances = plan_instances(file, &pf.instances, base, caps)?;
-        let solvers_out = plan_solvers(file, &pf.solvers, max_trials)?;
+        let solvers_out = plan_solvers(file, &pf.solvers, base, max_trials)?;
         let reference = match &pf.reference {
             Some(r) => {
                 if !solvers_out.iter().any(|s| &s.id == r) {

@@ -16,36 +16,37 @@ pub static DETAILS: &[(&str, &str)] = &[
         "auto",
         "A portfolio: phases of other solvers, each given a share of what is left of the budget \
 (evaluations as well as time, so a run under `--max-evals` stays deterministic), each later \
-phase able to start from the best sequence so far; the best sequence wins.
+phase able to start from the best sequence so far; the best sequence wins. What runs is data: \
+`auto` computes the instance's features once (cells, modes per cell, geometric or matrix, \
+symmetric costs, precedence closure density, free density, widest precedence level, share of \
+zero-cost arcs, cost spread) and takes the first rule of a portfolio file whose conditions \
+hold; the built-in file is `src/solvers/auto/portfolio.toml`, `--portfolio FILE` (or \
+`--param portfolio=FILE`) names another. The format, the features and what is refused: \
+[portfolio.md](portfolio.md).
 
-1. On instances of at most `beam-max-cells` cells, and under a wall-clock budget of at least \
-`beam-min-seconds`, a `beam` proof attempt gets `beam-share` of the budget; when it proves \
-the optimum, `auto` stops there.
-2. Then the phases of a plan. Which plan depends on the instance (`cellseq info` prints the \
-precedence closure density it is chosen by):
-   - **default** (`plan`): `local-search`, then an `eacs` colony of its own, then `ils` from \
-the best so far;
-   - **symmetric costs** (matrix instances whose costs read the same backwards, such as \
-prob.100 and prob.42): the beam gets `symmetric-beam-share` and `ils`, with its \
-Lin–Kernighan chains, starts from the beam's sequence (`symmetric-beam-plan`); without a beam \
-phase, `symmetric-plan`;
-   - **sparse precedence** (other matrix instances with a closure density below \
-`dense-density`): `sparse-plan`: a short `local-search`, the colony run backwards (`~eacs`), \
-`ils` first in a 1 % and then in a 3 % acceptance band with the bounded-shift DP ending every \
-kick's repair, and window re-optimization (`reopt`) of the best;
-   - **dense precedence, small** (at most `dense-beam-max-cells` cells): the beam gets \
-`dense-beam-share`, then the default plan;
-   - **dense precedence, large**: no beam phase; `large-dense-plan`: `ils` with kicks that \
-reorder up to 45 cells.
+1. A `beam` proof attempt gets the rule's beam share of the budget, on instances of at most \
+its `max_cells` cells and, under a wall-clock budget, only when that budget is at least its \
+`min_seconds`; when it proves the optimum, `auto` stops there.
+2. Then the rule's phases (or its `after_beam` phases after a beam phase that ran). The \
+built-in rules: **symmetric** cost matrices (`ils` with Lin–Kernighan chains gets most of the \
+time, from the beam's sequence when the beam ran); **free** asymmetric matrices with no \
+precedence apart from a fixed start and end (`atsp`); **sparse** precedence (a short \
+`local-search`, a colony run backwards, `ils` in a 1 % then a 3 % acceptance band with the \
+bounded-shift DP ending every repair, window re-optimization of the best); **dense** \
+precedence on few cells (half the budget for the beam, then the default phases); **large \
+dense** (no beam; `ils` with kicks that reorder up to 45 cells); and the catch-all \
+**default**, geometric instances among them (`local-search`, an `eacs` colony of its own, \
+`ils` from the best so far).
 
-Plan syntax: `solver[key=value;...]:share,...`, where the share is a fraction of what is \
-left. After the name, `*` starts the phase from the best sequence so far and `+` from the \
-previous phase's sequence; `~` before the name runs the phase on the instance travelled \
-backwards (matrix instances; elsewhere the phase runs forwards). A solver named twice gets a \
-new seed each time. Example: \
-`cellseq solve F --param plan=local-search:0.3,eacs:0.5,ils*:1`. \
-`CELLSEQ_TRACE=1` prints one line per phase. How each plan was chosen, with the \
-measurements: [notes/lab/README.md](../notes/lab/README.md).",
+`cellseq solve F --explain` prints the features, the rule and its plan before solving; \
+`CELLSEQ_TRACE=1` prints them and one line per phase on stderr. `--param plan=...` skips the \
+rules: its phases run with the beam settings of the portfolio's last rule. Plan syntax: \
+`solver[key=value;...]:share,...`, where the share is a fraction of what is left. After the \
+name, `*` starts the phase from the best sequence so far and `+` from the previous phase's \
+sequence; `~` before the name runs the phase on the instance travelled backwards (matrix \
+instances; elsewhere the phase runs forwards). A solver named twice gets a new seed each time. \
+Example: `cellseq solve F --param plan=local-search:0.3,eacs:0.5,ils*:1`. How the built-in \
+rules were chosen: [notes/portfolio.md](../notes/portfolio.md).",
     ),
     (
         "as-given",
@@ -114,9 +115,9 @@ lists ranked by the assignment's reduced costs (`cand=reduced`, ties by raw cost
 cell), precedence checked on every move; kicks swap two blocks across a third (`kick=far`) \
 or two adjacent blocks (`near`), of up to `kick-len` cells; equal-or-better results are \
 accepted.
-- `auto` runs it (`free-plan`) on asymmetric matrix instances whose closure density, apart \
-from cells ordered against every other (a fixed start and end), is at most `free-density`; \
-notes/atsp.md has the measurements.",
+- `auto` runs it (the built-in portfolio's `free` rule) on asymmetric matrix instances whose \
+`free_density` (the closure density apart from cells ordered against every other: a fixed \
+start and end) is at most 0.001; notes/atsp.md has the measurements.",
     ),
     (
         "exact",
@@ -154,7 +155,7 @@ cells either side and searched by `beam` from the window's order, so a window ne
 worse. A later sweep has windows a quarter larger, centred where the last sweep could not \
 prove its windows optimal, up to `max-window`; one window gets at most `window-share` of the \
 budget, and a gain is polished by the VND. Alone it starts from `greedy`; in `auto` it ends \
-`sparse-plan`, from the best so far. On rbg323a it turns `ils`'s 3141 into the optimum 3140.",
+the built-in portfolio's `sparse` rule, from the best so far. On rbg323a it turns `ils`'s 3141 into the optimum 3140.",
     ),
     (
         "two-opt",

@@ -5,7 +5,7 @@
 use cellseq::cost::CostModel;
 use cellseq::engine::atsp::free_density;
 use cellseq::model::{Cell, CostMatrix, Instance, Mode, Objective};
-use cellseq::solvers::auto::{Auto, Case};
+use cellseq::solvers::auto::Auto;
 use cellseq::solvers::{Budget, NoObserver, Params, find, run};
 use std::collections::BTreeMap;
 
@@ -42,19 +42,19 @@ fn instance(n: usize, c: u64, seed: u64, pairs: &[(usize, usize)]) -> Instance {
 
 fn auto_default() -> Auto {
     let info = find("auto").unwrap();
-    Auto::from_params(&Params::new("auto", info.params, &BTreeMap::new()).unwrap())
+    Auto::from_params(&Params::new("auto", info.params, &BTreeMap::new()).unwrap()).unwrap()
 }
 
 #[test]
 fn auto_routes_free_instances_to_atsp_and_keeps_the_rest() {
     let free = CostModel::new(&instance(80, 100, 1, &[]), Objective::Matrix);
     assert_eq!(free_density(&free), 0.0);
-    assert_eq!(auto_default().case(&free), Case::Free);
+    assert_eq!(auto_default().choose(&free).rule, "free");
     // a chain through a tenth of the cells: far above the free threshold
     let chain: Vec<(usize, usize)> = (1..40).map(|i| (i, i + 1)).collect();
     let tied = CostModel::new(&instance(80, 100, 1, &chain), Objective::Matrix);
     assert!(free_density(&tied) > 0.01);
-    assert_eq!(auto_default().case(&tied), Case::Sparse);
+    assert_eq!(auto_default().choose(&tied).rule, "sparse");
 }
 
 #[test]

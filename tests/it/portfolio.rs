@@ -54,16 +54,16 @@ fn plans_parse_and_bad_plans_are_rejected() {
 
 #[test]
 fn auto_rejects_a_bad_plan_parameter() {
-    // ESC12's costs are asymmetric, so the symmetric plan is not the one that would run
+    // every bad value is refused when the solver is built, before anything runs
     let inst = sop("ESC12");
-    for key in [
-        "plan",
-        "symmetric-plan",
-        "symmetric-beam-plan",
-        "sparse-plan",
+    for (key, value) in [
+        ("plan", "ils:2"),
+        ("beam-share", "1.5"),
+        ("beam-share", "x"),
+        ("portfolio", "/nonexistent/portfolio.toml"),
     ] {
         let mut given = BTreeMap::new();
-        given.insert(key.to_string(), "ils:2".to_string());
+        given.insert(key.to_string(), value.to_string());
         let e = run(
             "auto",
             &inst,
@@ -73,7 +73,7 @@ fn auto_rejects_a_bad_plan_parameter() {
             evals(10_000),
             &mut NoObserver,
         );
-        assert!(e.is_err(), "{key}=ils:2 was accepted");
+        assert!(e.is_err(), "{key}={value} was accepted");
     }
 }
 
@@ -160,77 +160,84 @@ fn ils_lin_kernighan_chains_help_on_a_symmetric_instance_and_stay_deterministic(
 }
 
 #[test]
-fn auto_picks_its_plan_by_symmetry_and_precedence_density() {
+fn auto_picks_its_rule_by_symmetry_and_precedence_density() {
     use cellseq::cost::CostModel;
-    use cellseq::solvers::auto::{
-        Auto, Case, LARGE_DENSE_PLAN, PLAN, SPARSE_PLAN, SYMMETRIC_BEAM_PLAN, SYMMETRIC_PLAN,
-    };
-    let auto = |plan: &str| Auto {
-        seconds: 1.0,
-        beam_share: 0.1,
-        beam_max_cells: 400,
-        plan: plan.to_string(),
-        symmetric_plan: SYMMETRIC_PLAN.to_string(),
-        free_plan: cellseq::solvers::auto::FREE_PLAN.to_string(),
-        free_density: 0.001,
-        beam_min_seconds: 2.0,
-        symmetric_beam_share: 0.3,
-        symmetric_beam_plan: SYMMETRIC_BEAM_PLAN.to_string(),
-        sparse_plan: SPARSE_PLAN.to_string(),
-        dense_density: 0.8,
-        dense_beam_share: 0.5,
-        dense_beam_max_cells: 300,
-        large_dense_plan: LARGE_DENSE_PLAN.to_string(),
+    use cellseq::solvers::auto::{Auto, PLAN_RULE, plan_text};
+    use cellseq::solvers::{Params, find};
+    let auto = |kv: &[(&str, &str)]| {
+        let given: BTreeMap<String, String> = kv
+            .iter()
+            .map(|(k, v)| (k.to_string(), v.to_string()))
+            .collect();
+        let info = find("auto").unwrap();
+        Auto::from_params(&Params::new("auto", info.params, &given).unwrap()).unwrap()
     };
     let model = |name: &str| {
         let inst = sop(name);
         CostModel::new(&inst, inst.default_objective())
     };
     // prob.42's matrix reads the same backwards; ESC25's does not, and its precedence
-    // closure is sparse (0.18); rbg109a's is dense (0.91)
-    let (p42, esc, rbg) = (model("prob.42"), model("ESC25"), model("rbg109a"));
-    assert_eq!(auto(PLAN).case(&p42), Case::Symmetric);
-    assert_eq!(auto(PLAN).plan_for(&p42, false), SYMMETRIC_PLAN);
-    assert_eq!(auto(PLAN).plan_for(&p42, true), SYMMETRIC_BEAM_PLAN);
-    assert_eq!(auto(PLAN).beam_share_for(&p42), 0.3);
-    assert_eq!(auto(PLAN).case(&esc), Case::Sparse);
-    assert_eq!(auto(PLAN).case(&rbg), Case::Dense);
+    // closure is sparse (0.18); rbg109a's is dense (0.91), rbg323a is dense and large
+    let (p42, esc, rbg, big) = (
+        model("prob.42"),
+        model("ESC25"),
+        model("rbg109a"),
+        model("rbg323a"),
+    );
+    let a = auto(&[]);
+    let c = a.choose(&p42);
+    assert_eq!(c.rule, "symmetric");
+    assert!(c.features.symmetric && !c.features.geometric);
+    assert_eq!(
+        plan_text(c.plan(false)),
+        "local-search:0.2,eacs*:0.3,ils*:1"
+    );
+    assert_eq!(plan_text(c.plan(true)), "ils[accept=0.01]*:1");
+    assert_eq!(c.beam.share, 0.3);
+    let c = a.choose(&esc);
+    assert_eq!(c.rule, "sparse");
+    assert!((c.features.closure_density - 0.18).abs() < 0.01);
+    assert_eq!(c.beam.share, 0.1);
     for after_beam in [false, true] {
-        assert_eq!(auto(PLAN).plan_for(&esc, after_beam), SPARSE_PLAN);
-        assert_eq!(auto(PLAN).plan_for(&rbg, after_beam), PLAN);
+        assert_eq!(
+            plan_text(c.plan(after_beam)),
+            "local-search:0.1,~eacs:0.5,ils[accept=0.01;shift-repair=2]*:0.25,\
+             ils[accept=0.03;shift-repair=2]*:0.85,reopt[window=16]*:1"
+        );
     }
-    assert_eq!(auto(PLAN).beam_share_for(&esc), 0.1);
-    // dense and at most dense-beam-max-cells cells: the beam gets dense-beam-share
-    assert_eq!(auto(PLAN).beam_share_for(&rbg), 0.5);
-    let small_cap = Auto {
-        dense_beam_max_cells: 100,
-        ..auto(PLAN)
-    };
-    // larger dense instances: large-dense-plan (ils with longer kicks) and no beam phase
-    assert_eq!(small_cap.case(&rbg), Case::LargeDense);
-    assert_eq!(small_cap.beam_share_for(&rbg), 0.0);
-    for after_beam in [false, true] {
-        assert_eq!(small_cap.plan_for(&rbg, after_beam), LARGE_DENSE_PLAN);
-    }
-    // a plan the user chose is kept, and so is the beam share
+    let c = a.choose(&rbg);
+    assert_eq!((c.rule, c.beam.share), ("dense", 0.5));
+    assert_eq!(plan_text(c.plan(true)), "local-search:0.3,eacs:0.5,ils*:1");
+    // larger dense instances: ils with longer kicks and no beam phase
+    let c = a.choose(&big);
+    assert_eq!((c.rule, c.beam.share), ("large-dense", 0.0));
+    assert_eq!(
+        plan_text(c.plan(false)),
+        "local-search:0.1,ils[max-seg=45]*:1"
+    );
+    // a plan the user chose replaces the rules, with the catch-all rule's beam share
     let own = "local-search:0.5,ils*:1";
-    for after_beam in [false, true] {
-        assert_eq!(auto(own).plan_for(&p42, after_beam), own);
+    let mine = auto(&[("plan", own)]);
+    for m in [&p42, &rbg, &big] {
+        let c = mine.choose(m);
+        assert_eq!((c.rule, c.beam.share), (PLAN_RULE, 0.1));
+        for after_beam in [false, true] {
+            assert_eq!(plan_text(c.plan(after_beam)), own);
+        }
     }
-    assert_eq!(auto(own).beam_share_for(&p42), 0.1);
-    assert_eq!(auto(own).beam_share_for(&rbg), 0.1);
-    // geometric instances keep the default plan
+    // beam-share replaces the rule's share
+    assert_eq!(auto(&[("beam-share", "0")]).choose(&p42).beam.share, 0.0);
+    // geometric instances get the catch-all rule
     let kv: BTreeMap<String, String> = [("n", "30"), ("modes", "2"), ("reversible", "true")]
         .into_iter()
         .map(|(k, v)| (k.to_string(), v.to_string()))
         .collect();
     let inst = cellseq::generate::generate("uniform", &kv, 3).unwrap();
     let m = CostModel::new(&inst, inst.default_objective());
-    assert_eq!(auto(PLAN).plan_for(&m, true), PLAN);
-    assert!(parse_plan(SYMMETRIC_PLAN).is_ok());
-    assert!(parse_plan(SYMMETRIC_BEAM_PLAN).is_ok());
-    assert!(parse_plan(SPARSE_PLAN).is_ok());
-    assert!(parse_plan(LARGE_DENSE_PLAN).is_ok());
+    let c = a.choose(&m);
+    assert_eq!(c.rule, "default");
+    assert!(c.features.geometric);
+    assert_eq!(plan_text(c.plan(true)), "local-search:0.3,eacs:0.5,ils*:1");
 }
 
 #[test]
@@ -273,4 +280,346 @@ fn a_colony_run_backwards_solves_the_forward_instance() {
     let (a, b) = (solve(), solve());
     assert_eq!(a.outcome.sequence, b.outcome.sequence);
     assert_eq!(a.report.cost, b.report.cost);
+}
+
+// ---- the portfolio file ----
+
+/// A portfolio whose every instance goes to one rule running `greedy` alone, no beam phase.
+const GREEDY_ONLY: &str = r#"
+[beam]
+max_cells = 400
+min_seconds = 2.0
+
+[[rule]]
+name = "greedy-everywhere"
+beam = { share = 0.0 }
+phases = [ { solver = "greedy", share = 1.0 } ]
+"#;
+
+#[test]
+fn the_built_in_portfolio_parses_validates_and_ends_with_a_catch_all() {
+    use cellseq::solvers::auto::portfolio::{BUILT_IN, Portfolio};
+    let p = Portfolio::built_in().unwrap();
+    let names: Vec<&str> = p.rules.iter().map(|r| r.name.as_str()).collect();
+    assert_eq!(
+        names,
+        [
+            "symmetric",
+            "free",
+            "sparse",
+            "dense",
+            "large-dense",
+            "default"
+        ]
+    );
+    assert!(p.catch_all().when.is_empty());
+    assert!(
+        p.rules[..p.rules.len() - 1]
+            .iter()
+            .all(|r| !r.when.is_empty())
+    );
+    // the file says what each rule is for in terms of features, never by benchmark instance
+    for word in ["ESC", "rbg", "kro", "prob.", "ft70", "ry48", "p43", "br17"] {
+        assert!(
+            !BUILT_IN.contains(word),
+            "the built-in portfolio names '{word}'"
+        );
+    }
+}
+
+#[test]
+fn bad_portfolios_are_refused_naming_the_file_and_the_entry() {
+    use cellseq::solvers::auto::portfolio::Portfolio;
+    let head = "[beam]\nmax_cells = 400\nmin_seconds = 2.0\n";
+    let rule = |name: &str, when: &str, phases: &str| {
+        format!(
+            "[[rule]]\nname = \"{name}\"\n{when}beam = {{ share = 0.1 }}\nphases = [ {phases} ]\n"
+        )
+    };
+    let ok_phase = "{ solver = \"greedy\", share = 1.0 }";
+    let last = rule("rest", "", ok_phase);
+    let cases: Vec<(String, &str)> = vec![
+        (
+            format!(
+                "{head}{}{last}",
+                rule(
+                    "a",
+                    "when = { clossure_density = { max = 0.5 } }\n",
+                    ok_phase
+                )
+            ),
+            "unknown field `clossure_density`",
+        ),
+        (
+            format!(
+                "{head}{}{last}",
+                rule("a", "", "{ solver = \"nosuch\", share = 1.0 }")
+            ),
+            "rule 1 'a': phases: phase 1 (nosuch): unknown solver 'nosuch'",
+        ),
+        (
+            format!(
+                "{head}{}{last}",
+                rule(
+                    "a",
+                    "when = { cells = { max = 9 } }\n",
+                    "{ solver = \"greedy\", share = 0.0 }"
+                )
+            ),
+            "share must be in (0, 1]",
+        ),
+        (
+            format!(
+                "{head}{}{last}",
+                rule(
+                    "a",
+                    "when = { cells = { max = 9 } }\n",
+                    "{ solver = \"greedy\", share = 1.5 }"
+                )
+            ),
+            "share must be in (0, 1]",
+        ),
+        (
+            format!(
+                "{head}{}",
+                rule("a", "when = { geometric = true }\n", ok_phase)
+            ),
+            "the last rule must have none",
+        ),
+        (
+            format!(
+                "{head}{}{}{last}",
+                rule("wide", "when = { cells = { max = 500 } }\n", ok_phase),
+                rule(
+                    "narrow",
+                    "when = { cells = { min = 10, max = 100 } }\n",
+                    ok_phase
+                )
+            ),
+            "rule 2 'narrow' is never reached: every instance it matches is taken by the earlier rule 'wide'",
+        ),
+        (
+            format!("{head}{last}{}", rule("after", "", ok_phase)),
+            "rule 2 'after' is never reached",
+        ),
+        (
+            format!(
+                "{head}{}{last}",
+                rule(
+                    "a",
+                    "when = { zero_arcs = { min = 0.5, below = 0.5 } }\n",
+                    ok_phase
+                )
+            ),
+            "when.zero_arcs is empty",
+        ),
+        (
+            format!(
+                "{head}{}{last}",
+                rule(
+                    "a",
+                    "",
+                    "{ solver = \"greedy\", share = 1.0, start = \"best\" }"
+                )
+            ),
+            "only ils, eacs and reopt can start from an earlier sequence",
+        ),
+        (
+            format!(
+                "{head}{}{last}",
+                rule(
+                    "a",
+                    "",
+                    "{ solver = \"ils\", share = 1.0, params = { nosuch = 1 } }"
+                )
+            ),
+            "'ils' has no parameter 'nosuch'",
+        ),
+        (
+            format!(
+                "{head}{}{last}",
+                rule("a", "", "{ solver = \"auto\", share = 1.0 }")
+            ),
+            "a plan cannot contain auto itself",
+        ),
+        (head.to_string(), "no [[rule]]"),
+        (last.clone(), "missing field `beam`"),
+        ("[[rule]\n".to_string(), "p.toml:1:"),
+    ];
+    for (text, want) in cases {
+        let e = Portfolio::parse("p.toml", &text)
+            .err()
+            .unwrap_or_else(|| panic!("accepted:\n{text}"))
+            .to_string();
+        assert!(e.starts_with("p.toml"), "{e}");
+        assert!(e.contains(want), "want '{want}', got '{e}'\n{text}");
+        assert!(!e.contains('\n'), "one line: {e}");
+    }
+}
+
+#[test]
+fn a_custom_portfolio_changes_the_plan_that_runs() {
+    let d = tempfile::tempdir().unwrap();
+    let file = d.path().join("greedy.toml");
+    std::fs::write(&file, GREEDY_ONLY).unwrap();
+    let inst = sop("ESC25");
+    let given = BTreeMap::from([("portfolio".to_string(), file.to_string_lossy().into_owned())]);
+    let go = |solver: &str, given: &BTreeMap<String, String>| {
+        run(
+            solver,
+            &inst,
+            inst.default_objective(),
+            given,
+            1,
+            evals(200_000),
+            &mut NoObserver,
+        )
+        .unwrap()
+    };
+    // auto under the one-rule portfolio is greedy, exactly
+    let mine = go("auto", &given);
+    let greedy = go("greedy", &BTreeMap::new());
+    assert_eq!(mine.outcome.sequence, greedy.outcome.sequence);
+    assert_eq!(mine.report.cost, greedy.report.cost);
+    // and the built-in one does better on this instance
+    let built_in = go("auto", &BTreeMap::new());
+    assert!(built_in.report.cost < mine.report.cost);
+    // the rule is reported
+    let out = crate::common::cellseq()
+        .arg("solve")
+        .arg(crate::common::instance_path("tsplib-sop/ESC25.sop"))
+        .args(["--max-evals", "20000", "--explain", "--portfolio"])
+        .arg(&file)
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(text.contains("rule       greedy-everywhere"), "{text}");
+    assert!(text.contains("phases     greedy:1"), "{text}");
+    assert!(text.contains("free_density="), "{text}");
+    let out = crate::common::cellseq()
+        .arg("solve")
+        .arg(crate::common::instance_path("tsplib-sop/ESC25.sop"))
+        .args(["--max-evals", "20000", "--explain", "--json"])
+        .output()
+        .unwrap();
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["explain"]["rule"], "sparse", "{v}");
+    assert_eq!(v["explain"]["portfolio"], "built-in");
+    assert!(
+        v["explain"]["features"]["closure_density"]
+            .as_f64()
+            .unwrap()
+            > 0.1
+    );
+}
+
+#[test]
+fn check_and_solve_refuse_a_bad_portfolio_with_exit_2() {
+    let d = tempfile::tempdir().unwrap();
+    let bad = d.path().join("bad.toml");
+    std::fs::write(
+        &bad,
+        GREEDY_ONLY.replace("[[rule]]\nname", "[[rule]]\nwhen = { colour = true }\nname"),
+    )
+    .unwrap();
+    let good = d.path().join("good.toml");
+    std::fs::write(&good, GREEDY_ONLY).unwrap();
+    let esc = crate::common::instance_path("tsplib-sop/ESC07.sop");
+    let runs: Vec<Vec<std::ffi::OsString>> = vec![
+        vec!["check".into(), bad.clone().into()],
+        vec![
+            "solve".into(),
+            esc.clone().into(),
+            "--portfolio".into(),
+            bad.clone().into(),
+        ],
+        vec![
+            "solve".into(),
+            esc.clone().into(),
+            "--param".into(),
+            format!("portfolio={}", bad.display()).into(),
+        ],
+    ];
+    for args in runs {
+        let out = crate::common::cellseq().args(&args).output().unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+        assert!(err.contains("bad.toml"), "{args:?}: {err}");
+        assert!(err.contains("unknown field `colour`"), "{args:?}: {err}");
+        assert!(!err.contains("panicked"), "{err}");
+    }
+    // a missing file, and --portfolio with another solver
+    let out = crate::common::cellseq()
+        .arg("solve")
+        .arg(&esc)
+        .args(["--portfolio", "/nonexistent/p.toml"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("/nonexistent/p.toml"));
+    let out = crate::common::cellseq()
+        .arg("solve")
+        .arg(&esc)
+        .args(["--solver", "greedy", "--portfolio"])
+        .arg(&good)
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    // check accepts the good one and names its rules
+    let out = crate::common::cellseq()
+        .arg("check")
+        .arg(&good)
+        .output()
+        .unwrap();
+    assert!(out.status.success());
+    assert!(
+        String::from_utf8_lossy(&out.stdout)
+            .contains("ok: portfolio with 1 rules (greedy-everywhere)")
+    );
+}
+
+#[test]
+fn a_plan_reads_its_portfolio_from_the_plan_directory() {
+    let d = tempfile::tempdir().unwrap();
+    std::fs::create_dir(d.path().join("plans")).unwrap();
+    std::fs::write(d.path().join("plans/mine.toml"), GREEDY_ONLY).unwrap();
+    let plan = |portfolio: &str| {
+        format!(
+            "name = \"p\"\n[budget]\nevaluations = 1000\n[[instances]]\nfiles = [\"{}\"]\n\
+             [[solvers]]\nname = \"auto\"\nparams = {{ portfolio = \"{portfolio}\" }}\n",
+            crate::common::instance_path("tsplib-sop/ESC07.sop").display()
+        )
+    };
+    let path = d.path().join("plans/plan.toml");
+    std::fs::write(&path, plan("mine.toml")).unwrap();
+    // run from elsewhere: the relative name is the plan directory's file
+    let out = crate::common::cellseq()
+        .current_dir(d.path())
+        .arg("check")
+        .arg(&path)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    std::fs::write(&path, plan("missing.toml")).unwrap();
+    let out = crate::common::cellseq()
+        .current_dir(d.path())
+        .arg("check")
+        .arg(&path)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("plan.toml") && err.contains("missing.toml"),
+        "{err}"
+    );
 }

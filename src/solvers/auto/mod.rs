@@ -1,0 +1,416 @@
+//! `auto`: the default solver — a portfolio whose rules are data.
+//!
+//! The instance's [`Features`] are computed once; the first rule of the [`Portfolio`] whose
+//! conditions hold gives the plan (the built-in portfolio is `portfolio.toml` beside this
+//! module; the `portfolio` parameter or `--portfolio FILE` names another):
+//!
+//! 1. `beam` (iterative beam search with dominance and bounds) for the rule's beam share of
+//!    the budget, on instances of at most its `max_cells` cells and, under a wall-clock
+//!    budget, only when that budget is at least its `min_seconds`: when it proves the
+//!    optimum, `auto` stops.
+//! 2. The rule's phases (or its `after_beam` phases after a beam phase that ran), each with
+//!    a share of what is left; each phase starts fresh, from the best sequence so far or from
+//!    the previous phase's, and may run on the instance travelled backwards.
+//!
+//! The `plan` parameter replaces the rule selection: its phases run with the beam settings
+//! of the portfolio's last (catch-all) rule. Plan syntax: `solver[key=value;...]:share`,
+//! with `*` after the name to start from the best sequence so far, `+` to start from the
+//! sequence of the phase just before, and `~` before the name to run the phase on the
+//! instance travelled backwards ([`crate::model::Instance::reversed_matrix`]; matrix
+//! instances only, elsewhere the phase runs forwards). A solver named twice in a plan gets a
+//! new seed each time ([`phase_seed`]), so `eacs:0.4,~eacs:0.5` runs two independent colonies.
+//!
+//! The best sequence wins. Budgets are split by fraction, evaluations as well as time, so a
+//! run with an evaluation budget stays deterministic. Without any budget `auto` gives itself
+//! `seconds` of wall-clock time.
+
+pub mod features;
+pub mod plan;
+pub mod portfolio;
+
+pub use features::Features;
+pub use plan::{Phase, Start, parse_plan, phase_seed, plan_text};
+pub use portfolio::{Beam, Portfolio, Rule};
+
+use super::{
+    Budget, Caps, Context, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo, Sub, sub_run,
+};
+use crate::cost::CostModel;
+use crate::error::{Error, Result};
+use crate::model::Instance;
+use std::collections::BTreeMap;
+use std::time::Duration;
+
+/// The `plan` and `beam-share` parameters' default: take them from the portfolio's rule.
+pub const FROM_RULE: &str = "rule";
+
+/// The rule name reported when the `plan` parameter replaces the rule selection.
+pub const PLAN_RULE: &str = "plan parameter";
+
+/// Registry entry.
+pub static INFO: SolverInfo = SolverInfo {
+    name: "auto",
+    summary: "portfolio (default): instance features pick a rule of a portfolio file; a beam proof attempt on small instances, then the rule's phases (local-search, eacs, ils, atsp...) chained; best wins",
+    params: &[
+        ParamSpec {
+            name: "seconds",
+            default: "10",
+            kind: ParamKind::Float,
+            help: "wall-clock budget used when neither --time-limit nor --max-evals is given",
+        },
+        ParamSpec {
+            name: "portfolio",
+            default: portfolio::BUILT_IN_NAME,
+            kind: ParamKind::Text,
+            help: "the portfolio file (TOML, docs/portfolio.md) whose rules choose the plan; built-in: the one compiled in (`cellseq solve --portfolio FILE` sets it)",
+        },
+        ParamSpec {
+            name: "plan",
+            default: FROM_RULE,
+            kind: ParamKind::Text,
+            help: "phases that replace the rule selection, with the beam settings of the portfolio's last rule: solver[key=value;...]:share,... (share of what is left; a '*' after the name starts ils, eacs or reopt from the best so far, a '+' from the sequence of the phase before; a '~' before the name runs the phase on the matrix instance travelled backwards; a solver named twice gets a new seed each time); rule: the chosen rule's phases",
+        },
+        ParamSpec {
+            name: "beam-share",
+            default: FROM_RULE,
+            kind: ParamKind::Text,
+            help: "share of the budget given to the beam proof attempt, in [0, 1] (0: none); rule: the chosen rule's",
+        },
+    ],
+    caps: Caps { ..Caps::NONE },
+    make: |p: &Params| Ok(Box::new(Auto::from_params(p)?)),
+};
+
+/// The portfolio solver.
+pub struct Auto {
+    /// Default wall-clock budget.
+    pub seconds: f64,
+    /// The rules.
+    pub portfolio: Portfolio,
+    /// Phases that replace the rule selection (the `plan` parameter).
+    pub plan: Option<Vec<Phase>>,
+    /// Beam share that replaces the rule's (the `beam-share` parameter).
+    pub beam_share: Option<f64>,
+}
+
+/// What `auto` runs on one instance: the rule, the features it was chosen by, and the
+/// settings in force.
+#[derive(Debug, Clone)]
+pub struct Choice<'a> {
+    /// The rule's name ([`PLAN_RULE`] when the `plan` parameter replaced the selection).
+    pub rule: &'a str,
+    /// The instance's features.
+    pub features: Features,
+    /// The beam phase's settings (share, limits).
+    pub beam: Beam,
+    /// The phases.
+    pub phases: &'a [Phase],
+    /// The phases after a beam phase that ran, when they differ.
+    pub after_beam: Option<&'a [Phase]>,
+}
+
+impl Choice<'_> {
+    /// The phases to run, after a beam phase that ran (`after_beam`) or not.
+    pub fn plan(&self, after_beam: bool) -> &[Phase] {
+        match (after_beam, self.after_beam) {
+            (true, Some(p)) => p,
+            _ => self.phases,
+        }
+    }
+
+    /// A few lines for `solve --explain` and the trace: the rule, the features, the beam
+    /// settings and the phases.
+    pub fn lines(&self, source: &str) -> Vec<String> {
+        let mut out = vec![
+            format!("portfolio  {source}"),
+            format!("rule       {}", self.rule),
+            format!("features   {}", self.features.line()),
+            format!(
+                "beam       share {} up to {} cells, budgets of at least {} s",
+                self.beam.share, self.beam.max_cells, self.beam.min_seconds
+            ),
+            format!("phases     {}", plan_text(self.phases)),
+        ];
+        if let Some(p) = self.after_beam {
+            out.push(format!("after beam {}", plan_text(p)));
+        }
+        out
+    }
+}
+
+/// A share of `b` (what is left of it after `used_evals` and `used_s`).
+fn share(b: Budget, used_evals: u64, used_s: f64, frac: f64) -> Budget {
+    Budget {
+        time_limit: b
+            .time_limit
+            .map(|t| Duration::from_secs_f64((t.as_secs_f64() - used_s).max(0.0) * frac)),
+        max_evals: b
+            .max_evals
+            .map(|m| ((m.saturating_sub(used_evals)) as f64 * frac) as u64),
+    }
+}
+
+/// One phase as it runs: what [`Phase`] says, resolved against the run so far.
+struct Run<'p> {
+    /// Solver name.
+    name: &'p str,
+    /// The phase's own solver parameters.
+    given: &'p BTreeMap<String, String>,
+    /// Its share of the budget.
+    budget: Budget,
+    /// Where it starts ([`Start::Fresh`] for the beam).
+    from: Start,
+    /// The sequence it starts from (`None` with [`Start::Fresh`]).
+    start: Option<&'p Outcome>,
+    /// How often the solver ran before in the plan (its seed's repeat index).
+    repeat: u64,
+    /// The backwards twin it runs on (`~`), if any.
+    twin: Option<&'p (Instance, CostModel)>,
+}
+
+impl Auto {
+    /// The solver for validated parameters `p` (of [`INFO`]): loads and validates the
+    /// portfolio, parses a given `plan` and checks a given `beam-share`.
+    pub fn from_params(p: &Params) -> Result<Auto> {
+        let portfolio = Portfolio::load(p.word("portfolio"))?;
+        let plan = match p.word("plan") {
+            FROM_RULE => None,
+            text => Some(parse_plan(text)?),
+        };
+        let beam_share = match p.word("beam-share") {
+            FROM_RULE => None,
+            text => Some(
+                text.parse::<f64>()
+                    .ok()
+                    .filter(|s| s.is_finite() && (0.0..=1.0).contains(s))
+                    .ok_or_else(|| Error::Param(format!(
+                        "'auto': parameter 'beam-share' must be a number in [0, 1] or {FROM_RULE}, got '{text}'"
+                    )))?,
+            ),
+        };
+        Ok(Auto {
+            seconds: p.float("seconds").max(0.001),
+            portfolio,
+            plan,
+            beam_share,
+        })
+    }
+
+    /// What runs on model `m`: the features, the first rule that holds (or the `plan`
+    /// parameter with the last rule's beam settings), and the beam share in force.
+    pub fn choose(&self, m: &CostModel) -> Choice<'_> {
+        let features = Features::of(m);
+        let (rule, phases, after_beam, mut beam) = match &self.plan {
+            Some(p) => (
+                PLAN_RULE,
+                p.as_slice(),
+                None,
+                self.portfolio.catch_all().beam,
+            ),
+            None => {
+                let r = self.portfolio.select(&features);
+                (
+                    r.name.as_str(),
+                    r.phases.as_slice(),
+                    r.after_beam.as_deref(),
+                    r.beam,
+                )
+            }
+        };
+        if let Some(s) = self.beam_share {
+            beam.share = s;
+        }
+        Choice {
+            rule,
+            features,
+            beam,
+            phases,
+            after_beam,
+        }
+    }
+
+    fn phase(&self, ctx: &mut Context, run: Run) -> Result<Outcome> {
+        let Run {
+            name,
+            given,
+            budget,
+            from,
+            start,
+            repeat,
+            twin,
+        } = run;
+        let (instance, on) = match twin {
+            Some((i, m)) => (i, Some((i, m))),
+            None => (ctx.instance, None),
+        };
+        let seq = start.map(|o| match twin {
+            Some(_) => ctx.instance.reverse_sequence(&o.sequence),
+            None => o.sequence.clone(),
+        });
+        let sub = Sub {
+            name,
+            params: given,
+            budget,
+            seed: phase_seed(ctx.seed, repeat),
+            start: seq.as_ref(),
+            on,
+        };
+        let mut out = sub_run(ctx, sub)?;
+        if twin.is_some() {
+            out.sequence = instance.reverse_sequence(&out.sequence);
+        }
+        ctx.report(out.cost);
+        if super::trace_enabled() {
+            eprintln!(
+                "auto: {}{name}{} cost {} after {} evaluations, {:.2} s",
+                if twin.is_some() { "~" } else { "" },
+                match (from, start.is_some()) {
+                    (Start::Best, true) => "*",
+                    (Start::Previous, true) => "+",
+                    _ => "",
+                },
+                out.cost,
+                ctx.evaluations(),
+                ctx.elapsed()
+            );
+        }
+        Ok(out)
+    }
+}
+
+impl Solver for Auto {
+    fn solve(&self, ctx: &mut Context) -> Result<Outcome> {
+        let choice = self.choose(ctx.model);
+        if super::trace_enabled() {
+            for l in choice.lines(&self.portfolio.source) {
+                eprintln!("auto: {l}");
+            }
+        }
+        let mut budget = ctx.budget;
+        if budget.time_limit.is_none() && budget.max_evals.is_none() {
+            budget.time_limit = Some(Duration::from_secs_f64(self.seconds));
+        }
+        let mut best: Option<Outcome> = None;
+        let keep = |best: &mut Option<Outcome>, o: Outcome| {
+            if best.as_ref().is_none_or(|b| o.cost < b.cost) {
+                *best = Some(o);
+            }
+        };
+        let beam_cfg = choice.beam;
+        let short = budget
+            .time_limit
+            .is_some_and(|t| t.as_secs_f64() < beam_cfg.min_seconds);
+        let mut after_beam = false;
+        if ctx.model.n() <= beam_cfg.max_cells && beam_cfg.share > 0.0 && !short {
+            let b = share(budget, 0, 0.0, beam_cfg.share);
+            let beam = Run {
+                name: "beam",
+                given: &BTreeMap::new(),
+                budget: b,
+                from: Start::Fresh,
+                start: None,
+                repeat: 0,
+                twin: None,
+            };
+            if let Ok(o) = self.phase(ctx, beam) {
+                if o.proven_optimal {
+                    return Ok(o);
+                }
+                keep(&mut best, o);
+                after_beam = true;
+            }
+        }
+        let plan = choice.plan(after_beam);
+        let mut last: Option<Outcome> = None;
+        let twin = if plan.iter().any(|p| p.reversed) {
+            ctx.instance.reversed_matrix().map(|i| {
+                let m = CostModel::new(&i, ctx.model.objective());
+                (i, m)
+            })
+        } else {
+            None
+        };
+        for (i, ph) in plan.iter().enumerate() {
+            // past the time limit, a later phase would only overrun it (its construction alone
+            // can take seconds on large instances): stop with the best so far
+            let late = budget
+                .time_limit
+                .is_some_and(|t| ctx.elapsed() >= t.as_secs_f64());
+            if late && best.is_some() {
+                break;
+            }
+            let b = share(budget, ctx.evaluations(), ctx.elapsed(), ph.share);
+            let start = match ph.start {
+                Start::Fresh => None,
+                Start::Best => best.as_ref(),
+                Start::Previous => last.as_ref(),
+            };
+            // how often this solver ran before in the plan: its seed's repeat index
+            let repeat = plan[..i].iter().filter(|p| p.solver == ph.solver).count() as u64;
+            let on = if ph.reversed { twin.as_ref() } else { None };
+            let run = Run {
+                name: &ph.solver,
+                given: &ph.params,
+                budget: b,
+                from: ph.start,
+                start,
+                repeat,
+                twin: on,
+            };
+            let o = self.phase(ctx, run)?;
+            keep(&mut best, o.clone());
+            last = Some(o);
+        }
+        let mut out = best.expect("at least one phase ran");
+        out.proven_optimal = false;
+        Ok(out)
+    }
+}
+
+/// What `auto` runs on one instance, for `cellseq solve --explain` (text or JSON).
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct Explanation {
+    /// The portfolio: `built-in` or the file's path.
+    pub portfolio: String,
+    /// The rule chosen ([`PLAN_RULE`] when the `plan` parameter replaced the selection).
+    pub rule: String,
+    /// The instance's features.
+    pub features: Features,
+    /// The beam phase's share of the budget.
+    pub beam_share: f64,
+    /// Largest instance that gets the beam phase (cells).
+    pub beam_max_cells: usize,
+    /// Shortest wall-clock budget that gets the beam phase (seconds).
+    pub beam_min_seconds: f64,
+    /// The phases, in plan syntax.
+    pub phases: String,
+    /// The phases after a beam phase that ran, when they differ.
+    pub after_beam: Option<String>,
+    /// The same as lines of text.
+    #[serde(skip)]
+    pub lines: Vec<String>,
+}
+
+/// What `auto` with parameters `given` would run on `instance` under `objective`: the
+/// portfolio, the rule, the features, the beam settings and the phases.
+pub fn explain(
+    instance: &Instance,
+    objective: crate::model::Objective,
+    given: &BTreeMap<String, String>,
+) -> Result<Explanation> {
+    let params = Params::new(INFO.name, INFO.params, given)?;
+    let auto = Auto::from_params(&params)?;
+    let model = CostModel::new(instance, objective);
+    let c = auto.choose(&model);
+    Ok(Explanation {
+        portfolio: auto.portfolio.source.clone(),
+        rule: c.rule.to_string(),
+        features: c.features.clone(),
+        beam_share: c.beam.share,
+        beam_max_cells: c.beam.max_cells,
+        beam_min_seconds: c.beam.min_seconds,
+        phases: plan_text(c.phases),
+        after_beam: c.after_beam.map(plan_text),
+        lines: c.lines(&auto.portfolio.source),
+    })
+}
