@@ -21,7 +21,7 @@
 //! assignment gives 900; with the multipliers, about the optimum minus a few percent of the
 //! part outside that cluster.
 
-use super::assignment;
+use super::assignment::{self, Assignment};
 use super::cells::CellGraph;
 use crate::precedence::Closure;
 use rustc_hash::FxHashMap;
@@ -97,12 +97,7 @@ pub fn sec_bound(
 ) -> Option<SecBound> {
     let n = g.n;
     let d = n + 1;
-    let mut sets: Vec<Vec<u32>> = Vec::new();
-    let mut pi: Vec<Vec<u32>> = Vec::new();
-    // each set's index in `sets`
-    let mut known: FxHashMap<Vec<u32>, usize> = FxHashMap::default();
-    let mut member: Vec<Vec<bool>> = Vec::new();
-    let mut mu: Vec<f64> = Vec::new();
+    let mut f = Family::default();
     let mut best: Option<SecBound> = None;
     let mut theta = 0.25;
     let mut stale = 0;
@@ -110,9 +105,9 @@ pub fn sec_bound(
     let mut ascent = true;
     for it in 0..iterations.max(1) {
         done = it + 1;
-        let ma = arc_multipliers(n, &sets, &pi, &mu);
+        let ma = arc_multipliers(n, &f.sets, &f.pi, &f.mu);
         let a = assignment::hungarian_duals(d, |i, j| g.c(i, j) - ma[i * d + j])?;
-        let value = a.value + mu.iter().sum::<f64>();
+        let value = a.value + f.mu.iter().sum::<f64>();
         if best
             .as_ref()
             .is_none_or(|b| value > b.value + 1e-9 * b.value.abs().max(1.0))
@@ -121,9 +116,9 @@ pub fn sec_bound(
                 value,
                 u: a.u.clone(),
                 v: a.v.clone(),
-                sets: sets.clone(),
-                pi: pi.clone(),
-                mu: mu.clone(),
+                sets: f.sets.clone(),
+                pi: f.pi.clone(),
+                mu: f.mu.clone(),
                 iterations: 0,
             });
             stale = 0;
@@ -134,74 +129,7 @@ pub fn sec_bound(
                 stale = 0;
             }
         }
-        // subtours avoiding home become new sets
-        let mut seen = vec![false; d];
-        let mut tours = 0;
-        let mut raised = false;
-        for s0 in 0..d {
-            if seen[s0] {
-                continue;
-            }
-            tours += 1;
-            let mut cyc = Vec::new();
-            let mut x = s0;
-            while !seen[x] {
-                seen[x] = true;
-                cyc.push(x as u32);
-                x = a.col[x];
-            }
-            if cyc.contains(&(n as u32)) || sets.len() >= max_sets {
-                continue;
-            }
-            cyc.sort_unstable();
-            let k = if let Some(&k) = known.get(&cyc) {
-                if !ascent {
-                    continue;
-                }
-                k
-            } else {
-                // `mem`: S ∪ π(S), the heads that do not count as leaving S
-                let mut mem = vec![false; d];
-                for &c in &cyc {
-                    mem[c as usize] = true;
-                }
-                let mut p = Vec::new();
-                if let Some(cl) = closure {
-                    for a in 0..n {
-                        if !mem[a] && cyc.iter().any(|&s| cl.before(a, s as usize)) {
-                            p.push(a as u32);
-                        }
-                    }
-                }
-                for &a in &p {
-                    mem[a as usize] = true;
-                }
-                member.push(mem);
-                pi.push(p);
-                known.insert(cyc.clone(), sets.len());
-                sets.push(cyc);
-                mu.push(0.0);
-                sets.len() - 1
-            };
-            if ascent {
-                // cheapest reduced cost of leaving the subtour
-                let mem = &member[k];
-                let mut delta = f64::INFINITY;
-                for &i in &sets[k] {
-                    let i = i as usize;
-                    for (j, inside) in mem.iter().enumerate() {
-                        let c = g.c(i, j);
-                        if !inside && c.is_finite() {
-                            delta = delta.min(c - ma[i * d + j] - a.u[i] - a.v[j]);
-                        }
-                    }
-                }
-                if delta.is_finite() && delta > 1e-9 * value.abs().max(1.0) {
-                    mu[k] += delta;
-                    raised = true;
-                }
-            }
-        }
+        let (tours, raised) = f.subtours(g, closure, &a, &ma, value, ascent, max_sets);
         if ascent {
             if raised {
                 continue;
@@ -218,25 +146,8 @@ pub fn sec_bound(
         {
             break;
         }
-        // subgradient 1 − (arcs leaving S); projected onto μ ≥ 0
-        let sub: Vec<f64> = sets
-            .iter()
-            .zip(&member)
-            .map(|(s, mem)| 1.0 - s.iter().filter(|&&i| !mem[a.col[i as usize]]).count() as f64)
-            .collect();
-        let norm: f64 = sub
-            .iter()
-            .zip(&mu)
-            .filter(|&(&s, &m)| !(m <= 0.0 && s < 0.0))
-            .map(|(s, _)| s * s)
-            .sum();
-        if norm == 0.0 || theta < 1e-4 {
+        if !f.subgradient_step(&a, theta, value, b, upper) {
             break;
-        }
-        let target = upper.unwrap_or(b + 0.05 * b.abs().max(1.0));
-        let step = theta * (target - value).max(1e-6 * b.abs().max(1.0)) / norm;
-        for (m, s) in mu.iter_mut().zip(&sub) {
-            *m = (*m + step * s).max(0.0);
         }
     }
     let mut b = best?;
@@ -247,6 +158,151 @@ pub fn sec_bound(
     b.mu = keep.iter().map(|&k| b.mu[k]).collect();
     b.iterations = done;
     Some(b)
+}
+
+/// The growing family of subtour-elimination sets of [`sec_bound`].
+#[derive(Default)]
+struct Family {
+    /// the sets (cells, sorted)
+    sets: Vec<Vec<u32>>,
+    /// per set, its predecessors outside it `π(S)`
+    pi: Vec<Vec<u32>>,
+    /// each set's index in `sets`
+    known: FxHashMap<Vec<u32>, usize>,
+    /// per set, `S ∪ π(S)` as a mask over cells and home: the heads that do not count as
+    /// leaving S
+    member: Vec<Vec<bool>>,
+    /// per set, its multiplier
+    mu: Vec<f64>,
+}
+
+impl Family {
+    /// Adds the set `cyc` (sorted cells) with its `π(S)` from `closure` and `μ = 0`; returns
+    /// its index.
+    fn add(&mut self, cyc: Vec<u32>, closure: Option<&Closure>, n: usize) -> usize {
+        // `mem`: S ∪ π(S), the heads that do not count as leaving S
+        let mut mem = vec![false; n + 1];
+        for &c in &cyc {
+            mem[c as usize] = true;
+        }
+        let mut p = Vec::new();
+        if let Some(cl) = closure {
+            for a in 0..n {
+                if !mem[a] && cyc.iter().any(|&s| cl.before(a, s as usize)) {
+                    p.push(a as u32);
+                }
+            }
+        }
+        for &a in &p {
+            mem[a as usize] = true;
+        }
+        self.member.push(mem);
+        self.pi.push(p);
+        self.known.insert(cyc.clone(), self.sets.len());
+        self.sets.push(cyc);
+        self.mu.push(0.0);
+        self.sets.len() - 1
+    }
+
+    /// Walks the cycles of the assignment `a` (on costs net of the multipliers `ma`, bound
+    /// `value`): subtours avoiding home become new sets (up to `max_sets`), and during the
+    /// `ascent` each subtour's multiplier rises by the cheapest reduced cost of leaving it.
+    /// Returns the number of cycles and whether some multiplier rose.
+    #[allow(clippy::too_many_arguments)]
+    fn subtours(
+        &mut self,
+        g: &CellGraph,
+        closure: Option<&Closure>,
+        a: &Assignment,
+        ma: &[f64],
+        value: f64,
+        ascent: bool,
+        max_sets: usize,
+    ) -> (usize, bool) {
+        let n = g.n;
+        let d = n + 1;
+        let mut seen = vec![false; d];
+        let mut tours = 0;
+        let mut raised = false;
+        for s0 in 0..d {
+            if seen[s0] {
+                continue;
+            }
+            tours += 1;
+            let mut cyc = Vec::new();
+            let mut x = s0;
+            while !seen[x] {
+                seen[x] = true;
+                cyc.push(x as u32);
+                x = a.col[x];
+            }
+            if cyc.contains(&(n as u32)) || self.sets.len() >= max_sets {
+                continue;
+            }
+            cyc.sort_unstable();
+            let k = if let Some(&k) = self.known.get(&cyc) {
+                if !ascent {
+                    continue;
+                }
+                k
+            } else {
+                self.add(cyc, closure, n)
+            };
+            if ascent {
+                // cheapest reduced cost of leaving the subtour
+                let mem = &self.member[k];
+                let mut delta = f64::INFINITY;
+                for &i in &self.sets[k] {
+                    let i = i as usize;
+                    for (j, inside) in mem.iter().enumerate() {
+                        let c = g.c(i, j);
+                        if !inside && c.is_finite() {
+                            delta = delta.min(c - ma[i * d + j] - a.u[i] - a.v[j]);
+                        }
+                    }
+                }
+                if delta.is_finite() && delta > 1e-9 * value.abs().max(1.0) {
+                    self.mu[k] += delta;
+                    raised = true;
+                }
+            }
+        }
+        (tours, raised)
+    }
+
+    /// One subgradient step `μ_S += step · (1 − arcs of `a` leaving S)`, projected onto
+    /// `μ ≥ 0`, a Polyak step towards `upper` (or 5 % above the best bound `b`) scaled by
+    /// `theta`; false when there is no direction or `theta` is spent.
+    fn subgradient_step(
+        &mut self,
+        a: &Assignment,
+        theta: f64,
+        value: f64,
+        b: f64,
+        upper: Option<f64>,
+    ) -> bool {
+        let sub: Vec<f64> = self
+            .sets
+            .iter()
+            .zip(&self.member)
+            .map(|(s, mem)| 1.0 - s.iter().filter(|&&i| !mem[a.col[i as usize]]).count() as f64)
+            .collect();
+        let norm: f64 = sub
+            .iter()
+            .zip(&self.mu)
+            .filter(|&(&s, &m)| !(m <= 0.0 && s < 0.0))
+            .map(|(s, _)| s * s)
+            .sum();
+        if norm == 0.0 || theta < 1e-4 {
+            return false;
+        }
+        let target = upper.unwrap_or(b + 0.05 * b.abs().max(1.0));
+        let step = theta * (target - value).max(1e-6 * b.abs().max(1.0)) / norm;
+        for (m, s) in self.mu.iter_mut().zip(&sub) {
+            *m = (*m + step * s).max(0.0);
+        }
+        true
+    }
 }
 
 /// Subgradient iterations affordable within about `work` elementary steps (d³ per

@@ -185,15 +185,20 @@ impl<'a> Large<'a> {
 
     /// The best improving move around cell `x` and the number of deltas evaluated.
     fn best_move(&self, x: u32) -> (f64, Move, u64) {
-        let m = self.c.m;
-        let t = &self.t;
-        let n = t.n();
-        let nb = self.nb;
         let mut best = (0.0, Move::None);
         let mut evals = 0u64;
-        let q = t.pos(x);
-        let px = t.prev(x);
-        let nx = t.next(x);
+        self.mode_moves(x, &mut best, &mut evals);
+        let lx = self.link(self.sl(self.t.prev(x)), self.sl(Some(x)));
+        self.two_opt_moves(x, lx, &mut best, &mut evals);
+        self.or_moves(x, lx, &mut best, &mut evals);
+        (best.0, best.1, evals)
+    }
+
+    /// Mode changes of cell `x` in place, where better than `best`.
+    fn mode_moves(&self, x: u32, best: &mut (f64, Move), evals: &mut u64) {
+        let m = self.c.m;
+        let t = &self.t;
+        let (px, nx) = (t.prev(x), t.next(x));
         // mode change
         let k = m.modes(x as usize) as u32;
         if k > 1 {
@@ -203,17 +208,25 @@ impl<'a> Large<'a> {
                 + self.link(Some((x as usize, cur as usize)), b);
             for md in 0..k {
                 if md != cur {
-                    evals += 1;
+                    *evals += 1;
                     let s = Some((x as usize, md as usize));
                     let d = self.link(a, s) + self.link(s, b) - here;
                     if d < best.0 {
-                        best = (d, Move::Mode(x, md));
+                        *best = (d, Move::Mode(x, md));
                     }
                 }
             }
         }
+    }
+
+    /// 2-opt moves with an end at cell `x` (new links x → y' or x' → y for y after x,
+    /// y → x' or y' → x for y before x), where better than `best`; `lx`: the link into x.
+    fn two_opt_moves(&self, x: u32, lx: f64, best: &mut (f64, Move), evals: &mut u64) {
+        let t = &self.t;
+        let nb = self.nb;
+        let q = t.pos(x);
+        let (px, nx) = (t.prev(x), t.next(x));
         // 2-opt: new links x → y' or x' → y (y after x), y → x' or y' → x (y before x)
-        let lx = self.link(self.sl(px), self.sl(Some(x)));
         let rx = self.link(self.sl(Some(x)), self.sl(nx));
         let (flx, frx) = (self.fl(Some(x)), self.sl(Some(x)));
         for (k, &y) in nb.out[x as usize].iter().chain(t.last().iter()).enumerate() {
@@ -224,12 +237,12 @@ impl<'a> Large<'a> {
             let ny = t.next(y);
             let py = t.prev(y);
             // reverse [q+1..=r]: x → y', (x+1)' → y+1
-            evals += 2;
+            *evals += 2;
             let d = self.link(frx, self.fl(Some(y))) + self.link(self.fl(nx), self.sl(ny))
                 - rx
                 - self.link(self.sl(Some(y)), self.sl(ny));
             if d < best.0 && self.reversible(q + 1, r) {
-                best = (d, Move::Rev(q + 1, r));
+                *best = (d, Move::Rev(q + 1, r));
             }
             // reverse [q..=r-1]: x-1 → (y-1)', x' → y
             if r - 1 > q {
@@ -237,7 +250,7 @@ impl<'a> Large<'a> {
                     - lx
                     - self.link(self.sl(py), self.sl(Some(y)));
                 if d < best.0 && self.reversible(q, r - 1) {
-                    best = (d, Move::Rev(q, r - 1));
+                    *best = (d, Move::Rev(q, r - 1));
                 }
             }
         }
@@ -252,22 +265,33 @@ impl<'a> Large<'a> {
             }
             let ny = t.next(y);
             let py = t.prev(y);
-            evals += 2;
+            *evals += 2;
             // reverse [r+1..=q]: y → x', (y+1)' → x+1
             let d = self.link(self.sl(Some(y)), flx) + self.link(self.fl(ny), self.sl(nx))
                 - self.link(self.sl(Some(y)), self.sl(ny))
                 - rx;
             if d < best.0 && self.reversible(r + 1, q) {
-                best = (d, Move::Rev(r + 1, q));
+                *best = (d, Move::Rev(r + 1, q));
             }
             // reverse [r..=q-1]: y-1 → (x-1)', y' → x
             let d = self.link(self.sl(py), self.fl(px)) + self.link(self.fl(Some(y)), frx)
                 - self.link(self.sl(py), self.sl(Some(y)))
                 - lx;
             if d < best.0 && self.reversible(r, q - 1) {
-                best = (d, Move::Rev(r, q - 1));
+                *best = (d, Move::Rev(r, q - 1));
             }
         }
+    }
+
+    /// Or-opt moves of the segments x, x+1, x+2 (following the path), kept or reversed, to
+    /// an insertion point next to a candidate neighbour, where better than `best`; `lx`: the
+    /// link into x.
+    fn or_moves(&self, x: u32, lx: f64, best: &mut (f64, Move), evals: &mut u64) {
+        let t = &self.t;
+        let n = t.n();
+        let nb = self.nb;
+        let q = t.pos(x);
+        let px = t.prev(x);
         // Or-opt: segments x, x+1, x+2 following the path
         let mut seg = [x; 3];
         let mut len = 0usize;
@@ -328,22 +352,21 @@ impl<'a> Large<'a> {
                 };
                 let (a, b) = (self.sl(v), self.sl(w));
                 let open = self.link(a, b);
-                evals += 1;
+                *evals += 1;
                 let d = close + self.link(a, sf) + self.link(sl, b) - open;
                 if d < best.0 {
-                    best = (d, Move::Or(q, len, p, false));
+                    *best = (d, Move::Or(q, len, p, false));
                 }
                 if rev_ok {
-                    evals += 1;
+                    *evals += 1;
                     let d = close + inner_rev + self.link(a, fl) + self.link(ff, b) - open;
                     if d < best.0 {
-                        best = (d, Move::Or(q, len, p, true));
+                        *best = (d, Move::Or(q, len, p, true));
                     }
                 }
             }
             y = after;
         }
-        (best.0, best.1, evals)
     }
 
     fn apply_reverse(&mut self, i: usize, j: usize, d: f64) {

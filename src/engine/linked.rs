@@ -100,8 +100,6 @@ pub fn or_opt(c: &Costs, nb: &Neighbours, s: &mut Solution, ctx: &mut Context) -
     let mut on = vec![true; n];
     let mut queue: VecDeque<u32> = s.order.iter().copied().collect();
     let mut improved = false;
-    let mut seg_modes = [0u32; 3];
-    let mut seg = [0u32; 3];
     while let Some(x) = queue.pop_front() {
         on[x as usize] = false;
         if ctx.exhausted() {
@@ -116,166 +114,15 @@ pub fn or_opt(c: &Costs, nb: &Neighbours, s: &mut Solution, ctx: &mut Context) -
             w: 0,
             rev: false,
         };
-        // in-place mode change
-        let (p, q) = (l.ord.prev[x as usize], l.ord.next[x as usize]);
-        let here = l.cur(c, p, x) + l.cur(c, x, q);
-        for mx in 0..m.modes(x as usize) as u32 {
-            if mx == l.mode[x as usize] {
-                continue;
-            }
-            evals += 1;
-            let dl = l.link(c, p, l.md(p), x, mx) + l.link(c, x, mx, q, l.md(q)) - here;
-            if dl < best.delta {
-                best = Found {
-                    delta: dl,
-                    f: x,
-                    l: x,
-                    v: u32::MAX,
-                    w: mx,
-                    rev: false,
-                };
-            }
-        }
-        // segments x, x+1, x+2 following the order
-        let mut len = 0usize;
-        let mut y = x;
-        let mut can_rev = true;
-        while len < 3 && y != d {
-            seg[len] = y;
-            match m.turned(y as usize, l.mode[y as usize] as usize) {
-                Some(t) => seg_modes[len] = t as u32,
-                None => can_rev = false,
-            }
-            len += 1;
-            let (f, lst) = (seg[0], seg[len - 1]);
-            let (p, q) = (l.ord.prev[f as usize], l.ord.next[lst as usize]);
-            let gain = l.cur(c, p, f) + l.cur(c, lst, q) - l.cur(c, p, q);
-            let inside = |z: u32| seg[..len].contains(&z);
-            // labels the new place must lie between: after every outside predecessor, before
-            // every outside successor (read once per segment, O(1) per candidate)
-            let (lo, hi) = if prec {
-                bounds(m, &l.ord, &seg[..len])
-            } else {
-                (0, u64::MAX)
-            };
-            let fits = |v: u32, w: u32| l.ord.after(v) >= lo && l.ord.before(w) <= hi;
-            let rev_ok = !prec || reversible(m, &seg[..len]);
-            let (mf, ml) = (l.mode[f as usize], l.mode[lst as usize]);
-            let (rf, rl) = (seg_modes[0], seg_modes[len - 1]);
-            // candidate insertion edges (v, w = next v), forward: v → f … lst → w;
-            // reversed: v → lst' … f' → w
-            for v in insertion_points(nb, &l, f, lst) {
-                let w = l.ord.next[v as usize];
-                if inside(v) || inside(w) || v == p {
-                    continue;
-                }
-                if !fits(v, w) {
-                    continue;
-                }
-                evals += 1;
-                let dl = l.link(c, v, l.md(v), f, mf) + l.link(c, lst, ml, w, l.md(w))
-                    - l.cur(c, v, w)
-                    - gain;
-                if dl < best.delta {
-                    best = Found {
-                        delta: dl,
-                        f,
-                        l: lst,
-                        v,
-                        w,
-                        rev: false,
-                    };
-                }
-            }
-            if can_rev && (len > 1 || rf != mf) {
-                for v in insertion_points(nb, &l, lst, f) {
-                    let w = l.ord.next[v as usize];
-                    // v == p (then w == f) reverses the segment in place
-                    if inside(v) || (v != p && inside(w)) {
-                        continue;
-                    }
-                    let (vv, ww) = if v == p { (p, q) } else { (v, w) };
-                    if !rev_ok || !fits(vv, ww) {
-                        continue;
-                    }
-                    let removed = if v == p {
-                        l.cur(c, p, f) + l.cur(c, lst, q)
-                    } else {
-                        l.cur(c, v, w) + gain
-                    };
-                    evals += 1;
-                    let mut dl =
-                        l.link(c, vv, l.md(vv), lst, rl) + l.link(c, f, rf, ww, l.md(ww)) - removed;
-                    // inner links of the reversed segment
-                    for k in 0..len - 1 {
-                        let (a, b) = (seg[k], seg[k + 1]);
-                        dl += l.link(c, b, seg_modes[k + 1], a, seg_modes[k]) - l.cur(c, a, b);
-                    }
-                    if dl < best.delta {
-                        best = Found {
-                            delta: dl,
-                            f,
-                            l: lst,
-                            v,
-                            w,
-                            rev: true,
-                        };
-                    }
-                }
-            }
-            y = l.ord.next[y as usize];
-        }
+        mode_change(c, &l, x, &mut best, &mut evals);
+        segment_moves(c, nb, &l, x, prec, &mut best, &mut evals);
         ctx.count(evals);
         if !super::search::improves(best.delta, s.cost) {
             continue;
         }
         improved = true;
         s.cost += best.delta;
-        let mut touched = [d; 7];
-        if best.v == u32::MAX {
-            l.mode[x as usize] = best.w;
-            touched[..3].copy_from_slice(&[l.ord.prev[x as usize], x, l.ord.next[x as usize]]);
-        } else {
-            let (f, lst) = (best.f, best.l);
-            let (p, q) = (l.ord.prev[f as usize], l.ord.next[lst as usize]);
-            // the segment's cells, first to last
-            let mut cells = [d; 3];
-            let mut k = 0;
-            let mut z = f;
-            loop {
-                cells[k] = z;
-                k += 1;
-                if z == lst {
-                    break;
-                }
-                z = l.ord.next[z as usize];
-            }
-            // insertion edge (v, w) once the segment is unlinked
-            let (v, w) = if best.v == p {
-                (p, q)
-            } else {
-                (best.v, best.w)
-            };
-            for &z in &cells[..k] {
-                l.ord.unlink(z);
-            }
-            let mut order = cells;
-            if best.rev {
-                order[..k].reverse();
-            }
-            let mut a = v;
-            for &z in &order[..k] {
-                if best.rev {
-                    let md = l.mode[z as usize] as usize;
-                    l.mode[z as usize] = m.turned_or_same(z as usize, md) as u32;
-                }
-                l.ord.insert_after(a, z);
-                a = z;
-            }
-            touched[..k].copy_from_slice(&cells[..k]);
-            touched[3..7].copy_from_slice(&[p, q, v, w]);
-        }
-        for z in touched {
+        for z in apply(m, &mut l, &best, x) {
             if z != d && !on[z as usize] {
                 on[z as usize] = true;
                 queue.push_back(z);
@@ -289,6 +136,189 @@ pub fn or_opt(c: &Costs, nb: &Neighbours, s: &mut Solution, ctx: &mut Context) -
     }
     s.mode = l.mode;
     improved
+}
+
+/// The best in-place mode change of cell `x`, if better than `best`.
+fn mode_change(c: &Costs, l: &List, x: u32, best: &mut Found, evals: &mut u64) {
+    let m = c.m;
+    // in-place mode change
+    let (p, q) = (l.ord.prev[x as usize], l.ord.next[x as usize]);
+    let here = l.cur(c, p, x) + l.cur(c, x, q);
+    for mx in 0..m.modes(x as usize) as u32 {
+        if mx == l.mode[x as usize] {
+            continue;
+        }
+        *evals += 1;
+        let dl = l.link(c, p, l.md(p), x, mx) + l.link(c, x, mx, q, l.md(q)) - here;
+        if dl < best.delta {
+            *best = Found {
+                delta: dl,
+                f: x,
+                l: x,
+                v: u32::MAX,
+                w: mx,
+                rev: false,
+            };
+        }
+    }
+}
+
+/// The best Or-opt move of the segments x, x+1, x+2 (following the order), kept or reversed,
+/// to an insertion point next to a candidate neighbour, if better than `best` (`prec`: the
+/// instance has precedence).
+fn segment_moves(
+    c: &Costs,
+    nb: &Neighbours,
+    l: &List,
+    x: u32,
+    prec: bool,
+    best: &mut Found,
+    evals: &mut u64,
+) {
+    let m = c.m;
+    let d = l.mode.len() as u32;
+    let mut seg_modes = [0u32; 3];
+    let mut seg = [0u32; 3];
+    // segments x, x+1, x+2 following the order
+    let mut len = 0usize;
+    let mut y = x;
+    let mut can_rev = true;
+    while len < 3 && y != d {
+        seg[len] = y;
+        match m.turned(y as usize, l.mode[y as usize] as usize) {
+            Some(t) => seg_modes[len] = t as u32,
+            None => can_rev = false,
+        }
+        len += 1;
+        let (f, lst) = (seg[0], seg[len - 1]);
+        let (p, q) = (l.ord.prev[f as usize], l.ord.next[lst as usize]);
+        let gain = l.cur(c, p, f) + l.cur(c, lst, q) - l.cur(c, p, q);
+        let inside = |z: u32| seg[..len].contains(&z);
+        // labels the new place must lie between: after every outside predecessor, before
+        // every outside successor (read once per segment, O(1) per candidate)
+        let (lo, hi) = if prec {
+            bounds(m, &l.ord, &seg[..len])
+        } else {
+            (0, u64::MAX)
+        };
+        let fits = |v: u32, w: u32| l.ord.after(v) >= lo && l.ord.before(w) <= hi;
+        let rev_ok = !prec || reversible(m, &seg[..len]);
+        let (mf, ml) = (l.mode[f as usize], l.mode[lst as usize]);
+        let (rf, rl) = (seg_modes[0], seg_modes[len - 1]);
+        // candidate insertion edges (v, w = next v), forward: v → f … lst → w;
+        // reversed: v → lst' … f' → w
+        for v in insertion_points(nb, l, f, lst) {
+            let w = l.ord.next[v as usize];
+            if inside(v) || inside(w) || v == p {
+                continue;
+            }
+            if !fits(v, w) {
+                continue;
+            }
+            *evals += 1;
+            let dl = l.link(c, v, l.md(v), f, mf) + l.link(c, lst, ml, w, l.md(w))
+                - l.cur(c, v, w)
+                - gain;
+            if dl < best.delta {
+                *best = Found {
+                    delta: dl,
+                    f,
+                    l: lst,
+                    v,
+                    w,
+                    rev: false,
+                };
+            }
+        }
+        if can_rev && (len > 1 || rf != mf) {
+            for v in insertion_points(nb, l, lst, f) {
+                let w = l.ord.next[v as usize];
+                // v == p (then w == f) reverses the segment in place
+                if inside(v) || (v != p && inside(w)) {
+                    continue;
+                }
+                let (vv, ww) = if v == p { (p, q) } else { (v, w) };
+                if !rev_ok || !fits(vv, ww) {
+                    continue;
+                }
+                let removed = if v == p {
+                    l.cur(c, p, f) + l.cur(c, lst, q)
+                } else {
+                    l.cur(c, v, w) + gain
+                };
+                *evals += 1;
+                let mut dl =
+                    l.link(c, vv, l.md(vv), lst, rl) + l.link(c, f, rf, ww, l.md(ww)) - removed;
+                // inner links of the reversed segment
+                for k in 0..len - 1 {
+                    let (a, b) = (seg[k], seg[k + 1]);
+                    dl += l.link(c, b, seg_modes[k + 1], a, seg_modes[k]) - l.cur(c, a, b);
+                }
+                if dl < best.delta {
+                    *best = Found {
+                        delta: dl,
+                        f,
+                        l: lst,
+                        v,
+                        w,
+                        rev: true,
+                    };
+                }
+            }
+        }
+        y = l.ord.next[y as usize];
+    }
+}
+
+/// Applies the move `best` found for the looked-at cell `x` to the list; returns the cells
+/// whose links changed (the sentinel where fewer).
+fn apply(m: &CostModel, l: &mut List, best: &Found, x: u32) -> [u32; 7] {
+    let d = l.mode.len() as u32;
+    let mut touched = [d; 7];
+    if best.v == u32::MAX {
+        l.mode[x as usize] = best.w;
+        touched[..3].copy_from_slice(&[l.ord.prev[x as usize], x, l.ord.next[x as usize]]);
+    } else {
+        let (f, lst) = (best.f, best.l);
+        let (p, q) = (l.ord.prev[f as usize], l.ord.next[lst as usize]);
+        // the segment's cells, first to last
+        let mut cells = [d; 3];
+        let mut k = 0;
+        let mut z = f;
+        loop {
+            cells[k] = z;
+            k += 1;
+            if z == lst {
+                break;
+            }
+            z = l.ord.next[z as usize];
+        }
+        // insertion edge (v, w) once the segment is unlinked
+        let (v, w) = if best.v == p {
+            (p, q)
+        } else {
+            (best.v, best.w)
+        };
+        for &z in &cells[..k] {
+            l.ord.unlink(z);
+        }
+        let mut order = cells;
+        if best.rev {
+            order[..k].reverse();
+        }
+        let mut a = v;
+        for &z in &order[..k] {
+            if best.rev {
+                let md = l.mode[z as usize] as usize;
+                l.mode[z as usize] = m.turned_or_same(z as usize, md) as u32;
+            }
+            l.ord.insert_after(a, z);
+            a = z;
+        }
+        touched[..k].copy_from_slice(&cells[..k]);
+        touched[3..7].copy_from_slice(&[p, q, v, w]);
+    }
+    touched
 }
 
 /// The highest label among the outside predecessors of the segment `seg` (0 if none) and the

@@ -145,6 +145,49 @@ pub fn parse_pcgtsp(file: &str, text: &str) -> Result<Instance> {
     if p.get("GTSP_SETS").is_some() {
         return super::tsplib::parse_pcglns(file, text);
     }
+    let (dim, ngroups) = header(file, &p)?;
+    let weight = node_weights(file, &p, dim)?;
+    let (group_of, groups) = node_groups(file, &p, dim, ngroups)?;
+    let mut new_index = vec![0usize; dim];
+    for (k, &v) in groups.iter().flatten().enumerate() {
+        new_index[v] = k;
+    }
+    let (costs, mut edges) = matrix(file, &p, &weight, &group_of, &new_index)?;
+    let start = start_group(file, &p, &groups)?;
+    for g in 0..ngroups {
+        if g != start {
+            edges.insert((start, g));
+        }
+    }
+    let cells = groups
+        .iter()
+        .enumerate()
+        .map(|(g, nodes)| Cell::new((g + 1).to_string(), "", vec![Mode::default(); nodes.len()]))
+        .collect();
+    Ok(Instance {
+        name: instance_name(&p, file),
+        meta: Metadata {
+            generator: Some("pcgtsp".into()),
+            comment: p.get("COMMENT").map(|(_, v)| v.to_string()),
+            ..Default::default()
+        },
+        cells,
+        precedence: edges.into_iter().collect(),
+        matrix: Some(CostMatrix { size: dim, costs }),
+        first: Some(start),
+        closed: true,
+        ..Instance::default()
+    })
+}
+
+/// The error for a missing section `name` (at the file's last line).
+fn missing(file: &str, p: &Parts, name: &str) -> Error {
+    Error::parse(file, p.last_line, format!("missing {name}"))
+}
+
+/// The header's checks: the type and the matrix format, `DIMENSION` (within the node
+/// limit) and `GROUPS` (at most one per node); returns both.
+fn header(file: &str, p: &Parts) -> Result<(usize, usize)> {
     if let Some((ln, t)) = p.get("TYPE")
         && t != "PCGTSP"
     {
@@ -172,8 +215,8 @@ pub fn parse_pcgtsp(file: &str, text: &str) -> Result<Instance> {
             format!("EDGE_WEIGHT_FORMAT {v} is not supported (FULL_MATRIX only)"),
         ));
     }
-    let (dim_line, dim) = positive(file, &p, "DIMENSION")?;
-    let (groups_line, ngroups) = positive(file, &p, "GROUPS")?;
+    let (dim_line, dim) = positive(file, p, "DIMENSION")?;
+    let (groups_line, ngroups) = positive(file, p, "GROUPS")?;
     let limit = max_nodes();
     if dim > limit {
         return Err(Error::parse(
@@ -193,9 +236,12 @@ pub fn parse_pcgtsp(file: &str, text: &str) -> Result<Instance> {
             format!("GROUPS {ngroups} is more than the {dim} nodes (every group needs a node)"),
         ));
     }
-    let missing = |name: &str| Error::parse(file, p.last_line, format!("missing {name}"));
+    Ok((dim, ngroups))
+}
+
+/// The node weights of `NODE_WEIGHT_SECTION` (0 when the section is absent).
+fn node_weights(file: &str, p: &Parts, dim: usize) -> Result<Vec<f64>> {
     let max = crate::validate::MAX_MATRIX_COST;
-    // node weights (optional: 0 when absent)
     let mut weight = vec![0.0; dim];
     if let Some(lines) = p.section("NODE_WEIGHT_SECTION") {
         let mut k = 0;
@@ -230,12 +276,21 @@ pub fn parse_pcgtsp(file: &str, text: &str) -> Result<Instance> {
             ));
         }
     }
-    // groups
+    Ok(weight)
+}
+
+/// `NODE_GROUP_SECTION`: each node's group and each group's nodes.
+fn node_groups(
+    file: &str,
+    p: &Parts,
+    dim: usize,
+    ngroups: usize,
+) -> Result<(Vec<usize>, Vec<Vec<usize>>)> {
     let mut group_of = vec![usize::MAX; dim];
     let mut groups: Vec<Vec<usize>> = vec![Vec::new(); ngroups];
     for &(ln, line) in p
         .section("NODE_GROUP_SECTION")
-        .ok_or_else(|| missing("NODE_GROUP_SECTION"))?
+        .ok_or_else(|| missing(file, p, "NODE_GROUP_SECTION"))?
     {
         let nums = list(file, ln, line)?;
         let g = group_number(file, ln, nums[0], ngroups)?;
@@ -256,14 +311,25 @@ pub fn parse_pcgtsp(file: &str, text: &str) -> Result<Instance> {
         add_to_group(file, ln, g, &nums[1..], &mut group_of, &mut groups)?;
     }
     groups_complete(file, &groups, &group_of)?;
-    let mut new_index = vec![0usize; dim];
-    for (k, &v) in groups.iter().flatten().enumerate() {
-        new_index[v] = k;
-    }
+    Ok((group_of, groups))
+}
+
+/// `EDGE_WEIGHT_SECTION`: the costs, node weights added, rows and columns in group order
+/// (`new_index`), and the precedence pairs of groups its -1 entries give.
+#[allow(clippy::type_complexity)]
+fn matrix(
+    file: &str,
+    p: &Parts,
+    weight: &[f64],
+    group_of: &[usize],
+    new_index: &[usize],
+) -> Result<(Vec<f64>, BTreeSet<(usize, usize)>)> {
+    let dim = weight.len();
+    let max = crate::validate::MAX_MATRIX_COST;
     // the matrix: count what the section holds before allocating dim x dim
     let lines = p
         .section("EDGE_WEIGHT_SECTION")
-        .ok_or_else(|| missing("EDGE_WEIGHT_SECTION"))?;
+        .ok_or_else(|| missing(file, p, "EDGE_WEIGHT_SECTION"))?;
     let need = dim * dim;
     let have = tokens(lines).take(need + 1).count();
     if have != need {
@@ -326,10 +392,15 @@ pub fn parse_pcgtsp(file: &str, text: &str) -> Result<Instance> {
         }
         costs[slot] = if i == j { 0.0 } else { with_weight };
     }
-    // start group
+    Ok((costs, edges))
+}
+
+/// `START_GROUP_SECTION`: the start group, which must hold a single node.
+fn start_group(file: &str, p: &Parts, groups: &[Vec<usize>]) -> Result<usize> {
+    let ngroups = groups.len();
     let start_lines = p
         .section("START_GROUP_SECTION")
-        .ok_or_else(|| missing("START_GROUP_SECTION"))?;
+        .ok_or_else(|| missing(file, p, "START_GROUP_SECTION"))?;
     let mut it = tokens(start_lines);
     let Some((ln, t)) = it.next() else {
         return Err(Error::parse(
@@ -360,30 +431,7 @@ pub fn parse_pcgtsp(file: &str, text: &str) -> Result<Instance> {
             ),
         ));
     }
-    for g in 0..ngroups {
-        if g != start {
-            edges.insert((start, g));
-        }
-    }
-    let cells = groups
-        .iter()
-        .enumerate()
-        .map(|(g, nodes)| Cell::new((g + 1).to_string(), "", vec![Mode::default(); nodes.len()]))
-        .collect();
-    Ok(Instance {
-        name: instance_name(&p, file),
-        meta: Metadata {
-            generator: Some("pcgtsp".into()),
-            comment: p.get("COMMENT").map(|(_, v)| v.to_string()),
-            ..Default::default()
-        },
-        cells,
-        precedence: edges.into_iter().collect(),
-        matrix: Some(CostMatrix { size: dim, costs }),
-        first: Some(start),
-        closed: true,
-        ..Instance::default()
-    })
+    Ok(start)
 }
 
 fn instance_name(p: &Parts, file: &str) -> String {

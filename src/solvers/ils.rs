@@ -405,7 +405,6 @@ impl Ils {
         }
         let mut best = cur.clone();
         ctx.report(best.cost + m.constant());
-        let multimode = m.multimode();
         let max_seg = if self.max_seg > 0 {
             self.max_seg
         } else {
@@ -460,41 +459,13 @@ impl Ils {
                 since_best += 1;
                 continue;
             }
-            loop {
-                let a = search.or_opt_seeded(&mut trial, ctx, &seeds);
-                let b = if !self.sop3 {
-                    false
-                } else if self.two_way {
-                    sop3_two_way(&search, &mut w, &mut trial, ctx, &seeds)
-                } else {
-                    search.sop3_seeded(&mut trial, ctx, &seeds)
-                };
-                let l = match lk.as_mut() {
-                    Some(lk) => lk.improve(&c, &search.nb, &mut trial, ctx, &seeds),
-                    None => false,
-                };
-                if !(a || b || l) || ctx.exhausted() {
-                    break;
-                }
-            }
-            if self.shift_repair > 0 && !seeds.is_empty() {
-                let k = self.shift_repair;
-                let (mut lo, mut hi) = (usize::MAX, 0usize);
-                for &x in &seeds {
-                    let p = trial.pos[x as usize] as usize;
-                    lo = lo.min(p);
-                    hi = hi.max(p);
-                }
-                let lo = lo.saturating_sub(k);
-                let hi = (hi + k + 1).min(n);
-                shift_gains += shift_repair.improve_range(&c, &mut trial, ctx, lo, hi) as u64;
-            }
-            if multimode {
-                search.modes(&mut trial, ctx);
-                if self.window_repair {
-                    search.windows(&mut trial, ctx, Some(&seeds));
-                }
-            }
+            shift_gains += self.repair(
+                ctx,
+                &c,
+                (&mut search, lk.as_mut(), &mut w, &mut shift_repair),
+                &mut trial,
+                &seeds,
+            );
             since_best += 1;
             since_restart += 1;
             // a repaired kick that does not beat the best may still hold better segments:
@@ -541,5 +512,58 @@ impl Ils {
             );
         }
         Ok(outcome(m, &best))
+    }
+
+    /// Repairs a kicked `trial` around the kicked cells `seeds`: Or-opt, SOP-3-exchange and
+    /// Lin–Kernighan to a local optimum, the shift DP over the kicked range, then the modes
+    /// (and windows). `moves`: the search, Lin–Kernighan, the two-way SOP-3 scratch and the
+    /// shift DP. Returns the number of improvements by the shift DP.
+    fn repair(
+        &self,
+        ctx: &mut Context,
+        c: &Costs,
+        moves: (&mut Search, Option<&mut Lk>, &mut TwoWay, &mut ShiftDp),
+        trial: &mut Solution,
+        seeds: &[u32],
+    ) -> u64 {
+        let (search, mut lk, w, shift_repair) = moves;
+        let n = ctx.model.n();
+        loop {
+            let a = search.or_opt_seeded(trial, ctx, seeds);
+            let b = if !self.sop3 {
+                false
+            } else if self.two_way {
+                sop3_two_way(search, w, trial, ctx, seeds)
+            } else {
+                search.sop3_seeded(trial, ctx, seeds)
+            };
+            let l = match lk.as_deref_mut() {
+                Some(lk) => lk.improve(c, &search.nb, trial, ctx, seeds),
+                None => false,
+            };
+            if !(a || b || l) || ctx.exhausted() {
+                break;
+            }
+        }
+        let mut gains = 0;
+        if self.shift_repair > 0 && !seeds.is_empty() {
+            let k = self.shift_repair;
+            let (mut lo, mut hi) = (usize::MAX, 0usize);
+            for &x in seeds {
+                let p = trial.pos[x as usize] as usize;
+                lo = lo.min(p);
+                hi = hi.max(p);
+            }
+            let lo = lo.saturating_sub(k);
+            let hi = (hi + k + 1).min(n);
+            gains += shift_repair.improve_range(c, trial, ctx, lo, hi) as u64;
+        }
+        if ctx.model.multimode() {
+            search.modes(trial, ctx);
+            if self.window_repair {
+                search.windows(trial, ctx, Some(seeds));
+            }
+        }
+        gains
     }
 }

@@ -6,23 +6,13 @@
 
 use cellseq::formats::{self, Format};
 use cellseq::model::{CostMatrix, Instance, Mode};
-use cellseq::solvers::{self, Budget, NoObserver};
+use cellseq::solvers::{self, Budget};
 use cellseq::{Cell, Objective, Visit};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
-use std::process::Output;
 
-fn cellseq(args: &[&str]) -> Output {
-    crate::common::cellseq().args(args).output().unwrap()
-}
-
-fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
-    let p = dir.join(name);
-    std::fs::write(&p, text).unwrap();
-    p
-}
+use crate::common::{run as cellseq, solve, solve_with, write};
 
 /// `validate`, `info`, `bound` and `solve` (with each solver given) all refuse `text` with one line holding
 /// the file name and every needle, exit code 2 and no panic.
@@ -449,16 +439,8 @@ fn exact_path_read_back_matches_enumeration() {
         let n = rng.random_range(2..=5usize);
         let inst = random_instance(&mut rng, n);
         cellseq::validate::validate(&inst, "r").unwrap();
-        let r = solvers::run(
-            "exact",
-            &inst,
-            Objective::Matrix,
-            &BTreeMap::new(),
-            1,
-            Budget::default(),
-            &mut NoObserver,
-        )
-        .unwrap_or_else(|e| panic!("case {case}: {e}"));
+        let r =
+            solve("exact", &inst, Objective::Matrix).unwrap_or_else(|e| panic!("case {case}: {e}"));
         let want = brute_force(&inst);
         assert!(
             (r.report.cost - want).abs() <= 1e-6,
@@ -477,19 +459,11 @@ fn unvalidated_contradictory_instance_is_an_error_not_a_panic() {
     let inst = formats::parse_instance("first.json", &text, Format::Json).unwrap();
     for s in all_solvers() {
         let r = std::panic::catch_unwind(|| {
-            solvers::run(
-                s,
-                &inst,
-                Objective::Time,
-                &BTreeMap::new(),
-                1,
-                Budget {
-                    time_limit: None,
-                    max_evals: Some(10_000),
-                },
-                &mut NoObserver,
-            )
-            .map(|_| ())
+            let budget = Budget {
+                time_limit: None,
+                max_evals: Some(10_000),
+            };
+            solve_with(s, &inst, Objective::Time, &BTreeMap::new(), budget).map(|_| ())
         });
         match r {
             Ok(Err(e)) => assert!(e.to_string().contains("fixed first and last"), "{s}: {e}"),

@@ -5,27 +5,25 @@ use cellseq::bound::{self, BoundOptions};
 use cellseq::cost::CostModel;
 use cellseq::formats::{self, Format};
 use cellseq::model::{Instance, Objective, Sequence};
-use cellseq::solvers::{self, Budget, NoObserver};
+use cellseq::solvers::{self, Budget};
 use proptest::prelude::*;
 use std::collections::BTreeMap;
+
+use crate::common::{solve, solve_with};
 
 fn load(rel: &str) -> Instance {
     formats::load_instance(&crate::common::root().join(rel)).expect("instance loads")
 }
 
-fn exact(inst: &Instance, obj: Objective) -> f64 {
-    let r = solvers::run(
-        "exact",
-        inst,
-        obj,
-        &BTreeMap::new(),
-        1,
-        Budget::default(),
-        &mut NoObserver,
-    )
-    .expect("exact solves");
+/// The exact solver's result, proven optimal.
+fn exact_run(inst: &Instance, obj: Objective) -> solvers::RunResult {
+    let r = solve("exact", inst, obj).expect("exact solves");
     assert!(r.outcome.proven_optimal);
-    r.report.cost
+    r
+}
+
+fn exact(inst: &Instance, obj: Objective) -> f64 {
+    exact_run(inst, obj).report.cost
 }
 
 /// The beam with these parameters (the rest at their defaults).
@@ -34,7 +32,7 @@ fn beam_with(inst: &Instance, obj: Objective, params: &[(&str, &str)]) -> solver
         .iter()
         .map(|(k, v)| (k.to_string(), v.to_string()))
         .collect();
-    solvers::run("beam", inst, obj, &p, 1, Budget::default(), &mut NoObserver).expect("beam solves")
+    solve_with("beam", inst, obj, &p, Budget::default()).expect("beam solves")
 }
 
 fn beam(inst: &Instance, obj: Objective) -> solvers::RunResult {
@@ -203,16 +201,7 @@ fn qpath_bound_is_strong_under_dense_precedence() {
 
 /// The cost model, an optimal sequence (by the exact solver) and its cost.
 fn optimum(inst: &Instance, obj: Objective) -> (CostModel, Sequence, f64) {
-    let r = solvers::run(
-        "exact",
-        inst,
-        obj,
-        &BTreeMap::new(),
-        1,
-        Budget::default(),
-        &mut NoObserver,
-    )
-    .expect("exact solves");
+    let r = exact_run(inst, obj);
     let m = CostModel::new(inst, obj);
     let opt = m.evaluate(&r.outcome.sequence);
     (m, r.outcome.sequence, opt)
@@ -345,16 +334,7 @@ fn knn_bound_is_below_a_solution_on_a_large_geometric_instance() {
     };
     let b = bound::compute(&m, &opts);
     assert_eq!(b.best_name, "degree_knn");
-    let g = solvers::run(
-        "greedy",
-        &inst,
-        Objective::Time,
-        &BTreeMap::new(),
-        1,
-        Budget::default(),
-        &mut NoObserver,
-    )
-    .unwrap();
+    let g = solve("greedy", &inst, Objective::Time).unwrap();
     assert!(b.best > m.constant() && b.best <= g.report.cost);
 }
 

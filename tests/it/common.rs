@@ -5,9 +5,11 @@
 
 use cellseq::formats::load_instance;
 use cellseq::geom::Point3;
-use cellseq::model::{Cell, Instance, Machine, Mode, Tool, Visit};
+use cellseq::model::{Cell, Instance, Machine, Mode, Objective, Tool, Visit};
+use cellseq::solvers::{self, Budget, NoObserver, RunResult};
+use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
-use std::process::Command;
+use std::process::{Command, Output};
 
 /// The `cellseq` binary built for these tests.
 pub const BIN: &str = env!("CARGO_BIN_EXE_cellseq");
@@ -15,6 +17,61 @@ pub const BIN: &str = env!("CARGO_BIN_EXE_cellseq");
 /// A command running the `cellseq` binary (working directory: the caller's).
 pub fn cellseq() -> Command {
     Command::new(BIN)
+}
+
+/// Runs the `cellseq` binary with `args` and waits for it.
+pub fn run(args: &[&str]) -> Output {
+    cellseq().args(args).output().unwrap()
+}
+
+/// A command's standard error as text.
+pub fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+/// A path as a command-line argument.
+pub fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+/// Writes `text` to `dir/name` and returns the path.
+pub fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
+    let p = dir.join(name);
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+/// A one-solver plan (greedy on a 6-cell generated instance, 1000 evaluations) named `name`.
+pub fn tiny_plan(name: &str) -> String {
+    format!(
+        r#"
+name = "{name}"
+[budget]
+evaluations = 1000
+[[instances]]
+generator = "uniform"
+grid = {{ n = 6 }}
+[[solvers]]
+name = "greedy"
+"#
+    )
+}
+
+/// Runs registry solver `name` through `solvers::run` with default parameters, seed 1, no
+/// budget limit and no observer.
+pub fn solve(name: &str, inst: &Instance, obj: Objective) -> cellseq::Result<RunResult> {
+    solve_with(name, inst, obj, &BTreeMap::new(), Budget::default())
+}
+
+/// [`solve`] with parameters and a budget.
+pub fn solve_with(
+    name: &str,
+    inst: &Instance,
+    obj: Objective,
+    params: &BTreeMap<String, String>,
+    budget: Budget,
+) -> cellseq::Result<RunResult> {
+    solvers::run(name, inst, obj, params, 1, budget, &mut NoObserver)
 }
 
 /// The repository root.

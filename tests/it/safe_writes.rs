@@ -4,18 +4,10 @@
 
 use std::os::unix::fs::{FileTypeExt, symlink};
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Command;
 use std::time::{Duration, Instant};
 
-use crate::common::{BIN, root};
-
-fn run(args: &[&str]) -> Output {
-    Command::new(BIN).args(args).output().unwrap()
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
+use crate::common::{BIN, root, run, s, stderr, tiny_plan};
 
 /// Copies a repository file into `dir`.
 fn copy(dir: &Path, rel: &str) -> PathBuf {
@@ -33,10 +25,6 @@ fn names(dir: &Path) -> Vec<String> {
         .collect();
     v.sort();
     v
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
 }
 
 #[test]
@@ -155,23 +143,12 @@ fn sigterm_during_a_write_leaves_no_temporary_file() {
     assert_eq!(names(d.path()), ["paused"], "temporary file left behind");
 }
 
-const PLAN: &str = r#"
-name = "NAME"
-[budget]
-evaluations = 1000
-[[instances]]
-generator = "uniform"
-grid = { n = 6 }
-[[solvers]]
-name = "greedy"
-"#;
-
 #[test]
 fn plan_names_that_are_paths_are_refused_by_check_and_run() {
     let d = tempfile::tempdir().unwrap();
     for bad in ["../../escaped", "/tmp/escaped", ".hidden", ""] {
         let plan = d.path().join("p.toml");
-        std::fs::write(&plan, PLAN.replace("NAME", bad)).unwrap();
+        std::fs::write(&plan, tiny_plan(bad)).unwrap();
         for cmd in ["check", "run"] {
             let o = Command::new(BIN)
                 .args([cmd, s(&plan)])
@@ -190,9 +167,7 @@ fn plan_names_that_are_paths_are_refused_by_check_and_run() {
 fn check_and_run_refuse_a_million_replicates_alike() {
     let d = tempfile::tempdir().unwrap();
     let plan = d.path().join("p.toml");
-    let text = PLAN
-        .replace("NAME", "big")
-        .replace("[budget]", "replicates = 1000000\n[budget]");
+    let text = tiny_plan("big").replace("[budget]", "replicates = 1000000\n[budget]");
     std::fs::write(&plan, text).unwrap();
     for cmd in ["check", "run"] {
         let o = Command::new(BIN)
@@ -213,7 +188,7 @@ fn check_and_run_refuse_a_million_replicates_alike() {
 fn run_refuses_a_planted_results_symlink() {
     let d = tempfile::tempdir().unwrap();
     let plan = d.path().join("p.toml");
-    std::fs::write(&plan, PLAN.replace("NAME", "t")).unwrap();
+    std::fs::write(&plan, tiny_plan("t")).unwrap();
     let out = d.path().join("out");
     std::fs::create_dir(&out).unwrap();
     let victim = d.path().join("victim.txt");

@@ -4,25 +4,8 @@
 
 use std::os::unix::fs::symlink;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
-const BIN: &str = env!("CARGO_BIN_EXE_cellseq");
-
-fn root() -> &'static Path {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-}
-
-fn run(args: &[&str]) -> Output {
-    Command::new(BIN).args(args).output().unwrap()
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
-}
+use crate::common::{root, run, s, stderr, tiny_plan};
 
 /// A copy of a committed results directory (results, instances, summary tables).
 fn results_copy(dir: &Path, name: &str) -> PathBuf {
@@ -126,22 +109,11 @@ fn report_into_the_results_directory_leaves_the_results_alone() {
     assert_eq!(read(&res), before[0]);
 }
 
-const PLAN: &str = r#"
-name = "t"
-[budget]
-evaluations = 1000
-[[instances]]
-generator = "uniform"
-grid = { n = 6 }
-[[solvers]]
-name = "greedy"
-"#;
-
 #[test]
 fn run_refuses_an_out_directory_that_is_a_symbolic_link() {
     let d = tempfile::tempdir().unwrap();
     let plan = d.path().join("p.toml");
-    std::fs::write(&plan, PLAN).unwrap();
+    std::fs::write(&plan, tiny_plan("t")).unwrap();
     let elsewhere = d.path().join("elsewhere");
     std::fs::create_dir(&elsewhere).unwrap();
     let link = d.path().join("out");

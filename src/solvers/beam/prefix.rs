@@ -1,0 +1,90 @@
+//! Stored prefixes of the beam (visited set, last node, cost so far, the incremental bound
+//! terms) and the ranking that keeps a level's best.
+
+use super::tables::Tables;
+use crate::cost::CostModel;
+
+/// One stored prefix.
+#[derive(Clone, Copy)]
+pub(super) struct Prefix<const W: usize> {
+    pub(super) bits: [u64; W],
+    pub(super) node: u32,
+    pub(super) parent: u32,
+    pub(super) g: f64,
+    /// Σ cheapest in-arc over unvisited cells
+    pub(super) rem_in: f64,
+    /// Σ cheapest out-arc over unvisited cells
+    pub(super) rem_out: f64,
+    /// Σ qpath multipliers over unvisited cells
+    pub(super) lam_open: f64,
+    /// Σ μ_S over the sets the rest must still leave ([`Tables::active_mu`], kept
+    /// incrementally: a child has its parent's less [`Tables::closing_mu`] of the parent)
+    pub(super) act: f64,
+    pub(super) f: f64,
+}
+
+impl<const W: usize> Prefix<W> {
+    /// The one-cell prefix of cell `c` in mode `md` with its incremental bound terms
+    /// (`lam_open`: Σ qpath multipliers over the other cells); `f` is left at 0.
+    pub(super) fn first(m: &CostModel, t: &Tables, c: usize, md: usize, lam_open: f64) -> Self {
+        let mut bits = [0u64; W];
+        bits[c / 64] |= 1 << (c % 64);
+        Prefix {
+            bits,
+            node: m.node(c, md) as u32,
+            parent: u32::MAX,
+            g: m.constant() + m.start(c, md),
+            rem_in: t.total_in - t.cell_in[c],
+            rem_out: t.total_out - t.cell_out[c],
+            lam_open,
+            act: t.active_mu(&bits, c),
+            f: 0.0,
+        }
+    }
+}
+
+/// Every one-cell prefix: each cell that may come first (no predecessor, twins included), in
+/// each mode; `lam_total` = Σ qpath multipliers, `lam(c)` the multiplier of cell `c`.
+pub(super) fn first_prefixes<const W: usize>(
+    m: &CostModel,
+    t: &Tables,
+    lam_total: f64,
+    lam: impl Fn(usize) -> f64,
+) -> Vec<Prefix<W>> {
+    (0..m.n())
+        .filter(|&c| t.pred_mask[c].iter().all(|&w| w == 0))
+        .flat_map(|c| (0..m.modes(c)).map(move |md| (c, md)))
+        .map(|(c, md)| Prefix::first(m, t, c, md, lam_total - lam(c)))
+        .collect()
+}
+
+/// Order by bound, then cost, last node and visited set (a total order on distinct prefixes).
+pub(super) fn rank<const W: usize>(a: &Prefix<W>, b: &Prefix<W>) -> std::cmp::Ordering {
+    a.f.total_cmp(&b.f)
+        .then(a.g.total_cmp(&b.g))
+        .then(a.node.cmp(&b.node))
+        .then(a.bits.cmp(&b.bits))
+}
+
+/// Keeps the `width` candidates with the smallest bound (ties: cost, then last node and visited
+/// set, so the choice is deterministic). Returns true when some were discarded.
+pub(super) fn keep_best<const W: usize>(
+    c: &mut Vec<Prefix<W>>,
+    width: usize,
+    by_cost: bool,
+) -> bool {
+    if c.len() <= width {
+        return false;
+    }
+    let key = |a: &Prefix<W>, b: &Prefix<W>| {
+        let (x, y) = if by_cost { (a.g, b.g) } else { (a.f, b.f) };
+        x.total_cmp(&y)
+            .then(a.f.total_cmp(&b.f))
+            .then(a.g.total_cmp(&b.g))
+            .then(a.node.cmp(&b.node))
+            .then(a.bits.cmp(&b.bits))
+    };
+    c.select_nth_unstable_by(width - 1, key);
+    c.truncate(width);
+    true
+}
