@@ -28,11 +28,11 @@
 //! every error names the file and the line.
 
 use super::tsplib::{
-    FORBIDDEN_ARC, MAX_NODES_ENV, add_to_group, group_number, groups_complete, max_nodes,
-    parse_list as list,
+    FORBIDDEN_ARC, MAX_NODES_ENV, add_to_group, generalized_instance, group_number,
+    groups_complete, max_nodes, parse_list as list,
 };
 use crate::error::{Error, Result};
-use crate::model::{Cell, CostMatrix, Instance, Metadata, Mode};
+use crate::model::{CostMatrix, Instance};
 use std::collections::BTreeSet;
 
 const SECTIONS: [&str; 4] = [
@@ -152,32 +152,17 @@ pub fn parse_pcgtsp(file: &str, text: &str) -> Result<Instance> {
     for (k, &v) in groups.iter().flatten().enumerate() {
         new_index[v] = k;
     }
-    let (costs, mut edges) = matrix(file, &p, &weight, &group_of, &new_index)?;
+    let (costs, edges) = matrix(file, &p, &weight, &group_of, &new_index)?;
     let start = start_group(file, &p, &groups)?;
-    for g in 0..ngroups {
-        if g != start {
-            edges.insert((start, g));
-        }
-    }
-    let cells = groups
-        .iter()
-        .enumerate()
-        .map(|(g, nodes)| Cell::new((g + 1).to_string(), "", vec![Mode::default(); nodes.len()]))
-        .collect();
-    Ok(Instance {
-        name: instance_name(&p, file),
-        meta: Metadata {
-            generator: Some("pcgtsp".into()),
-            comment: p.get("COMMENT").map(|(_, v)| v.to_string()),
-            ..Default::default()
-        },
-        cells,
-        precedence: edges.into_iter().collect(),
-        matrix: Some(CostMatrix { size: dim, costs }),
-        first: Some(start),
-        closed: true,
-        ..Instance::default()
-    })
+    Ok(generalized_instance(
+        instance_name(&p, file),
+        "pcgtsp",
+        p.get("COMMENT").map(|(_, v)| v.to_string()),
+        &groups,
+        start,
+        edges,
+        CostMatrix { size: dim, costs },
+    ))
 }
 
 /// The error for a missing section `name` (at the file's last line).

@@ -421,7 +421,29 @@ pub fn parse_pcglns(file: &str, text: &str) -> Result<Instance> {
         pcglns_ordering(file, order, ngroups, &mut edges)?;
     }
     let start = pcglns_start(file, section("START_GROUP_SECTION")?, &groups)?;
-    for g in 0..ngroups {
+    Ok(generalized_instance(
+        instance_name(&h, file),
+        "pcglns",
+        h.get("COMMENT").map(|(_, v)| v.to_string()),
+        &groups,
+        start,
+        edges,
+        CostMatrix { size: dim, costs },
+    ))
+}
+
+/// The instance of a generalized file (PCGLNS, PCGTSP): one cell per group with one mode per
+/// node, the start group ordered before every other group, the node matrix, a closed tour.
+pub(crate) fn generalized_instance(
+    name: String,
+    generator: &str,
+    comment: Option<String>,
+    groups: &[Vec<usize>],
+    start: usize,
+    mut edges: BTreeSet<(usize, usize)>,
+    matrix: CostMatrix,
+) -> Instance {
+    for g in 0..groups.len() {
         if g != start {
             edges.insert((start, g));
         }
@@ -431,20 +453,20 @@ pub fn parse_pcglns(file: &str, text: &str) -> Result<Instance> {
         .enumerate()
         .map(|(g, nodes)| Cell::new((g + 1).to_string(), "", vec![Mode::default(); nodes.len()]))
         .collect();
-    Ok(Instance {
-        name: instance_name(&h, file),
+    Instance {
+        name,
         meta: Metadata {
-            generator: Some("pcglns".into()),
-            comment: h.get("COMMENT").map(|(_, v)| v.to_string()),
+            generator: Some(generator.into()),
+            comment,
             ..Default::default()
         },
         cells,
         precedence: edges.into_iter().collect(),
-        matrix: Some(CostMatrix { size: dim, costs }),
+        matrix: Some(matrix),
         first: Some(start),
         closed: true,
         ..Instance::default()
-    })
+    }
 }
 
 /// The groups of a PCGLNS file (`GTSP_SET_SECTION`): the group of every node and the nodes
