@@ -39,14 +39,7 @@ impl<'a> PolygonIndex<'a> {
         }
         let height = (hi - lo).max(f64::MIN_POSITIVE);
         let mut slabs = (n / 2).clamp(1, 1 << 20);
-        let slab_of = |y: f64, inv_h: f64, slabs: usize| -> usize {
-            let k = ((y - lo) * inv_h).floor();
-            if k.is_nan() || k < 0.0 {
-                0
-            } else {
-                (k as usize).min(slabs - 1)
-            }
-        };
+        let slab_of = |y: f64, inv_h: f64, slabs: usize| slab(y, lo, inv_h, slabs);
         // fewer slabs while long edges would fill the lists beyond FILL entries per edge
         let inv_h = loop {
             let inv_h = slabs as f64 / height;
@@ -100,12 +93,7 @@ impl<'a> PolygonIndex<'a> {
         if n == 0 {
             return false;
         }
-        let k = ((p[1] - self.y0) * self.inv_h).floor();
-        let k = if k.is_nan() || k < 0.0 {
-            0
-        } else {
-            (k as usize).min(self.slabs - 1)
-        };
+        let k = slab(p[1], self.y0, self.inv_h, self.slabs);
         let mut c = false;
         for &e in &self.edges[self.start[k]..self.start[k + 1]] {
             let i = e as usize;
@@ -121,6 +109,18 @@ impl<'a> PolygonIndex<'a> {
             }
         }
         c
+    }
+}
+
+/// The slab of height `y` among `slabs` slabs of height `1 / inv_h` from `y0`, clamped to the
+/// first and last; monotone in `y`, so an edge listed in the slabs of its ends' heights is in
+/// the slab of every height between them.
+fn slab(y: f64, y0: f64, inv_h: f64, slabs: usize) -> usize {
+    let k = ((y - y0) * inv_h).floor();
+    if k.is_nan() || k < 0.0 {
+        0
+    } else {
+        (k as usize).min(slabs - 1)
     }
 }
 
