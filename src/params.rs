@@ -147,3 +147,15 @@ pub fn parse_kv(pairs: &[String]) -> Result<BTreeMap<String, String>> {
     }
     Ok(m)
 }
+
+/// A TOML scalar (string, integer, float, boolean) as `--param` text; none for tables and
+/// arrays. Plans and portfolio files give parameters this way.
+pub fn toml_text(v: &toml::Value) -> Option<String> {
+    match v {
+        toml::Value::String(s) => Some(s.clone()),
+        toml::Value::Integer(i) => Some(i.to_string()),
+        toml::Value::Float(f) => Some(f.to_string()),
+        toml::Value::Boolean(b) => Some(b.to_string()),
+        _ => None,
+    }
+}

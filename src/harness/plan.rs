@@ -283,16 +283,6 @@ pub fn check_name(name: &str) -> std::result::Result<(), String> {
     ))
 }
 
-fn value_text(v: &toml::Value) -> Option<String> {
-    match v {
-        toml::Value::String(s) => Some(s.clone()),
-        toml::Value::Integer(i) => Some(i.to_string()),
-        toml::Value::Float(f) => Some(f.to_string()),
-        toml::Value::Boolean(b) => Some(b.to_string()),
-        _ => None,
-    }
-}
-
 /// Expands `{k: v or [v...]}` into the cartesian product, in key order then value order.
 fn expand_grid(
     file: &str,
@@ -325,7 +315,7 @@ fn expand_grid(
                 }
                 a.iter()
                     .map(|x| {
-                        value_text(x).ok_or_else(|| {
+                        crate::params::toml_text(x).ok_or_else(|| {
                             Error::invalid(
                                 file,
                                 format!("{what}: parameter '{k}' has a non-scalar value"),
@@ -334,7 +324,7 @@ fn expand_grid(
                     })
                     .collect::<Result<_>>()?
             }
-            other => vec![value_text(other).ok_or_else(|| {
+            other => vec![crate::params::toml_text(other).ok_or_else(|| {
                 Error::invalid(
                     file,
                     format!("{what}: parameter '{k}' has a non-scalar value"),

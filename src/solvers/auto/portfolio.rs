@@ -263,17 +263,6 @@ struct PhaseText {
     params: BTreeMap<String, toml::Value>,
 }
 
-/// A parameter value as the solver's `--param` text.
-fn param_text(v: &toml::Value) -> Option<String> {
-    match v {
-        toml::Value::String(s) => Some(s.clone()),
-        toml::Value::Integer(i) => Some(i.to_string()),
-        toml::Value::Float(f) => Some(f.to_string()),
-        toml::Value::Boolean(b) => Some(b.to_string()),
-        _ => None,
-    }
-}
-
 /// 1-based line of byte offset `at` in `text`.
 fn line_of(text: &str, at: usize) -> usize {
     text.as_bytes()[..at.min(text.len())]
@@ -450,7 +439,7 @@ fn phases_of(list: &[PhaseText]) -> std::result::Result<Vec<Phase>, String> {
     for (i, p) in list.iter().enumerate() {
         let mut params = BTreeMap::new();
         for (k, v) in &p.params {
-            let v = param_text(v).ok_or_else(|| {
+            let v = crate::params::toml_text(v).ok_or_else(|| {
                 format!(
                     "phase {} ({}): parameter '{k}' is not a single value",
                     i + 1,
