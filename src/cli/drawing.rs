@@ -21,6 +21,12 @@ pub struct DrawingArgs {
     /// Cut mode: strokes inside a closed stroke are drawn/cut before it.
     #[arg(long)]
     pub cut: bool,
+    /// SVG: draw the file's plain top-level groups (boxes.py parts, …) in the file's order.
+    /// By default only Inkscape layers keep their order; plain groups between them are drawn
+    /// in the order of least pen-up travel, each still as one contiguous block (see
+    /// docs/drawings.md).
+    #[arg(long)]
+    pub keep_group_order: bool,
     /// Containment tolerance of cut mode (mm).
     #[arg(long, default_value_t = 0.01)]
     pub contain_tol: f64,
@@ -146,6 +152,7 @@ fn svg_options(
         reversible,
         scopes: !a.no_scopes,
         cut: a.cut,
+        free_groups: !a.keep_group_order,
         contain_tol: a.contain_tol / d.mm_per_unit,
         max_starts: a.max_starts,
     }
@@ -199,6 +206,7 @@ fn optimize_svg(a: &OptimizeArgs) -> anyhow::Result<()> {
             "solve_s": out.solve_s,
             "total_s": total_s,
             "kept_original_scopes": out.kept_original,
+            "groups_reordered": out.groups_reordered,
             "kept_note": out.note,
             "before": out.before,
             "after": out.after,
@@ -215,6 +223,11 @@ fn optimize_svg(a: &OptimizeArgs) -> anyhow::Result<()> {
             segments
         );
         say_skipped(&d, out.note.as_ref());
+        if out.groups_reordered {
+            say!(
+                "top-level groups drawn in a shorter order than the file's (--keep-group-order keeps it)"
+            );
+        }
         let (b, f) = (&out.before, &out.after);
         let t = Table::new(20);
         t.saved("pen-up mm (layer)", b.pen_up_mm, f.pen_up_mm);

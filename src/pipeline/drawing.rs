@@ -17,6 +17,8 @@ use crate::model::{Cell, Instance, Machine, Metadata, Mode, Objective, StepKind,
 use rstar::RTree;
 use rstar::primitives::{GeomWithData, Rectangle};
 
+pub mod blocks;
+
 /// The registry solver drawings get by default ([`crate::solvers::drawing`]).
 pub const DRAWING_SOLVER: &str = "drawing";
 
@@ -48,6 +50,11 @@ pub struct Options {
     pub scopes: bool,
     /// Cut mode: strokes inside a closed stroke come before it.
     pub cut: bool,
+    /// Plain groups that are children of the root (not Inkscape layers) are blocks whose
+    /// order between one another is free: each is still drawn as one contiguous run with its
+    /// own colour order, and runs of them are put in the order of least travel. Off: every
+    /// layer in the file's order. No effect with cut mode or without scopes.
+    pub free_groups: bool,
     /// Containment tolerance (user units).
     pub contain_tol: f64,
     /// Maximum start-vertex candidates of a closed stroke.
@@ -65,6 +72,7 @@ impl Default for Options {
             reversible: true,
             scopes: true,
             cut: false,
+            free_groups: true,
             contain_tol: 0.01,
             max_starts: 8,
         }
@@ -366,6 +374,9 @@ pub struct Optimized {
     /// Scopes where the solver's order was not shorter than the file's: they kept the file's
     /// order.
     pub kept_original: usize,
+    /// Plain top-level groups were drawn in another order than the file's
+    /// ([`Options::free_groups`]).
+    pub groups_reordered: bool,
     /// Why the whole drawing was kept in the file's order, when it was (the new order failed
     /// the built-in check; see [`render`]).
     pub note: Option<String>,
@@ -386,29 +397,53 @@ pub fn optimize(d: &Drawing, opts: &Options) -> Result<Optimized> {
     optimize_within(d, opts, &Allowance::new(opts.time_limit, opts.max_evals))
 }
 
-/// Sequences each scope with a registry solver through the steps the G-code pipeline uses:
-/// the scope's share of the command's [`Allowance`], [`solve_group`] (air-travel objective,
-/// start at the previous scope's exit, the first at the origin; the file's order kept unless
-/// the solver's is shorter). [`render`] then writes and verifies the result.
-pub fn optimize_within(d: &Drawing, opts: &Options, allowance: &Allowance) -> Result<Optimized> {
-    let mut sc = scopes(d, opts.scopes);
-    if opts.cut && sc.len() > 1 {
-        sc = inner_scopes_first(d, sc, opts.contain_tol);
-    }
-    let total = d.strokes.len().max(1);
-    let mut left = total;
+/// The scopes solved in one order: the strokes, the figures of the report, and each scope's
+/// entry (first stroke's start) and exit (last stroke's end).
+struct Pass {
+    strokes: Vec<Stroke>,
+    solve_s: f64,
+    edges: usize,
+    kept: usize,
+    ends: Vec<([f64; 2], [f64; 2])>,
+}
+
+/// How much of the budget is still to be shared ([`Allowance::share_or`]): strokes left and
+/// strokes in all passes.
+struct Shares {
+    left: usize,
+    total: usize,
+    reserve_s: f64,
+}
+
+/// Solves the scopes `sc` in this order, each from the previous one's exit (the first from the
+/// origin) with its share of `allowance` ([`solve_group`]: the scope's file order kept unless
+/// the solver's is shorter).
+fn solve_pass(
+    d: &Drawing,
+    sc: &[Vec<usize>],
+    opts: &Options,
+    allowance: &Allowance,
+    shares: &mut Shares,
+) -> Result<Pass> {
     let mut home = [0.0, 0.0];
-    let mut out: Vec<Stroke> = Vec::with_capacity(d.strokes.len());
-    let mut solve_s = 0.0;
-    let mut edges = 0;
-    let mut kept = 0;
-    // keep time for writing and verifying: both linear in the drawing
-    let reserve_s = 0.02 * allowance.time_limit.unwrap_or(0.0);
-    for s in &sc {
+    let mut p = Pass {
+        strokes: Vec::with_capacity(d.strokes.len()),
+        solve_s: 0.0,
+        edges: 0,
+        kept: 0,
+        ends: Vec::with_capacity(sc.len()),
+    };
+    for s in sc {
         let (inst, orient) = scope_instance(d, s, home, opts);
-        edges += inst.precedence.len();
-        let budget = allowance.share_or(s.len(), left, total, reserve_s, default_evals(s.len()));
-        left = left.saturating_sub(s.len());
+        p.edges += inst.precedence.len();
+        let budget = allowance.share_or(
+            s.len(),
+            shares.left,
+            shares.total,
+            shares.reserve_s,
+            default_evals(s.len()),
+        );
+        shares.left = shares.left.saturating_sub(s.len());
         let r = solve_group(
             &inst,
             Objective::Air,
@@ -417,25 +452,135 @@ pub fn optimize_within(d: &Drawing, opts: &Options, allowance: &Allowance) -> Re
             opts.seed,
             budget,
         )?;
-        solve_s += r.elapsed_s;
-        kept += usize::from(r.kept_original && opts.solver != "as-given");
+        p.solve_s += r.elapsed_s;
+        p.kept += usize::from(r.kept_original && opts.solver != "as-given");
+        let first = p.strokes.len();
         for v in &r.sequence {
             let (rev, k) = orient[v.cell][v.mode];
-            out.push(d.strokes[s[v.cell]].oriented(rev, k));
+            p.strokes.push(d.strokes[s[v.cell]].oriented(rev, k));
         }
-        if let Some(l) = out.last() {
+        let entry = p.strokes.get(first).map_or(home, |x| x.start());
+        if let Some(l) = p.strokes.last() {
             home = l.end();
         }
+        p.ends.push((entry, home));
     }
+    Ok(p)
+}
+
+/// The blocks of scopes `sc` (file order, one layer's scopes contiguous): `(first scope, end
+/// scope, free)` per layer. A block is free when its layer is a plain group that is a child of
+/// the root (not an Inkscape layer, not the root's own strokes).
+fn blocks_of(d: &Drawing, sc: &[Vec<usize>]) -> Vec<(usize, usize, bool)> {
+    let layer = |k: usize| d.strokes[sc[k][0]].layer;
+    let mut out: Vec<(usize, usize, bool)> = Vec::new();
+    for k in 0..sc.len() {
+        match out.last_mut() {
+            Some(b) if layer(b.0) == layer(k) => b.1 = k + 1,
+            _ => {
+                let l = layer(k);
+                out.push((k, k + 1, l != 0 && !d.layers[l].inkscape));
+            }
+        }
+    }
+    out
+}
+
+/// The scopes in a new order in which every run of consecutive free blocks is put in the order
+/// of least travel between them ([`blocks::order`], on the entries and exits the blocks had in
+/// `pass`), from the exit of the block before the run (or the origin) to the entry of the block
+/// after it; `None` when no order changes.
+fn free_block_order(d: &Drawing, sc: &[Vec<usize>], pass: &Pass) -> Option<Vec<usize>> {
+    let bl = blocks_of(d, sc);
+    let mut order: Vec<usize> = Vec::with_capacity(sc.len());
+    let mut changed = false;
+    let mut i = 0;
+    while i < bl.len() {
+        let mut j = i + 1;
+        if bl[i].2 {
+            while j < bl.len() && bl[j].2 {
+                j += 1;
+            }
+        }
+        let run = &bl[i..j];
+        let start = if i == 0 {
+            [0.0, 0.0]
+        } else {
+            pass.ends[bl[i - 1].1 - 1].1
+        };
+        let finish = bl.get(j).map(|b| pass.ends[b.0].0);
+        let ends: Vec<_> = run
+            .iter()
+            .map(|b| (pass.ends[b.0].0, pass.ends[b.1 - 1].1))
+            .collect();
+        let o = blocks::order(start, &ends, finish);
+        changed |= o.iter().enumerate().any(|(k, &b)| k != b);
+        for b in o {
+            order.extend(run[b].0..run[b].1);
+        }
+        i = j;
+    }
+    changed.then_some(order)
+}
+
+/// Sequences each scope with a registry solver through the steps the G-code pipeline uses:
+/// the scope's share of the command's [`Allowance`], [`solve_group`] (air-travel objective,
+/// start at the previous scope's exit, the first at the origin; the file's order kept unless
+/// the solver's is shorter). With [`Options::free_groups`], plain top-level groups are then
+/// put in the order of least travel between them and solved again in that order; that result
+/// is kept only when its pen-up travel in all is shorter. [`render`] then writes and verifies
+/// the result.
+pub fn optimize_within(d: &Drawing, opts: &Options, allowance: &Allowance) -> Result<Optimized> {
+    let mut sc = scopes(d, opts.scopes);
+    if opts.cut && sc.len() > 1 {
+        sc = inner_scopes_first(d, sc, opts.contain_tol);
+    }
+    // block order is free only with scopes (one layer's scopes contiguous) and without cut
+    // mode (whose containment order between scopes crosses layers)
+    let reorder = opts.free_groups && opts.scopes && !opts.cut && sc.len() > 1;
+    let free_strokes: usize = if reorder {
+        blocks_of(d, &sc)
+            .iter()
+            .filter(|b| b.2)
+            .map(|b| sc[b.0..b.1].iter().map(Vec::len).sum::<usize>())
+            .sum()
+    } else {
+        0
+    };
+    let total = d.strokes.len().max(1) + free_strokes;
+    // keep time for writing and verifying: both linear in the drawing
+    let mut shares = Shares {
+        left: total,
+        total,
+        reserve_s: 0.02 * allowance.time_limit.unwrap_or(0.0),
+    };
     let key = layer_label(d);
+    let figures = |s: &[Stroke]| pen_up(s, d.mm_per_unit, &key);
+    let mut best = solve_pass(d, &sc, opts, allowance, &mut shares)?;
+    let mut groups_reordered = false;
+    if reorder && let Some(order) = free_block_order(d, &sc, &best) {
+        let sc2: Vec<Vec<usize>> = order.iter().map(|&k| sc[k].clone()).collect();
+        let p = solve_pass(d, &sc2, opts, allowance, &mut shares)?;
+        let (a, b) = (figures(&best.strokes), figures(&p.strokes));
+        if b.pen_up_total_mm < a.pen_up_total_mm {
+            best = Pass {
+                solve_s: best.solve_s + p.solve_s,
+                ..p
+            };
+            groups_reordered = true;
+        } else {
+            best.solve_s += p.solve_s;
+        }
+    }
     Ok(Optimized {
-        before: pen_up(&d.strokes, d.mm_per_unit, &key),
-        after: pen_up(&out, d.mm_per_unit, &key),
-        strokes: out,
-        solve_s,
+        before: figures(&d.strokes),
+        after: figures(&best.strokes),
+        strokes: best.strokes,
+        solve_s: best.solve_s,
         scopes: sc.len(),
-        edges,
-        kept_original: kept,
+        edges: best.edges,
+        kept_original: best.kept,
+        groups_reordered,
         note: None,
     })
 }
@@ -476,6 +621,7 @@ pub fn render(d: &Drawing, opt: &mut Optimized, output: Output) -> Result<(Strin
             let r = emit(&d.strokes)?;
             opt.strokes = d.strokes.clone();
             opt.after = opt.before;
+            opt.groups_reordered = false;
             opt.note = Some(format!("the new order failed the built-in check: {e}"));
             Ok(r)
         }
