@@ -22,6 +22,12 @@ only.
   /tmp/corpus-vpenv/bin/python scripts/svg_vs_vpype.py [--cellseq target/release/cellseq]
       [--dir tests/fixtures/svg/real] [--timeout 600] [--out notes/table.md]
       [--vpype-cache DIR] [FILE ...]
+  ... scripts/svg_vs_vpype.py --per-layer [--out notes/per-layer.md] [FILE ...]
+
+--per-layer measures the two searches on identical scopes: every layer of every file, as
+vpype's reader sees it (curves already flattened), is written by vpype as its own one-layer,
+one-colour SVG, and both tools sequence that same file; the figure compared is the pen-up
+travel within the layer without the leg from the origin (vpype's metric).
 
 Every tool runs in a child process with a timeout; a refusal or a timeout is a row of the table,
 never a silent gap.
@@ -139,6 +145,78 @@ def at_or_below(c, v):
     return c <= v * (1 + 1e-9) + 1e-6
 
 
+def per_layer(files, args, tmp):
+    """Rows of the identical-scope comparison: one per (file, vpype layer)."""
+    import vpype
+
+    vpype_exe = os.path.join(os.path.dirname(sys.executable), "vpype")
+    rows = []
+    for svg in files:
+        name = os.path.basename(svg)
+        doc = vpype.read_multilayer_svg(svg, QUANTIZATION, crop=False)
+        for lid, lc in doc.layers.items():
+            if len(lc) < 2:
+                continue
+            one_doc = vpype.Document(page_size=doc.page_size)
+            one_doc.add(lc, layer_id=1)
+            src = os.path.join(tmp, "layer%d_%s" % (lid, name))
+            with open(src, "w") as fh:
+                vpype.write_svg(fh, one_doc, set_date=False)
+            row = {"file": name, "layer": lid, "paths": len(lc),
+                   "orig": measure(src)[0]}
+            # the same travel with the leg from the origin (what cellseq minimizes)
+            row["vpype_o"] = row["cellseq_o"] = None
+            vout = os.path.join(tmp, "vpype_layer%d_%s" % (lid, name))
+            rc, msg, _ = run([vpype_exe, "read", "--no-crop", src, "linesort", "--two-opt",
+                              "write", vout], args.timeout)
+            if rc == 0:
+                m = measure(vout)
+                row["vpype"], row["vpype_o"] = m[0], m[4]
+            else:
+                row["vpype"] = None
+            cout = os.path.join(tmp, "cellseq_layer%d_%s" % (lid, name))
+            rc, msg, _ = run([args.cellseq, "optimize", src, "-o", cout], args.timeout)
+            if rc == 0:
+                m = measure(cout)
+                row["cellseq"], row["cellseq_o"] = m[0], m[4]
+            else:
+                row["cellseq"] = None
+            row["error"] = None if rc == 0 else msg.splitlines()[-1:]
+            rows.append(row)
+            print(fmt_layer(row), flush=True)
+    return rows
+
+
+def main_per_layer(files, args):
+    head = ["| file | vpype layer | paths | pen-up original (mm) | vpype two-opt | cellseq "
+            "| cellseq / vpype | cellseq ≤ vpype | with origin leg: vpype / cellseq |",
+            "|---|---:|---:|---:|---:|---:|---:|---|---|"]
+    print("\n".join(head), flush=True)
+    with tempfile.TemporaryDirectory() as tmp:
+        rows = per_layer(files, args, tmp)
+    both = [r for r in rows if r["vpype"] is not None and r["cellseq"] is not None]
+    ok = sum(1 for r in both if at_or_below(r["cellseq"], r["vpype"]))
+    summary = ("\nIdentical scopes: cellseq at or below vpype linesort --two-opt on %d of %d "
+               "layers (%d with both results); sum %.1f mm against vpype's %.1f mm."
+               % (ok, len(rows), len(both), sum(r["cellseq"] for r in both),
+                  sum(r["vpype"] for r in both)))
+    print(summary)
+    if args.out:
+        with open(args.out, "w") as fh:
+            fh.write("\n".join(head + [fmt_layer(r) for r in rows]) + "\n" + summary + "\n")
+
+
+def fmt_layer(r):
+    v, c = r["vpype"], r["cellseq"]
+    o = lambda x: "%.3f" % x if x is not None else "—"
+    return "| %s | %d | %d | %.3f | %s | %s | %s | %s | %s / %s |" % (
+        r["file"], r["layer"], r["paths"], r["orig"],
+        "%.3f" % v if v is not None else "—", "%.3f" % c if c is not None else "—",
+        "%.3f" % (c / v) if v and c is not None else "—",
+        ("yes" if at_or_below(c, v) else "**no**") if v is not None and c is not None
+        else "n/a", o(r["vpype_o"]), o(r["cellseq_o"]))
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -149,10 +227,14 @@ def main():
     ap.add_argument("--out", help="also write the Markdown table here")
     ap.add_argument("--vpype-cache", help="keep vpype's outputs in this directory and reuse "
                     "them on a later run (vpype's result does not depend on cellseq)")
+    ap.add_argument("--per-layer", action="store_true",
+                    help="compare the two searches on identical one-layer files instead")
     args = ap.parse_args()
     files = args.files or sorted(glob.glob(os.path.join(args.dir, "*.svg")))
     if not files:
         sys.exit("no SVG files found")
+    if args.per_layer:
+        return main_per_layer(files, args)
     head = ["| file | paths / layers | pen-up original (mm) | vpype two-opt | cellseq default "
             "| cellseq / vpype | cellseq ≤ vpype | pen-up in all orig / vpype / cellseq (mm) "
             "| in all: cellseq ≤ vpype | pen-down orig / vpype / cellseq (mm) "

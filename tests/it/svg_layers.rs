@@ -1,7 +1,8 @@
 //! The SVG writer keeps the file's layers as the file has them: every group that is a child
 //! of the root (boxes.py's parts, the layers plotter tools such as vpype read) and every
-//! Inkscape layer comes back as one group with its id, in the file's order, holding exactly
-//! its own strokes.
+//! Inkscape layer comes back as one group with its id, holding exactly its own strokes.
+//! Inkscape layers keep the file's order; plain top-level groups are blocks put in the order
+//! of least pen-up travel (the file's with `--keep-group-order`).
 
 use cellseq::io::svg::{self, ReadOptions};
 use cellseq::pipeline::drawing::{self as pipe, Options};
@@ -30,7 +31,11 @@ fn top_level_groups_are_layers_and_are_written_back_as_groups() {
         .map(|i| (Some(i.clone()), i.clone(), false))
         .collect();
     assert_eq!(layers(&d), want, "each part of boxes.py is a layer");
-    let out = pipe::optimize(&d, &Options::default()).unwrap();
+    let keep = Options {
+        free_groups: false,
+        ..Options::default()
+    };
+    let out = pipe::optimize(&d, &keep).unwrap();
     // layers are scopes: each stays contiguous, in the file's order
     let order: Vec<usize> = out.strokes.iter().map(|s| s.layer).collect();
     assert!(order.windows(2).all(|w| w[0] <= w[1]), "{order:?}");
@@ -86,4 +91,94 @@ fn split_layers_keep_unique_ids_and_their_labels() {
         assert!(w.matches(&format!("id=\"p-{i}\"")).count() <= 1);
     }
     svg::verify(&d, "w.svg", &w).unwrap();
+}
+
+#[test]
+fn plain_groups_are_blocks_in_a_shorter_order_and_never_longer() {
+    let text = real("boxespy_ABox.svg");
+    let d = svg::read("ABox.svg", &text, ReadOptions::default()).unwrap();
+    let keep = pipe::optimize(
+        &d,
+        &Options {
+            free_groups: false,
+            ..Options::default()
+        },
+    )
+    .unwrap();
+    let free = pipe::optimize(&d, &Options::default()).unwrap();
+    assert!(free.groups_reordered);
+    assert!(
+        free.after.pen_up_total_mm < keep.after.pen_up_total_mm,
+        "{} vs {}",
+        free.after.pen_up_total_mm,
+        keep.after.pen_up_total_mm
+    );
+    assert!((free.after.draw_mm - keep.after.draw_mm).abs() < 1e-9);
+    // each part is one contiguous block, written back as one group; not the file's order
+    let mut order: Vec<usize> = free.strokes.iter().map(|s| s.layer).collect();
+    order.dedup();
+    let mut sorted = order.clone();
+    sorted.sort_unstable();
+    sorted.dedup();
+    assert_eq!(order.len(), sorted.len(), "a part split: {order:?}");
+    assert_ne!(order, sorted, "the file's order");
+    let w = svg::write(&d, &free.strokes);
+    for i in 0..6 {
+        assert_eq!(w.matches(&format!("<g id=\"p-{i}\">")).count(), 1);
+    }
+    svg::verify(&d, "w.svg", &w).unwrap();
+    // within each part, the colour order of the file is kept
+    let colours = |strokes: &[cellseq::io::drawing::Stroke], layer: usize| {
+        let mut c: Vec<&str> = strokes
+            .iter()
+            .filter(|s| s.layer == layer)
+            .map(|s| d.styles[s.style].stroke.as_str())
+            .collect();
+        c.dedup();
+        c
+    };
+    for l in 1..d.layers.len() {
+        assert_eq!(colours(&free.strokes, l), colours(&keep.strokes, l));
+    }
+}
+
+#[test]
+fn inkscape_layers_keep_their_place_and_plain_groups_between_them_take_the_shortest_order() {
+    // one stroke per group; file order a, b, c of plain groups is far from the shortest
+    let line = |x: f64| format!("<path d=\"M{x},0 L{x},1\" stroke=\"black\" fill=\"none\"/>");
+    let text = format!(
+        "<svg xmlns=\"http://www.w3.org/2000/svg\" \
+         xmlns:inkscape=\"http://www.inkscape.org/namespaces/inkscape\">\
+         <g inkscape:groupmode=\"layer\" id=\"first\">{}</g>\
+         <g id=\"a\">{}</g><g id=\"b\">{}</g><g id=\"c\">{}</g><g id=\"d\">{}</g>\
+         <g inkscape:groupmode=\"layer\" id=\"last\">{}</g></svg>",
+        line(0.0),
+        line(40.0),
+        line(10.0),
+        line(30.0),
+        line(20.0),
+        line(50.0)
+    );
+    let d = svg::read("g.svg", &text, ReadOptions::default()).unwrap();
+    let out = pipe::optimize(&d, &Options::default()).unwrap();
+    let ids: Vec<&str> = out
+        .strokes
+        .iter()
+        .map(|s| d.layers[s.layer].id.as_deref().unwrap_or(""))
+        .collect();
+    assert_eq!(ids, ["first", "b", "d", "c", "a", "last"]);
+    let keep = pipe::optimize(
+        &d,
+        &Options {
+            free_groups: false,
+            ..Options::default()
+        },
+    )
+    .unwrap();
+    let ids: Vec<&str> = keep
+        .strokes
+        .iter()
+        .map(|s| d.layers[s.layer].id.as_deref().unwrap_or(""))
+        .collect();
+    assert_eq!(ids, ["first", "a", "b", "c", "d", "last"]);
 }
