@@ -17,10 +17,12 @@ A documented sweep with a held-back part (notes/portfolio.md has the method and 
    one thread, a fixed evaluation budget (deterministic: the result does not depend on the
    machine's load). Runs are cached in `OUT/runs.jsonl` (an interrupted sweep resumes).
 3. **Candidate portfolios** are decision lists in the built-in's shape: a symmetric rule (on
-   or off), a free rule (`free_density <= F`), a sparse rule (`closure_density < D`), a dense
-   rule (`cells <= K`), a large-dense rule and the catch-all. The threshold values tried are
-   the built-in's and the midpoints between consecutive feature values seen on the training
-   part; for each set of thresholds every rule gets the plan (of all plan portfolios) with the
+   or off), a free rule (`free_density <= F`), a sparse rule (`closure_density < D`), a
+   medium rule (`D <= closure_density < 0.8`, `cells <= K`) and a large-medium one (more
+   cells), the built-in's dense and large-dense rules (closure density >= 0.8: no asymmetric
+   training instance lies there, so the sweep keeps them as they are) and the catch-all.
+   The threshold values tried are the built-in's and the midpoints between consecutive
+   feature values seen on the training part; for each set of thresholds every rule gets the plan (of all plan portfolios) with the
    least total score over the training instances it takes (ties: the built-in's plan). As every rule's plan has been run on every instance, a candidate's
    result on an instance is the result of the plan it selects there (the same run: the
    solver is deterministic under an evaluation budget); the held-back check below runs the
@@ -34,7 +36,7 @@ A documented sweep with a held-back part (notes/portfolio.md has the method and 
    pick at the same budget; reported, never used for choosing.
 
 usage: portfolio_sweep.py OUT [--cellseq PATH] [--families DIR] [--max-n 500] [--evals 10000000]
-                          [--seeds 1] [--jobs 1] [--validate DIR...]
+                          [--seeds 1] [--jobs 1] [--keep-symmetric] [--validate DIR...]
 
 Writes OUT/report.md (tables), OUT/pick.toml (the chosen portfolio) and OUT/runs.jsonl.
 Run it under `nice`; it is untimed (evaluation budgets only).
@@ -121,10 +123,15 @@ def load_plans():
 
 # ---- candidates ----
 
-BUILT_IN_CAND = {"sym": True, "free": 0.001, "split": 0.8, "cells": 300,
+# The built-in rules' shape. `medium` and `large-medium` (split <= closure_density < DENSE)
+# are the built-in's `sparse` region cut at `split`: their home plan is the sparse one, so a
+# split of DENSE leaves them empty and the candidate is the built-in.
+DENSE = 0.8
+BUILT_IN_CAND = {"sym": True, "free": 0.001, "split": DENSE, "cells": 300,
                  "plans": {"symmetric": "symmetric", "free": "free", "sparse": "sparse",
+                           "medium": "sparse", "large-medium": "sparse",
                            "dense": "dense", "large-dense": "large-dense"}}
-REGIONS = ("symmetric", "free", "sparse", "dense", "large-dense")
+REGIONS = ("symmetric", "free", "sparse", "medium", "large-medium", "dense", "large-dense")
 
 
 def region(c, f):
@@ -137,9 +144,9 @@ def region(c, f):
         return "free"
     if f["closure_density"] < c["split"]:
         return "sparse"
-    if f["cells"] <= c["cells"]:
-        return "dense"
-    return "large-dense"
+    if f["closure_density"] < DENSE:
+        return "medium" if f["cells"] <= c["cells"] else "large-medium"
+    return "dense" if f["cells"] <= 300 else "large-dense"
 
 
 def choose(c, f):
@@ -156,11 +163,17 @@ def candidate_rules(c, plans):
     rules.append(("free", pl("free"), {"geometric": False, "free_density": {"max": c["free"]}}))
     rules.append(("sparse", pl("sparse"),
                   {"geometric": False, "closure_density": {"below": c["split"]}}))
+    if c["split"] < DENSE:
+        rules.append(("medium", pl("medium"), {
+            "geometric": False, "closure_density": {"below": DENSE},
+            "cells": {"max": c["cells"]}}))
+        rules.append(("large-medium", pl("large-medium"),
+                      {"geometric": False, "closure_density": {"below": DENSE}}))
     rules.append(("dense", pl("dense"), {"geometric": False,
-                                         "closure_density": {"min": c["split"]},
-                                         "cells": {"max": c["cells"]}}))
+                                         "closure_density": {"min": DENSE},
+                                         "cells": {"max": 300}}))
     rules.append(("large-dense", pl("large-dense"),
-                  {"geometric": False, "closure_density": {"min": c["split"]}}))
+                  {"geometric": False, "closure_density": {"min": DENSE}}))
     rules.append(("default", plans["default"], None))
     return rules
 
@@ -172,15 +185,17 @@ def midpoints(values, keep=None):
 
 
 def nice_round(x, lo, hi):
-    """A short decimal in (lo, hi) near x (so the file reads well), else x."""
+    """x rounded to the fewest significant digits that keep it in the middle half of
+    (lo, hi) (so the file reads well and the bound stays away from both sides), else x."""
+    q = (hi - lo) / 4
     for digits in range(1, 8):
         r = float("%.*g" % (digits, x))
-        if lo < r < hi:
+        if lo + q <= r <= hi - q:
             return r
     return x
 
 
-def grid(train_feats):
+def grid(train_feats, keep_symmetric=False):
     fd = [f["free_density"] for f in train_feats]
     cd = [f["closure_density"] for f in train_feats]
     cells = [f["cells"] for f in train_feats]
@@ -190,9 +205,9 @@ def grid(train_feats):
         return [nice_round((a + b) / 2, a, b) for a, b in zip(v, v[1:])
                 if keep((a + b) / 2)]
     frees = sorted({0.001} | set(rounded(fd, lambda m: m < 0.1)))
-    splits = sorted({0.8} | set(rounded(cd, lambda m: m > 0.2)))
+    splits = sorted({DENSE} | set(rounded(cd, lambda m: 0.2 < m < DENSE)))
     cellss = sorted({300} | {int(m) for m in midpoints(cells)})
-    for sym in (True, False):
+    for sym in ((True,) if keep_symmetric else (True, False)):
         for fr in frees:
             for sp in splits:
                 for k in cellss:
@@ -360,6 +375,8 @@ def main():
     ap.add_argument("--evals", type=int, default=10_000_000)
     ap.add_argument("--seeds", type=int, nargs="+", default=[1])
     ap.add_argument("--jobs", type=int, default=1)
+    ap.add_argument("--keep-symmetric", action="store_true",
+                    help="only candidates that keep the symmetric rule")
     ap.add_argument("--validate", nargs="*", default=None,
                     help="directories of TSPLIB SOP / PCGTSPLIB files to validate on")
     a = ap.parse_args()
@@ -384,7 +401,7 @@ def main():
 
     # the pick, on the training part
     tr_sc, tr_ft = scores_of(parts["train"], names, runs, a)
-    cands = list(grid(list(tr_ft.values())))
+    cands = list(grid(list(tr_ft.values()), a.keep_symmetric))
     scored = []
     for t in cands:
         c, score = fit_plans(t, parts["train"], tr_sc, tr_ft, names)
