@@ -307,8 +307,6 @@ fn the_built_in_portfolio_parses_validates_and_ends_with_a_catch_all() {
             "symmetric",
             "free",
             "sparse",
-            "medium",
-            "large-medium",
             "dense",
             "large-dense",
             "default"
@@ -624,40 +622,4 @@ fn a_plan_reads_its_portfolio_from_the_plan_directory() {
         err.contains("plan.toml") && err.contains("missing.toml"),
         "{err}"
     );
-}
-
-/// The rules the family sweep added (notes/portfolio.md): asymmetric matrices whose closure
-/// density lies between the sparse bound and 0.8 go to `medium` up to 300 cells and to
-/// `large-medium` above; sparser ones stay with `sparse`.
-#[test]
-fn medium_precedence_gets_the_medium_rules() {
-    use cellseq::cost::CostModel;
-    use cellseq::model::Objective;
-    use cellseq::solvers::auto::Auto;
-    let a = Auto::from_params(
-        &cellseq::solvers::Params::new(
-            "auto",
-            cellseq::solvers::find("auto").unwrap().params,
-            &BTreeMap::new(),
-        )
-        .unwrap(),
-    )
-    .unwrap();
-    let rule = |n: usize, p: usize| {
-        let given = BTreeMap::from([
-            ("n".to_string(), n.to_string()),
-            ("p".to_string(), p.to_string()),
-        ]);
-        let inst = cellseq::generate::generate("random-sop", &given, 3).unwrap();
-        let m = CostModel::new(&inst, Objective::Matrix);
-        let c = a.choose(&m);
-        (c.rule.to_string(), c.features.closure_density)
-    };
-    let (r, d) = rule(100, 40);
-    assert_eq!(r, "medium", "closure density {d}");
-    assert!((0.28..0.8).contains(&d), "{d}");
-    let (r, d) = rule(320, 40);
-    assert_eq!(r, "large-medium", "closure density {d}");
-    let (r, d) = rule(100, 15);
-    assert_eq!(r, "sparse", "closure density {d}");
 }
