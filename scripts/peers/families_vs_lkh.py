@@ -53,10 +53,12 @@ def describe(path):
     return family, int(params.get("n", (dim or 2) - 2)), params.get("p", "-")
 
 
-def run_cellseq(binary, path, limit, seed):
+def run_cellseq(binary, path, limit, seed, bound=True):
     env = dict(os.environ, RAYON_NUM_THREADS="1")
     t0 = time.time()
     cmd = [binary, "solve", path, "--json", "--time-limit", str(limit), "--seed", str(seed)]
+    if not bound:
+        cmd.append("--no-bound")
     out = subprocess.run(cmd, capture_output=True, text=True, check=True, env=env).stdout
     wall = time.time() - t0
     r = json.loads(out)
@@ -67,7 +69,7 @@ def run_cellseq(binary, path, limit, seed):
             "lower_bound": r.get("lower_bound")}
 
 
-def run_lkh(binary, path, limit, seed):
+def run_lkh(binary, path, limit, seed, bound=True):
     r = lkh_sop.solve(path, binary, time_limit=limit, runs=1, max_trials=UNBOUNDED_TRIALS,
                       seed=seed, special=True)
     return {"peer": "lkh3", "cost": r["cost"], "wall_s": r["wall_s"], "lower_bound": None}
@@ -93,19 +95,23 @@ def main():
     a = ap.parse_args()
     if not os.path.exists(a.lkh):
         ap.error("no LKH-3 binary at %s (--lkh PATH or LKH_BIN)" % a.lkh)
-    rows = []
+    rows, loads = [], []
     for path in a.files:
+        bound = None
         family, n, p = describe(path)
         best = sc.best_known(path)
         for limit in a.time_limit:
             runs = {"cellseq": [], "lkh3": []}
-            bound = None
             for seed in a.seeds:
                 # alternately: cellseq, then LKH-3, for every seed
                 for peer, fn, binary in (("cellseq", run_cellseq, a.cellseq),
                                          ("lkh3", run_lkh, a.lkh)):
-                    r = fn(binary, path, limit, seed)
-                    r.update(instance=sc.instance_name(path), time_limit=limit, seed=seed)
+                    # cellseq's lower bound (after its search, outside the time limit) is
+                    # computed on the first run of an instance only
+                    r = fn(binary, path, limit, seed, bound=(bound is None))
+                    r.update(instance=sc.instance_name(path), time_limit=limit, seed=seed,
+                             loadavg=round(os.getloadavg()[0], 2))
+                    loads.append(r["loadavg"])
                     runs[peer].append(r)
                     if r["lower_bound"] is not None:
                         bound = max(bound or 0, r["lower_bound"])
@@ -126,6 +132,9 @@ def main():
             r[0], r[1], r[2], r[3], fmt(r[4]), fmt(r[5]), fmt(r[6]), fmt(r[7]),
             "∞" if r[8] == float("inf") else "%.3f" % r[8], r[9], r[10], r[11]))
     text = "\n".join(lines) + "\n"
+    if loads:
+        text += "\n1-minute load average at the end of each run: %.2f to %.2f (median %.2f).\n" % (
+            min(loads), max(loads), statistics.median(loads))
     if a.out:
         with open(a.out, "w") as f:
             f.write(text)
