@@ -31,7 +31,7 @@ use super::sections::{
     Parts, check_dimension, check_explicit, check_type, instance_name, number, positive,
 };
 use super::tsplib::{
-    FORBIDDEN_ARC, add_to_group, generalized_instance, group_number, groups_complete,
+    add_to_group, forbidden_arc, generalized_instance, group_number, groups_complete,
     parse_list as list,
 };
 use crate::error::{Error, Result};
@@ -214,16 +214,7 @@ fn matrix(
         })?;
         let slot = new_index[i] * dim + new_index[j];
         if v == -1.0 {
-            let (gi, gj) = (group_of[i], group_of[j]);
-            if gi == gj {
-                return Err(Error::parse(
-                    file,
-                    ln,
-                    format!("group {} must precede itself", gi + 1),
-                ));
-            }
-            edges.insert((gj, gi));
-            costs[slot] = FORBIDDEN_ARC;
+            costs[slot] = forbidden_arc(file, ln, (group_of[i], group_of[j]), &mut edges)?;
             continue;
         }
         if !(0.0..=max).contains(&v) {
@@ -320,7 +311,7 @@ mod tests {
         assert_eq!(m.get(0, 1), 1.5); // no weight on node 2
         assert_eq!(m.get(0, 2), 2.5); // node 3 weighs 0.5
         assert_eq!(m.get(3, 2), 8.75);
-        assert_eq!(m.get(1, 2), FORBIDDEN_ARC);
+        assert_eq!(m.get(1, 2), super::super::tsplib::FORBIDDEN_ARC);
         assert_eq!(m.get(2, 3), 7.0); // node 3 -> node 4 (weight 1)
     }
 

@@ -378,17 +378,7 @@ fn pcglns_matrix(
             let (gi, gj) = (group_of[i], group_of[j]);
             let slot = new_index[i] * dim + new_index[j];
             match entry(file, ln, i, j, v)? {
-                None => {
-                    if gi == gj {
-                        return Err(Error::parse(
-                            file,
-                            ln,
-                            format!("group {} must precede itself", gi + 1),
-                        ));
-                    }
-                    edges.insert((gj, gi));
-                    costs[slot] = FORBIDDEN_ARC;
-                }
+                None => costs[slot] = forbidden_arc(file, ln, (gi, gj), edges)?,
                 Some(v) => costs[slot] = v,
             }
         }
@@ -401,6 +391,25 @@ fn pcglns_matrix(
         ));
     }
     Ok(costs)
+}
+
+/// A -1 entry from a node of group `gi` to a node of group `gj` of a generalized file: group
+/// `gj` precedes `gi` (added to `edges`), and the arc costs [`FORBIDDEN_ARC`].
+pub(crate) fn forbidden_arc(
+    file: &str,
+    ln: usize,
+    (gi, gj): (usize, usize),
+    edges: &mut BTreeSet<(usize, usize)>,
+) -> Result<f64> {
+    if gi == gj {
+        return Err(Error::parse(
+            file,
+            ln,
+            format!("group {} must precede itself", gi + 1),
+        ));
+    }
+    edges.insert((gj, gi));
+    Ok(FORBIDDEN_ARC)
 }
 
 /// The precedence of `GTSP_SET_ORDERING`: each line's first group before the others.
