@@ -6,7 +6,7 @@
 # cost and evaluation count; the script records both so that this can be checked.
 #
 # usage: bash notes/lab/release-profile.sh [OUT_DIR]      (default /tmp/cellseq-profile)
-#   PHASES="build runs" (default both), VARIANTS="base cgu1 thin" (default), ROUNDS=5.
+#   PHASES="build runs" (default both; "summary" prints the base/cgu1 table of runs.tsv), VARIANTS="base cgu1 thin" (default), ROUNDS=5.
 # Variants (set through cargo's --config and CARGO_PROFILE_RELEASE_* variables, so Cargo.toml
 # is left alone): base = the committed profile; cgu1 = codegen-units = 1 for the cellseq crate
 # only (its target directory starts as a copy of base's, so only cellseq recompiles and the
@@ -95,5 +95,30 @@ case " $PHASES " in *" runs "*)
       for v in $VARIANTS; do one_run "$round" "$v" "$1" "$2" "$3"; done
     done
   done ;;
+esac
+case " $PHASES " in *" summary "*)
+  # medians per run kind, base against cgu1 (the table in release-profile.md)
+  python3 - "$OUT/runs.tsv" <<'PY'
+import sys, collections, statistics as st
+rows=[l.rstrip('\n').split('\t') for l in open(sys.argv[1]) if l.strip()]
+t=collections.defaultdict(lambda: collections.defaultdict(list)); res=collections.defaultdict(set)
+rounds=collections.defaultdict(set)
+for r,v,inst,s,ev,u,cost,evals in rows:
+    k=(inst.split('/')[-1],s,ev); t[k][v].append(float(u)); res[k].add((cost,evals)); rounds[k].add(r)
+tb=tc=0; ratios=[]
+print('| instance | solver | --max-evals | runs | base user s (median) | cgu1 user s (median) | cgu1/base | same cost and evaluations |')
+print('|---|---|---|---|---|---|---|---|')
+for k in t:
+    b=t[k]['base']; c=t[k].get('cgu1',[])
+    n=min(len(b),len(c))
+    if n==0: continue
+    b,c=b[:n],c[:n]
+    mb,mc=st.median(b),st.median(c); ratios.append(mc/mb); tb+=sum(b); tc+=sum(c)
+    print(f'| {k[0]} | {k[1]} | {k[2]} | {n}+{n} | {mb:.2f} | {mc:.2f} | {mc/mb:.3f} | {"yes" if len(res[k])==1 else "NO: "+str(res[k])} |')
+import math
+g=math.exp(sum(map(math.log,ratios))/len(ratios))
+print(f'\ngeometric mean of the median ratios cgu1/base: {g:.3f} over {len(ratios)} runs kinds; total user s base {tb:.1f}, cgu1 {tc:.1f} ({tc/tb:.3f})')
+PY
+  ;;
 esac
 echo "done $(date -u +%H:%M:%S)" >> "$OUT/build.tsv"
