@@ -6,6 +6,7 @@
 
 pub mod json;
 pub mod pcgtsp;
+mod sections;
 pub mod tsplib;
 pub mod write;
 

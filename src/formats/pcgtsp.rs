@@ -27,9 +27,12 @@
 //! [`super::tsplib::max_nodes`], and the number of matrix entries the file really holds);
 //! every error names the file and the line.
 
+use super::sections::{
+    Parts, check_dimension, check_explicit, check_type, instance_name, number, positive,
+};
 use super::tsplib::{
-    FORBIDDEN_ARC, MAX_NODES_ENV, add_to_group, generalized_instance, group_number,
-    groups_complete, max_nodes, parse_list as list,
+    add_to_group, forbidden_arc, generalized_instance, group_number, groups_complete,
+    parse_list as list,
 };
 use crate::error::{Error, Result};
 use crate::model::{CostMatrix, Instance};
@@ -42,71 +45,6 @@ const SECTIONS: [&str; 4] = [
     "START_GROUP_SECTION",
 ];
 
-/// Numbered lines of a section.
-type Lines<'a> = Vec<(usize, &'a str)>;
-
-struct Parts<'a> {
-    header: Vec<(usize, String, &'a str)>,
-    sections: Vec<(&'static str, Lines<'a>)>,
-    last_line: usize,
-}
-
-impl Parts<'_> {
-    fn get(&self, key: &str) -> Option<(usize, &str)> {
-        self.header
-            .iter()
-            .find(|(_, k, _)| k == key)
-            .map(|(l, _, v)| (*l, *v))
-    }
-    fn section(&self, name: &str) -> Option<&Lines<'_>> {
-        self.sections
-            .iter()
-            .find(|(k, _)| *k == name)
-            .map(|(_, l)| l)
-    }
-}
-
-fn split<'a>(file: &str, text: &'a str) -> Result<Parts<'a>> {
-    let mut parts = Parts {
-        header: Vec::new(),
-        sections: Vec::new(),
-        last_line: 1,
-    };
-    for (i, raw) in text.lines().enumerate() {
-        let ln = i + 1;
-        parts.last_line = ln;
-        let line = raw.trim();
-        if line.is_empty() {
-            continue;
-        }
-        if line == "EOF" {
-            break;
-        }
-        let key = line.split([':', ' ', '\t']).next().unwrap_or("");
-        if let Some(&name) = SECTIONS.iter().find(|s| **s == key) {
-            if parts.sections.iter().any(|(k, _)| *k == name) {
-                return Err(Error::parse(file, ln, format!("{name} appears twice")));
-            }
-            parts.sections.push((name, Vec::new()));
-            continue;
-        }
-        if let Some((_, lines)) = parts.sections.last_mut() {
-            lines.push((ln, line));
-        } else if let Some((k, v)) = line.split_once(':') {
-            parts
-                .header
-                .push((ln, k.trim().to_ascii_uppercase(), v.trim()));
-        } else {
-            return Err(Error::parse(
-                file,
-                ln,
-                format!("expected 'KEY: VALUE' or a section name, found '{line}'"),
-            ));
-        }
-    }
-    Ok(parts)
-}
-
 /// Whitespace tokens of numbered lines.
 fn tokens<'a>(lines: &'a [(usize, &'a str)]) -> impl Iterator<Item = (usize, &'a str)> + 'a {
     lines
@@ -114,34 +52,9 @@ fn tokens<'a>(lines: &'a [(usize, &'a str)]) -> impl Iterator<Item = (usize, &'a
         .flat_map(|&(ln, l)| l.split_whitespace().map(move |t| (ln, t)))
 }
 
-fn number(file: &str, ln: usize, t: &str, what: &dyn Fn() -> String) -> Result<f64> {
-    match t.parse::<f64>() {
-        Ok(v) if v.is_finite() => Ok(v),
-        _ => Err(Error::parse(
-            file,
-            ln,
-            format!("expected a number for {}, found '{t}'", what()),
-        )),
-    }
-}
-
-fn positive(file: &str, p: &Parts, key: &str) -> Result<(usize, usize)> {
-    let (ln, v) = p
-        .get(key)
-        .ok_or_else(|| Error::parse(file, 1, format!("missing header field {key}")))?;
-    let n = v.parse::<usize>().ok().filter(|&d| d > 0).ok_or_else(|| {
-        Error::parse(
-            file,
-            ln,
-            format!("{key} must be a positive integer, found '{v}'"),
-        )
-    })?;
-    Ok((ln, n))
-}
-
 /// Parses a `TYPE: PCGTSP` file (see the module documentation); no validation.
 pub fn parse_pcgtsp(file: &str, text: &str) -> Result<Instance> {
-    let p = split(file, text)?;
+    let p = super::sections::split(file, text, &SECTIONS, true)?;
     if p.get("GTSP_SETS").is_some() {
         return super::tsplib::parse_pcglns(file, text);
     }
@@ -155,7 +68,7 @@ pub fn parse_pcgtsp(file: &str, text: &str) -> Result<Instance> {
     let (costs, edges) = matrix(file, &p, &weight, &group_of, &new_index)?;
     let start = start_group(file, &p, &groups)?;
     Ok(generalized_instance(
-        instance_name(&p, file),
+        instance_name(&p, file, &[".pcgtsp"]),
         "pcgtsp",
         p.get("COMMENT").map(|(_, v)| v.to_string()),
         &groups,
@@ -173,47 +86,11 @@ fn missing(file: &str, p: &Parts, name: &str) -> Error {
 /// The header's checks: the type and the matrix format, `DIMENSION` (within the node
 /// limit) and `GROUPS` (at most one per node); returns both.
 fn header(file: &str, p: &Parts) -> Result<(usize, usize)> {
-    if let Some((ln, t)) = p.get("TYPE")
-        && t != "PCGTSP"
-    {
-        return Err(Error::parse(
-            file,
-            ln,
-            format!("TYPE is '{t}', expected PCGTSP"),
-        ));
-    }
-    if let Some((ln, v)) = p.get("EDGE_WEIGHT_TYPE")
-        && v != "EXPLICIT"
-    {
-        return Err(Error::parse(
-            file,
-            ln,
-            format!("EDGE_WEIGHT_TYPE {v} is not supported (EXPLICIT only)"),
-        ));
-    }
-    if let Some((ln, v)) = p.get("EDGE_WEIGHT_FORMAT")
-        && v != "FULL_MATRIX"
-    {
-        return Err(Error::parse(
-            file,
-            ln,
-            format!("EDGE_WEIGHT_FORMAT {v} is not supported (FULL_MATRIX only)"),
-        ));
-    }
+    check_type(file, p, &["PCGTSP"])?;
+    check_explicit(file, p)?;
     let (dim_line, dim) = positive(file, p, "DIMENSION")?;
     let (groups_line, ngroups) = positive(file, p, "GROUPS")?;
-    let limit = max_nodes();
-    if dim > limit {
-        return Err(Error::parse(
-            file,
-            dim_line,
-            format!(
-                "DIMENSION {dim} is above the limit of {limit} nodes (the matrix would take \
-                 {:.1} GB); set {MAX_NODES_ENV} to raise it",
-                8.0 * (dim as f64) * (dim as f64) / 1e9
-            ),
-        ));
-    }
+    check_dimension(file, dim_line, dim)?;
     if ngroups > dim {
         return Err(Error::parse(
             file,
@@ -337,16 +214,7 @@ fn matrix(
         })?;
         let slot = new_index[i] * dim + new_index[j];
         if v == -1.0 {
-            let (gi, gj) = (group_of[i], group_of[j]);
-            if gi == gj {
-                return Err(Error::parse(
-                    file,
-                    ln,
-                    format!("group {} must precede itself", gi + 1),
-                ));
-            }
-            edges.insert((gj, gi));
-            costs[slot] = FORBIDDEN_ARC;
+            costs[slot] = forbidden_arc(file, ln, (group_of[i], group_of[j]), &mut edges)?;
             continue;
         }
         if !(0.0..=max).contains(&v) {
@@ -419,21 +287,6 @@ fn start_group(file: &str, p: &Parts, groups: &[Vec<usize>]) -> Result<usize> {
     Ok(start)
 }
 
-fn instance_name(p: &Parts, file: &str) -> String {
-    let stem = std::path::Path::new(file)
-        .file_name()
-        .and_then(|s| s.to_str())
-        .unwrap_or(file);
-    let stem = stem.strip_suffix(".pcgtsp").unwrap_or(stem);
-    if stem.is_empty() {
-        p.get("NAME")
-            .map(|(_, v)| v.to_string())
-            .unwrap_or_default()
-    } else {
-        stem.to_string()
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -458,7 +311,7 @@ mod tests {
         assert_eq!(m.get(0, 1), 1.5); // no weight on node 2
         assert_eq!(m.get(0, 2), 2.5); // node 3 weighs 0.5
         assert_eq!(m.get(3, 2), 8.75);
-        assert_eq!(m.get(1, 2), FORBIDDEN_ARC);
+        assert_eq!(m.get(1, 2), super::super::tsplib::FORBIDDEN_ARC);
         assert_eq!(m.get(2, 3), 7.0); // node 3 -> node 4 (weight 1)
     }
 

@@ -1,5 +1,8 @@
 //! Readers for TSPLIB-style text: TSPLIB SOP (`TYPE: SOP`) and PCGLNS/PCGTSP (`TYPE: PCGLNS`).
 
+use super::sections::{
+    Lines, check_dimension, check_explicit, check_type, instance_name, number, positive, split,
+};
 use crate::error::{Error, Result};
 use crate::model::{Cell, CostMatrix, Instance, Metadata, Mode};
 use std::collections::BTreeSet;
@@ -84,14 +87,7 @@ impl<'a> Tokens<'a> {
                 format!("file ends early: expected {}", what()),
             ));
         };
-        match t.parse::<f64>() {
-            Ok(v) if v.is_finite() => Ok((ln, v)),
-            _ => Err(Error::parse(
-                self.file,
-                ln,
-                format!("expected a number for {}, found '{t}'", what()),
-            )),
-        }
+        Ok((ln, number(self.file, ln, t, what)?))
     }
     fn next_int(&mut self, what: &str) -> Result<(usize, i64)> {
         let (ln, v) = self.next_num(&|| what.to_string())?;
@@ -109,18 +105,7 @@ impl<'a> Tokens<'a> {
 /// Checks a declared matrix dimension against the limit and against the numbers the
 /// section holds, before anything of that size is allocated.
 fn check_matrix_size(file: &str, ln: usize, dim: usize, tok: &Tokens) -> Result<()> {
-    let limit = max_nodes();
-    if dim > limit {
-        return Err(Error::parse(
-            file,
-            ln,
-            format!(
-                "DIMENSION {dim} is above the limit of {limit} nodes (the matrix would take \
-                 {:.1} GB); set {MAX_NODES_ENV} to raise it",
-                8.0 * (dim as f64) * (dim as f64) / 1e9
-            ),
-        ));
-    }
+    check_dimension(file, ln, dim)?;
     let have = tok.remaining();
     let need = dim.saturating_mul(dim);
     if have < need {
@@ -170,139 +155,20 @@ fn entry(file: &str, ln: usize, i: usize, j: usize, v: f64) -> Result<Option<f64
     Ok(Some(v))
 }
 
-struct Header<'a> {
-    pairs: Vec<(usize, String, &'a str)>,
-}
-
-impl Header<'_> {
-    fn get(&self, key: &str) -> Option<(usize, &str)> {
-        self.pairs
-            .iter()
-            .find(|(_, k, _)| k == key)
-            .map(|(l, _, v)| (*l, *v))
-    }
-}
-
-/// Named sections, each with its numbered lines.
-type Sections<'a> = Vec<(String, Vec<(usize, &'a str)>)>;
-
-/// Splits a TSPLIB text into header `KEY: VALUE` pairs and named sections of lines.
-fn split_sections<'a>(
-    file: &str,
-    text: &'a str,
-    section_names: &[&str],
-) -> Result<(Header<'a>, Sections<'a>)> {
-    let mut header = Header { pairs: Vec::new() };
-    let mut sections: Vec<(String, Vec<(usize, &'a str)>)> = Vec::new();
-    for (i, raw) in text.lines().enumerate() {
-        let ln = i + 1;
-        let line = raw.trim();
-        if line.is_empty() {
-            continue;
-        }
-        if line == "EOF" {
-            break;
-        }
-        let key = line.split([':', ' ', '\t']).next().unwrap_or("");
-        if section_names.contains(&key) {
-            sections.push((key.to_string(), Vec::new()));
-            continue;
-        }
-        if let Some((_, lines)) = sections.last_mut() {
-            lines.push((ln, line));
-        } else if let Some((k, v)) = line.split_once(':') {
-            header
-                .pairs
-                .push((ln, k.trim().to_ascii_uppercase(), v.trim()));
-        } else {
-            return Err(Error::parse(
-                file,
-                ln,
-                format!("expected 'KEY: VALUE' or a section name, found '{line}'"),
-            ));
-        }
-    }
-    Ok((header, sections))
-}
-
-fn header_usize(file: &str, h: &Header, key: &str) -> Result<usize> {
-    let (ln, v) = h
-        .get(key)
-        .ok_or_else(|| Error::parse(file, 1, format!("missing header field {key}")))?;
-    v.parse::<usize>().ok().filter(|&d| d > 0).ok_or_else(|| {
-        Error::parse(
-            file,
-            ln,
-            format!("{key} must be a positive integer, found '{v}'"),
-        )
-    })
-}
-
-fn check_explicit(file: &str, h: &Header) -> Result<()> {
-    if let Some((ln, v)) = h.get("EDGE_WEIGHT_TYPE")
-        && v != "EXPLICIT"
-    {
-        return Err(Error::parse(
-            file,
-            ln,
-            format!("EDGE_WEIGHT_TYPE {v} is not supported (EXPLICIT only)"),
-        ));
-    }
-    if let Some((ln, v)) = h.get("EDGE_WEIGHT_FORMAT")
-        && v != "FULL_MATRIX"
-    {
-        return Err(Error::parse(
-            file,
-            ln,
-            format!("EDGE_WEIGHT_FORMAT {v} is not supported (FULL_MATRIX only)"),
-        ));
-    }
-    Ok(())
-}
-
-fn instance_name(h: &Header, file: &str) -> String {
-    let stem = std::path::Path::new(file)
-        .file_name()
-        .and_then(|s| s.to_str())
-        .unwrap_or(file);
-    let stem = stem
-        .strip_suffix(".sop")
-        .or_else(|| stem.strip_suffix(".pcglns"))
-        .unwrap_or(stem);
-    if stem.is_empty() {
-        h.get("NAME")
-            .map(|(_, v)| v.to_string())
-            .unwrap_or_default()
-    } else {
-        stem.to_string()
-    }
-}
-
 /// Parses a TSPLIB SOP file. Node i (1-based) becomes cell `"i"` with one mode.
 pub fn parse_sop(file: &str, text: &str) -> Result<Instance> {
-    let (h, sections) = split_sections(file, text, &["EDGE_WEIGHT_SECTION"])?;
-    if let Some((ln, t)) = h.get("TYPE")
-        && t != "SOP"
-    {
-        return Err(Error::parse(
-            file,
-            ln,
-            format!("TYPE is '{t}', expected SOP"),
-        ));
-    }
+    let h = split(file, text, &["EDGE_WEIGHT_SECTION"], false)?;
+    check_type(file, &h, &["SOP"])?;
     check_explicit(file, &h)?;
-    let dim = header_usize(file, &h, "DIMENSION")?;
-    let Some((_, lines)) = sections
-        .into_iter()
-        .find(|(k, _)| k == "EDGE_WEIGHT_SECTION")
-    else {
+    let (_, dim) = positive(file, &h, "DIMENSION")?;
+    let Some(lines) = h.section("EDGE_WEIGHT_SECTION") else {
         return Err(Error::parse(
             file,
             text.lines().count().max(1),
             "missing EDGE_WEIGHT_SECTION",
         ));
     };
-    let mut tok = Tokens::new(file, &lines);
+    let mut tok = Tokens::new(file, lines);
     let (ln, d2) = tok.next_int("the dimension after EDGE_WEIGHT_SECTION")?;
     if d2 != dim as i64 {
         return Err(Error::parse(
@@ -344,7 +210,7 @@ pub fn parse_sop(file: &str, text: &str) -> Result<Instance> {
         .map(|i| Cell::new((i + 1).to_string(), "", vec![Mode::default()]))
         .collect();
     Ok(Instance {
-        name: instance_name(&h, file),
+        name: instance_name(&h, file, &[".sop", ".pcglns"]),
         meta: Metadata {
             generator: Some("tsplib-sop".into()),
             comment: h.get("COMMENT").map(|(_, v)| v.to_string()),
@@ -362,7 +228,7 @@ pub fn parse_sop(file: &str, text: &str) -> Result<Instance> {
 /// Parses a PCGLNS (PCGTSP) file. Group g becomes cell `"g"` whose modes are the group's
 /// nodes in file order.
 pub fn parse_pcglns(file: &str, text: &str) -> Result<Instance> {
-    let (h, sections) = split_sections(
+    let h = split(
         file,
         text,
         &[
@@ -371,22 +237,13 @@ pub fn parse_pcglns(file: &str, text: &str) -> Result<Instance> {
             "GTSP_SET_ORDERING",
             "START_GROUP_SECTION",
         ],
+        false,
     )?;
-    if let Some((ln, t)) = h.get("TYPE")
-        && t != "PCGLNS"
-        && t != "PCGTSP"
-    {
-        return Err(Error::parse(
-            file,
-            ln,
-            format!("TYPE is '{t}', expected PCGLNS"),
-        ));
-    }
+    check_type(file, &h, &["PCGLNS", "PCGTSP"])?;
     check_explicit(file, &h)?;
-    let dim = header_usize(file, &h, "DIMENSION")?;
-    let ngroups = header_usize(file, &h, "GTSP_SETS")?;
+    let (dim_line, dim) = positive(file, &h, "DIMENSION")?;
+    let (sets_line, ngroups) = positive(file, &h, "GTSP_SETS")?;
     // sizes from the header, checked before the per-node and per-group tables are allocated
-    let dim_line = h.get("DIMENSION").map_or(1, |(l, _)| l);
     let limit = max_nodes();
     if dim > limit {
         return Err(Error::parse(
@@ -400,18 +257,14 @@ pub fn parse_pcglns(file: &str, text: &str) -> Result<Instance> {
     if ngroups > dim {
         return Err(Error::parse(
             file,
-            h.get("GTSP_SETS").map_or(1, |(l, _)| l),
+            sets_line,
             format!("GTSP_SETS {ngroups} is more than the {dim} nodes (every group needs a node)"),
         ));
     }
-    let section = |name: &str| -> Result<Vec<(usize, &str)>> {
-        sections
-            .iter()
-            .find(|(k, _)| k == name)
-            .map(|(_, l)| l.clone())
-            .ok_or_else(|| {
-                Error::parse(file, text.lines().count().max(1), format!("missing {name}"))
-            })
+    let section = |name: &str| -> Result<Lines> {
+        h.section(name).cloned().ok_or_else(|| {
+            Error::parse(file, text.lines().count().max(1), format!("missing {name}"))
+        })
     };
     let (group_of, groups) = pcglns_groups(file, section("GTSP_SET_SECTION")?, dim, ngroups)?;
     let lines = section("EDGE_WEIGHT_SECTION")?;
@@ -422,7 +275,7 @@ pub fn parse_pcglns(file: &str, text: &str) -> Result<Instance> {
     }
     let start = pcglns_start(file, section("START_GROUP_SECTION")?, &groups)?;
     Ok(generalized_instance(
-        instance_name(&h, file),
+        instance_name(&h, file, &[".sop", ".pcglns"]),
         "pcglns",
         h.get("COMMENT").map(|(_, v)| v.to_string()),
         &groups,
@@ -525,17 +378,7 @@ fn pcglns_matrix(
             let (gi, gj) = (group_of[i], group_of[j]);
             let slot = new_index[i] * dim + new_index[j];
             match entry(file, ln, i, j, v)? {
-                None => {
-                    if gi == gj {
-                        return Err(Error::parse(
-                            file,
-                            ln,
-                            format!("group {} must precede itself", gi + 1),
-                        ));
-                    }
-                    edges.insert((gj, gi));
-                    costs[slot] = FORBIDDEN_ARC;
-                }
+                None => costs[slot] = forbidden_arc(file, ln, (gi, gj), edges)?,
                 Some(v) => costs[slot] = v,
             }
         }
@@ -548,6 +391,25 @@ fn pcglns_matrix(
         ));
     }
     Ok(costs)
+}
+
+/// A -1 entry from a node of group `gi` to a node of group `gj` of a generalized file: group
+/// `gj` precedes `gi` (added to `edges`), and the arc costs [`FORBIDDEN_ARC`].
+pub(crate) fn forbidden_arc(
+    file: &str,
+    ln: usize,
+    (gi, gj): (usize, usize),
+    edges: &mut BTreeSet<(usize, usize)>,
+) -> Result<f64> {
+    if gi == gj {
+        return Err(Error::parse(
+            file,
+            ln,
+            format!("group {} must precede itself", gi + 1),
+        ));
+    }
+    edges.insert((gj, gi));
+    Ok(FORBIDDEN_ARC)
 }
 
 /// The precedence of `GTSP_SET_ORDERING`: each line's first group before the others.

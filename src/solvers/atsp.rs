@@ -173,41 +173,26 @@ impl Solver for Atsp {
 mod tests {
     use crate::cost::CostModel;
     use crate::engine::atsp::patch::{self, ApGraph, construct};
+    use crate::engine::atsp::random_matrix_instance;
     use crate::engine::{Costs, Solution};
-    use crate::model::{Cell, CostMatrix, Instance, Mode, Objective, Visit};
+    use crate::model::{Instance, Objective, Visit};
     use crate::solvers::{Budget, NoObserver, run};
-    use rand::{RngExt, SeedableRng};
-    use rand_chacha::ChaCha8Rng;
     use std::collections::BTreeMap;
 
     /// A random matrix instance with costs in 0..10 (many ties), SOP-like fixed ends on odd
     /// seeds and one precedence pair on seeds divisible by 3.
     fn tiny(n: usize, seed: u64) -> Instance {
-        let mut rng = ChaCha8Rng::seed_from_u64(seed);
-        let costs = (0..n * n)
-            .map(|k| {
-                if k / n == k % n {
-                    0.0
-                } else {
-                    rng.random_range(0..10) as f64
-                }
-            })
-            .collect();
+        let prec = if seed.is_multiple_of(3) {
+            vec![(2, 1)]
+        } else {
+            vec![]
+        };
         let ends = seed % 2 == 1;
         Instance {
             name: format!("tiny{seed}"),
-            cells: (0..n)
-                .map(|i| Cell::new(i.to_string(), "", vec![Mode::default()]))
-                .collect(),
-            precedence: if seed.is_multiple_of(3) {
-                vec![(2, 1)]
-            } else {
-                vec![]
-            },
-            matrix: Some(CostMatrix { size: n, costs }),
             first: ends.then_some(0),
             last: ends.then_some(n - 1),
-            ..Instance::default()
+            ..random_matrix_instance(n, seed, 10, &prec)
         }
     }
 

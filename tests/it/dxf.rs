@@ -13,6 +13,27 @@ fn ent(layer: &str, t: EntityType) -> Entity {
     e
 }
 
+/// A slot, closed: two straight sides from (40, 20) to (60, 20) and from (60, 30) to
+/// (40, 30), and two half circles (bulge 1) of radius 5 (in both test drawings).
+pub(crate) fn slot() -> LwPolyline {
+    let mut pl = LwPolyline::default();
+    for (x, y, b) in [
+        (40.0, 20.0, 0.0),
+        (60.0, 20.0, 1.0),
+        (60.0, 30.0, 0.0),
+        (40.0, 30.0, 1.0),
+    ] {
+        pl.vertices.push(LwPolylineVertex {
+            x,
+            y,
+            bulge: b,
+            ..Default::default()
+        });
+    }
+    pl.set_is_closed(true);
+    pl
+}
+
 /// An outer 100x60 frame made of 3 loose LINEs and an ARC-free closing line in shuffled
 /// directions, a hole (CIRCLE), a slot (LWPOLYLINE with two bulges), and a block of a small
 /// square inserted twice (once rotated) on layer "inner".
@@ -33,22 +54,7 @@ fn drawing() -> Vec<u8> {
         "inner",
         EntityType::Circle(Circle::new(Point::new(20.0, 20.0, 0.0), 5.0)),
     ));
-    let mut pl = LwPolyline::default();
-    for (x, y, b) in [
-        (40.0, 20.0, 0.0),
-        (60.0, 20.0, 1.0),
-        (60.0, 30.0, 0.0),
-        (40.0, 30.0, 1.0),
-    ] {
-        pl.vertices.push(LwPolylineVertex {
-            x,
-            y,
-            bulge: b,
-            ..Default::default()
-        });
-    }
-    pl.set_is_closed(true);
-    d.add_entity(ent("inner", EntityType::LwPolyline(pl)));
+    d.add_entity(ent("inner", EntityType::LwPolyline(slot())));
     let mut a = Arc::new(Point::new(80.0, 45.0, 0.0), 4.0, 0.0, 180.0);
     a.thickness = 0.0;
     d.add_entity(ent("inner", EntityType::Arc(a)));
@@ -74,9 +80,7 @@ fn drawing() -> Vec<u8> {
         };
         d.add_entity(ent("inner", EntityType::Insert(ins)));
     }
-    let mut buf = Vec::new();
-    d.save(&mut buf).unwrap();
-    buf
+    bytes_of(&d)
 }
 
 #[test]
@@ -169,7 +173,7 @@ proptest! {
     }
 }
 
-fn bytes_of(d: &::dxf::Drawing) -> Vec<u8> {
+pub(crate) fn bytes_of(d: &::dxf::Drawing) -> Vec<u8> {
     let mut buf = Vec::new();
     d.save(&mut buf).unwrap();
     buf

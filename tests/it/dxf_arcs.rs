@@ -3,8 +3,8 @@
 //! sweep are those of the DXF entity; the post's own check accepts them and refuses a moved
 //! centre; LinuxCNC's interpreter (`rs274`) runs the program and finds the same arcs.
 
-use ::dxf::entities::{Arc, Circle, Entity, EntityType, Insert, LwPolyline};
-use ::dxf::{Block, LwPolylineVertex, Point};
+use ::dxf::entities::{Arc, Circle, Entity, EntityType, Insert};
+use ::dxf::{Block, Point};
 use cellseq::io::dxf::{self, Post, ReadOptions};
 use cellseq::io::gcode::interp::{self, CutKind};
 use cellseq::pipeline::drawing::{self as pipe, Options};
@@ -34,22 +34,7 @@ fn drawing() -> (Vec<u8>, Expected) {
         180.0,
     ))));
     // a slot: two straight sides and two half circles (bulge 1) of radius 5
-    let mut pl = LwPolyline::default();
-    for (x, y, b) in [
-        (40.0, 20.0, 0.0),
-        (60.0, 20.0, 1.0),
-        (60.0, 30.0, 0.0),
-        (40.0, 30.0, 1.0),
-    ] {
-        pl.vertices.push(LwPolylineVertex {
-            x,
-            y,
-            bulge: b,
-            ..Default::default()
-        });
-    }
-    pl.set_is_closed(true);
-    d.add_entity(ent(EntityType::LwPolyline(pl)));
+    d.add_entity(ent(EntityType::LwPolyline(crate::dxf::slot())));
     // a quarter arc of radius 3 about the block's origin, inserted at (50, 70), scaled 2,
     // rotated 90°: centre (50, 70), radius 6, from 90° to 180°
     let mut b = Block {
@@ -71,8 +56,7 @@ fn drawing() -> (Vec<u8>, Expected) {
         y_scale_factor: 2.0,
         ..Default::default()
     })));
-    let mut buf = Vec::new();
-    d.save(&mut buf).unwrap();
+    let buf = crate::dxf::bytes_of(&d);
     let expected = vec![
         ([20.0, 20.0], 5.0, 2.0 * PI),
         ([80.0, 45.0], 4.0, PI),

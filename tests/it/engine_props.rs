@@ -56,6 +56,41 @@ fn close(a: f64, b: f64) -> bool {
 }
 
 /// `s` is a permutation of the model's cells, `pos` inverts `order`, and every mode exists.
+/// What a search context borrows, for tests: empty parameters and no observer.
+struct Ctx {
+    params: cellseq::params::Params,
+    obs: cellseq::solvers::NoObserver,
+}
+
+impl Ctx {
+    fn new() -> Self {
+        Ctx {
+            params: cellseq::params::Params::new("t", &[], &BTreeMap::new()).unwrap(),
+            obs: cellseq::solvers::NoObserver,
+        }
+    }
+    /// A context of seed 1 whose budget is `max_evals` evaluations.
+    fn ctx<'a>(
+        &'a mut self,
+        inst: &'a cellseq::model::Instance,
+        m: &'a CostModel,
+        max_evals: u64,
+    ) -> cellseq::solvers::Context<'a> {
+        let budget = cellseq::solvers::Budget {
+            max_evals: Some(max_evals),
+            ..Default::default()
+        };
+        cellseq::solvers::Context::new(inst, m, &self.params, 1, budget, &mut self.obs)
+    }
+}
+
+/// A window `[lo, lo + len)` of `len.min(n)` places in a sequence of `n`, placed by `a`.
+fn window_at(n: usize, len: usize, a: u64) -> (usize, usize, usize) {
+    let len = len.min(n);
+    let lo = (a % (n - len + 1) as u64) as usize;
+    (len, lo, lo + len)
+}
+
 fn well_formed(m: &CostModel, s: &Solution) -> Result<(), TestCaseError> {
     prop_assert_eq!(s.n(), m.n());
     let mut seen = vec![false; s.n()];
@@ -257,7 +292,6 @@ proptest! {
                               density in prop_oneof![Just(0.0), 0.01f64..0.3],
                               shuffle in prop::collection::vec(any::<u64>(), 50)) {
         use cellseq::engine::{Neighbours, linked};
-        use cellseq::solvers::{Budget, Context, NoObserver};
         let inst = instance(seed, n, modes, tools, density, reversible, rh);
         let m = CostModel::new(&inst, inst.default_objective());
         let c = Costs::open(&m);
@@ -265,11 +299,9 @@ proptest! {
         let mut s = Solution::new(&c, &start_seq);
         let start = s.cost;
         let nb = Neighbours::new(&m, k);
-        let params = cellseq::params::Params::new("t", &[], &BTreeMap::new()).unwrap();
-        let mut obs = NoObserver;
+        let mut fx = Ctx::new();
         // an evaluation budget, so that a wrong delta that cycles still ends (and fails below)
-        let budget = Budget { max_evals: Some(2_000_000), ..Budget::default() };
-        let mut ctx = Context::new(&inst, &m, &params, 1, budget, &mut obs);
+        let mut ctx = fx.ctx(&inst, &m, 2_000_000);
         linked::or_opt(&c, &nb, &mut s, &mut ctx);
         prop_assert!(close(s.cost, s.evaluate(&c)), "tracked {} vs evaluated {}", s.cost, s.evaluate(&c));
         prop_assert!(s.cost <= start + 1e-9 * start.abs().max(1.0));
@@ -335,7 +367,6 @@ proptest! {
                                  rh in any::<bool>(), k in 1usize..8, rev_max in 1usize..20,
                                  shuffle in prop::collection::vec(any::<u64>(), 60)) {
         use cellseq::engine::{Neighbours, large::{self, Large}};
-        use cellseq::solvers::{Budget, Context, NoObserver};
         let inst = instance(seed, n, modes, tools, density, reversible, rh);
         let m = CostModel::new(&inst, inst.default_objective());
         let c = Costs::open(&m);
@@ -348,11 +379,9 @@ proptest! {
         let mut s = Solution::new(&c, &seq);
         let start = s.cost;
         let nb = Neighbours::new(&m, k);
-        let params = cellseq::params::Params::new("t", &[], &BTreeMap::new()).unwrap();
-        let mut obs = NoObserver;
+        let mut fx = Ctx::new();
         // an evaluation budget, so that a wrong delta that cycles still ends (and fails below)
-        let budget = Budget { max_evals: Some(400_000), ..Budget::default() };
-        let mut ctx = Context::new(&inst, &m, &params, 1, budget, &mut obs);
+        let mut ctx = fx.ctx(&inst, &m, 400_000);
         let mut l = Large::new(c, &nb, &s);
         l.rev_max = rev_max;
         l.optimize(&mut ctx);
@@ -559,16 +588,13 @@ proptest! {
                               tools in 1usize..3, density in prop_oneof![Just(0.0), 0.05f64..0.5],
                               shuffle in prop::collection::vec(any::<u64>(), 30)) {
         use cellseq::engine::window::ModeWindow;
-        use cellseq::solvers::{Budget, Context, NoObserver};
         let inst = instance(seed, n, modes, tools, density, true, false);
         let m = CostModel::new(&inst, inst.default_objective());
         let c = Costs::open(&m);
         let mut s = Solution::new(&c, &shuffled_feasible(&m, &shuffle));
         let start = s.cost;
-        let params = cellseq::params::Params::new("t", &[], &BTreeMap::new()).unwrap();
-        let mut obs = NoObserver;
-        let budget = Budget { max_evals: Some(50_000_000), ..Budget::default() };
-        let mut ctx = Context::new(&inst, &m, &params, 1, budget, &mut obs);
+        let mut fx = Ctx::new();
+        let mut ctx = fx.ctx(&inst, &m, 50_000_000);
         let w = 4;
         let mut mw = ModeWindow::new(w);
         mw.improve(&c, &mut s, &mut ctx, None);
@@ -690,24 +716,19 @@ proptest! {
                               k in 2usize..6, a in any::<u64>(), len in 2usize..7,
                               shuffle in prop::collection::vec(any::<u64>(), 30)) {
         use cellseq::engine::shift::ShiftDp;
-        use cellseq::solvers::{Budget, Context, NoObserver};
         let inst = instance(seed, n, modes, tools, density, true, false);
         let m = CostModel::new(&inst, inst.default_objective());
         let c = Costs::open(&m);
         let mut s = Solution::new(&c, &shuffled_feasible(&m, &shuffle));
-        let len = len.min(n);
-        let lo = (a % (n - len + 1) as u64) as usize;
-        let hi = lo + len;
+        let (len, lo, hi) = window_at(n, len, a);
         // brute force first, on the sequence as it is
         let cells = s.order[lo..hi].to_vec();
         let brute = brute_window(&c, &s, lo, hi, |t| {
             (0..len).all(|i| (i + k..len).all(|j| t.pos[cells[i] as usize] < t.pos[cells[j] as usize]))
         });
         let start = s.cost;
-        let params = cellseq::params::Params::new("t", &[], &BTreeMap::new()).unwrap();
-        let mut obs = NoObserver;
-        let budget = Budget { max_evals: Some(50_000_000), ..Budget::default() };
-        let mut ctx = Context::new(&inst, &m, &params, 1, budget, &mut obs);
+        let mut fx = Ctx::new();
+        let mut ctx = fx.ctx(&inst, &m, 50_000_000);
         let mut dp = ShiftDp::new(k, 1_000_000);
         let improved = dp.improve_range(&c, &mut s, &mut ctx, lo, hi);
         window_result(&inst, &c, &s, start, brute, improved)?;
@@ -734,20 +755,15 @@ proptest! {
                               rh in any::<bool>(), a in any::<u64>(), len in 1usize..6,
                               shuffle in prop::collection::vec(any::<u64>(), 30)) {
         use cellseq::solvers::reopt::Reopt;
-        use cellseq::solvers::{Budget, Context, NoObserver};
         let inst = instance(seed, n, modes, tools, density, true, rh);
         let m = CostModel::new(&inst, inst.default_objective());
         let c = Costs::open(&m);
         let mut s = Solution::new(&c, &shuffled_feasible(&m, &shuffle));
-        let len = len.min(n);
-        let lo = (a % (n - len + 1) as u64) as usize;
-        let hi = lo + len;
+        let (len, lo, hi) = window_at(n, len, a);
         let brute = brute_window(&c, &s, lo, hi, |_| true);
         let start = s.cost;
-        let params = cellseq::params::Params::new("t", &[], &BTreeMap::new()).unwrap();
-        let mut obs = NoObserver;
-        let budget = Budget { max_evals: Some(500_000_000), ..Budget::default() };
-        let mut ctx = Context::new(&inst, &m, &params, 1, budget, &mut obs);
+        let mut fx = Ctx::new();
+        let mut ctx = fx.ctx(&inst, &m, 500_000_000);
         let r = Reopt { window: len, step: 0, window_share: 1.0, max_window: 200, k: 8 };
         let (gain, proven) = r.window(&c, &mut s, &mut ctx, lo, hi).unwrap();
         prop_assert!(proven);

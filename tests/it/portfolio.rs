@@ -82,26 +82,19 @@ fn chained_portfolio_is_deterministic_under_an_evaluation_budget() {
     let inst = sop("ry48p.1");
     let none = BTreeMap::new();
     for name in ["auto", "eacs"] {
-        let a = run(
-            name,
-            &inst,
-            inst.default_objective(),
-            &none,
-            3,
-            evals(400_000),
-            &mut NoObserver,
-        )
-        .unwrap();
-        let b = run(
-            name,
-            &inst,
-            inst.default_objective(),
-            &none,
-            3,
-            evals(400_000),
-            &mut NoObserver,
-        )
-        .unwrap();
+        let solve = || {
+            run(
+                name,
+                &inst,
+                inst.default_objective(),
+                &none,
+                3,
+                evals(400_000),
+                &mut NoObserver,
+            )
+            .unwrap()
+        };
+        let (a, b) = (solve(), solve());
         assert_eq!(a.outcome.sequence, b.outcome.sequence, "{name}");
         assert!(
             a.evaluations <= 400_000 + 50_000,
@@ -598,24 +591,22 @@ fn a_plan_reads_its_portfolio_from_the_plan_directory() {
     let path = d.path().join("plans/plan.toml");
     std::fs::write(&path, plan("mine.toml")).unwrap();
     // run from elsewhere: the relative name is the plan directory's file
-    let out = crate::common::cellseq()
-        .current_dir(d.path())
-        .arg("check")
-        .arg(&path)
-        .output()
-        .unwrap();
+    let check = || {
+        crate::common::cellseq()
+            .current_dir(d.path())
+            .arg("check")
+            .arg(&path)
+            .output()
+            .unwrap()
+    };
+    let out = check();
     assert!(
         out.status.success(),
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
     std::fs::write(&path, plan("missing.toml")).unwrap();
-    let out = crate::common::cellseq()
-        .current_dir(d.path())
-        .arg("check")
-        .arg(&path)
-        .output()
-        .unwrap();
+    let out = check();
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{err}");
     assert!(

@@ -52,3 +52,36 @@ pub fn free_density(m: &CostModel) -> f64 {
     }
     pairs as f64 / (k as f64 * (k as f64 - 1.0) / 2.0)
 }
+
+/// A random matrix instance for tests: `n` single-mode cells named by index, costs drawn
+/// uniformly from `0..max_cost` by ChaCha8 seeded with `seed` (0 on the diagonal), and the
+/// precedence pairs `prec`.
+#[cfg(test)]
+pub(crate) fn random_matrix_instance(
+    n: usize,
+    seed: u64,
+    max_cost: i32,
+    prec: &[(usize, usize)],
+) -> crate::model::Instance {
+    use crate::model::{Cell, CostMatrix, Instance, Mode};
+    use rand::{RngExt, SeedableRng};
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+    let costs = (0..n * n)
+        .map(|k| {
+            if k / n == k % n {
+                0.0
+            } else {
+                rng.random_range(0..max_cost) as f64
+            }
+        })
+        .collect();
+    Instance {
+        name: "t".into(),
+        cells: (0..n)
+            .map(|i| Cell::new(i.to_string(), "", vec![Mode::default()]))
+            .collect(),
+        precedence: prec.to_vec(),
+        matrix: Some(CostMatrix { size: n, costs }),
+        ..Instance::default()
+    }
+}

@@ -282,33 +282,12 @@ impl<'a> Or3<'a> {
 
 #[cfg(test)]
 mod tests {
+    use super::super::random_matrix_instance;
     use super::*;
     use crate::cost::CostModel;
-    use crate::model::{Cell, CostMatrix, Instance, Mode, Objective, Visit};
+    use crate::model::{Objective, Visit};
     use crate::solvers::{Budget, NoObserver, Params};
     use rand::SeedableRng;
-
-    fn random_instance(n: usize, seed: u64, prec: &[(usize, usize)]) -> Instance {
-        let mut rng = ChaCha8Rng::seed_from_u64(seed);
-        let costs = (0..n * n)
-            .map(|k| {
-                if k / n == k % n {
-                    0.0
-                } else {
-                    rng.random_range(0..20) as f64
-                }
-            })
-            .collect();
-        Instance {
-            name: "t".into(),
-            cells: (0..n)
-                .map(|i| Cell::new(i.to_string(), "", vec![Mode::default()]))
-                .collect(),
-            precedence: prec.to_vec(),
-            matrix: Some(CostMatrix { size: n, costs }),
-            ..Instance::default()
-        }
-    }
 
     /// Every swap the search finds and every kick changes the cost by its delta, exactly as a
     /// full re-evaluation says, and keeps the precedence.
@@ -321,7 +300,7 @@ mod tests {
             } else {
                 vec![(0, 3), (2, 5), (1, 4)]
             };
-            let inst = random_instance(n, seed, &prec);
+            let inst = random_matrix_instance(n, seed, 20, &prec);
             let m = CostModel::new(&inst, Objective::Matrix);
             let c = Costs::open(&m);
             let nb = Neighbours::new(&m, 4);
@@ -360,7 +339,7 @@ mod tests {
     fn full_lists_reach_a_true_or3opt_optimum() {
         for seed in 0..10u64 {
             let n = 9;
-            let inst = random_instance(n, 100 + seed, &[]);
+            let inst = random_matrix_instance(n, 100 + seed, 20, &[]);
             let m = CostModel::new(&inst, Objective::Matrix);
             let c = Costs::open(&m);
             let nb = Neighbours::new(&m, n - 1);

@@ -253,19 +253,7 @@ fn geometry(p: &Program, s: usize, e: usize, entry: [f64; 3]) -> Geometry {
 
 /// Splits a program. Errors: `(line, message)`.
 pub fn split(p: &Program) -> Result<Layout, (usize, String)> {
-    // no rapid across at a known height (a single helix, a wave): nothing to lift between, the
-    // program is split like a 2-D one
-    let z_split = if p.has_z {
-        find_safe(p).unwrap_or(Split::Flat)
-    } else {
-        Split::Flat
-    };
-    let split = match z_split {
-        // every cut at or above the travel height (a pen or a silkscreen pass at Z0 with
-        // rapids at Z0): the Z rule would make each move a cell; cells are runs of feed moves
-        Split::Z { safe, .. } if !cuts_below(p, safe) => Split::Flat,
-        s => s,
-    };
+    let split = choose_split(p);
     let safe = match split {
         Split::Z { safe, .. } => safe,
         Split::Flat => f64::INFINITY,
@@ -282,7 +270,7 @@ pub fn split(p: &Program) -> Result<Layout, (usize, String)> {
             return Err((li.line, "program end (M2/M30) before the last cut; move M2/M30 to the end of the program or remove the cuts after it".into()));
         }
     }
-    let mut cells = Vec::with_capacity(ranges.len());
+    let mut cells: Vec<GCell> = Vec::with_capacity(ranges.len());
     let mut blocks = vec![Block {
         tool: p.lines[header_end].before.tool,
         preamble: Vec::new(),
@@ -292,114 +280,17 @@ pub fn split(p: &Program) -> Result<Layout, (usize, String)> {
     let mut epoch = 0;
     let mut prev_end = header_end;
     for &(s, e, cycle) in &ranges {
-        let gap: Vec<usize> = (prev_end..s).collect();
         let gap_from = prev_end;
-        let mut prefix = Vec::new();
-        let boundary = |g: usize| is_boundary(p, g);
-        if gap.iter().any(|&g| p.lines[g].setup) {
-            epoch += 1;
-        }
-        if gap.iter().any(|&g| boundary(g)) {
-            let last_change = *gap.iter().rev().find(|&&g| boundary(g)).unwrap_or(&s);
-            blocks.push(Block {
-                tool: p.lines[s].before.tool,
-                preamble: gap
-                    .iter()
-                    .copied()
-                    .filter(|&g| {
-                        g <= last_change
-                            || p.lines[g].motion == Motion::None
-                            || has_other_words(p, g)
-                            || vertical(p, g)
-                    })
-                    .collect(),
-                gap_start: prev_end,
-                epoch,
-            });
-        } else if !cells.is_empty() {
-            prefix = gap
-                .iter()
-                .copied()
-                .filter(|&g| p.lines[g].motion == Motion::None || has_other_words(p, g))
-                .collect();
-        }
+        let prefix = gap(p, (prev_end, s), !cells.is_empty(), &mut epoch, &mut blocks);
         prev_end = e;
-        let first = &p.lines[s];
-        let last = &p.lines[e - 1];
-        let st = first.before;
-        if st.cutter_comp {
-            return Err((
-                first.line,
-                "cutter radius compensation (G41/G42) active at the start of a cut: cells cannot be reordered under it; turn it off (G40) before each retract, or use tool-centre paths instead".into(),
-            ));
-        }
-        let pinned = known(&first.pos_before).is_none();
-        let before = match known(&first.pos_before) {
-            Some(b) => b,
-            None => {
-                // right after G28/G30/G53/$H: the axes the program has not named since are
-                // where the controller left them; the cell keeps its place and approach
-                let to = known(&first.pos_after).ok_or((
-                    first.line,
-                    "the first move after G28/G30/G53/$H does not name X, Y and Z; give all \
-                     three in an absolute move before cutting"
-                        .to_string(),
-                ))?;
-                [0, 1, 2].map(|k| first.pos_before[k].unwrap_or(to[k]))
-            }
-        };
-        let exit = known(&last.pos_after).ok_or((
-            last.line,
-            "position unknown at the end of a cut".to_string(),
-        ))?;
-        let mut entry = before;
-        if !cycle
-            && first.motion == Motion::Rapid
-            && st.absolute
-            && let Some(t) = known(&first.pos_after)
-        {
-            entry = [t[0], t[1], before[2]];
-        }
-        let Geometry {
-            mut bbox,
-            cut_length,
-            depth,
-            pts,
-            planar,
-        } = geometry(p, s, e, entry);
-        if cycle {
-            entry = p.lines[s].cuts[0].from;
-        }
-        let exit = if cycle { entry } else { exit };
-        if !bbox[0].is_finite() {
-            bbox = [entry[0], entry[1], entry[0], entry[1]];
-        }
-        let closed_xy = (pts[0][0] - exit[0]).hypot(pts[0][1] - exit[1]) < 1e-3;
-        let closed = (planar && !cycle && closed_xy && pts.len() >= 4 && area(&pts).abs() > 1e-6)
-            .then_some(pts);
-        let block_first = cells
-            .last()
-            .is_none_or(|c: &GCell| c.block != blocks.len() - 1);
-        cells.push(GCell {
-            start: s,
-            end: e,
+        let block = blocks.len() - 1;
+        let block_first = cells.last().is_none_or(|c| c.block != block);
+        let place = Place {
             prefix,
             gap_start: if block_first { s } else { gap_from },
-            run: 0,
-            lead: false,
-            trail: false,
-            pinned,
-            block: blocks.len() - 1,
-            tool: st.tool,
-            entry,
-            exit,
-            state: st,
-            cycle,
-            bbox,
-            cut_length,
-            depth: if depth.is_finite() { depth } else { entry[2] },
-            closed,
-        });
+            block,
+        };
+        cells.push(cut_cell(p, (s, e, cycle), place)?);
     }
     let start = known(&p.lines[header_end].pos_before);
     assign_runs(p, &mut cells, &blocks);
@@ -412,6 +303,157 @@ pub fn split(p: &Program) -> Result<Layout, (usize, String)> {
         blocks,
         start,
         clearance,
+    })
+}
+
+/// How the program is delimited: by its safe height when it has one and cuts below it, else
+/// like a 2-D program.
+fn choose_split(p: &Program) -> Split {
+    // no rapid across at a known height (a single helix, a wave): nothing to lift between, the
+    // program is split like a 2-D one
+    let z_split = if p.has_z {
+        find_safe(p).unwrap_or(Split::Flat)
+    } else {
+        Split::Flat
+    };
+    match z_split {
+        // every cut at or above the travel height (a pen or a silkscreen pass at Z0 with
+        // rapids at Z0): the Z rule would make each move a cell; cells are runs of feed moves
+        Split::Z { safe, .. } if !cuts_below(p, safe) => Split::Flat,
+        s => s,
+    }
+}
+
+/// The gap lines `[from, to)` before a cut: when they cross a boundary (tool change, setup,
+/// pause …) they open a new block whose preamble they are (counting coordinate-system changes
+/// in `epoch`); otherwise, between two cells, the returned lines are the cell's prefix (the
+/// lines that are not plain motion).
+fn gap(
+    p: &Program,
+    (from, to): (usize, usize),
+    after_a_cell: bool,
+    epoch: &mut usize,
+    blocks: &mut Vec<Block>,
+) -> Vec<usize> {
+    let gap: Vec<usize> = (from..to).collect();
+    let boundary = |g: usize| is_boundary(p, g);
+    if gap.iter().any(|&g| p.lines[g].setup) {
+        *epoch += 1;
+    }
+    if gap.iter().any(|&g| boundary(g)) {
+        let last_change = *gap.iter().rev().find(|&&g| boundary(g)).unwrap_or(&to);
+        blocks.push(Block {
+            tool: p.lines[to].before.tool,
+            preamble: gap
+                .iter()
+                .copied()
+                .filter(|&g| {
+                    g <= last_change
+                        || p.lines[g].motion == Motion::None
+                        || has_other_words(p, g)
+                        || vertical(p, g)
+                })
+                .collect(),
+            gap_start: from,
+            epoch: *epoch,
+        });
+        Vec::new()
+    } else if after_a_cell {
+        gap.iter()
+            .copied()
+            .filter(|&g| p.lines[g].motion == Motion::None || has_other_words(p, g))
+            .collect()
+    } else {
+        Vec::new()
+    }
+}
+
+/// Where a cell sits among the gaps and blocks (see [`GCell`]).
+struct Place {
+    prefix: Vec<usize>,
+    gap_start: usize,
+    block: usize,
+}
+
+/// The cell of the body lines `[s, e)` (`cycle`: a single canned-cycle hole): its state,
+/// entry and exit, geometry and closed outline.
+fn cut_cell(
+    p: &Program,
+    (s, e, cycle): (usize, usize, bool),
+    place: Place,
+) -> Result<GCell, (usize, String)> {
+    let first = &p.lines[s];
+    let last = &p.lines[e - 1];
+    let st = first.before;
+    if st.cutter_comp {
+        return Err((
+            first.line,
+            "cutter radius compensation (G41/G42) active at the start of a cut: cells cannot be reordered under it; turn it off (G40) before each retract, or use tool-centre paths instead".into(),
+        ));
+    }
+    let pinned = known(&first.pos_before).is_none();
+    let before = match known(&first.pos_before) {
+        Some(b) => b,
+        None => {
+            // right after G28/G30/G53/$H: the axes the program has not named since are
+            // where the controller left them; the cell keeps its place and approach
+            let to = known(&first.pos_after).ok_or((
+                first.line,
+                "the first move after G28/G30/G53/$H does not name X, Y and Z; give all \
+                 three in an absolute move before cutting"
+                    .to_string(),
+            ))?;
+            [0, 1, 2].map(|k| first.pos_before[k].unwrap_or(to[k]))
+        }
+    };
+    let exit = known(&last.pos_after).ok_or((
+        last.line,
+        "position unknown at the end of a cut".to_string(),
+    ))?;
+    let mut entry = before;
+    if !cycle
+        && first.motion == Motion::Rapid
+        && st.absolute
+        && let Some(t) = known(&first.pos_after)
+    {
+        entry = [t[0], t[1], before[2]];
+    }
+    let Geometry {
+        mut bbox,
+        cut_length,
+        depth,
+        pts,
+        planar,
+    } = geometry(p, s, e, entry);
+    if cycle {
+        entry = p.lines[s].cuts[0].from;
+    }
+    let exit = if cycle { entry } else { exit };
+    if !bbox[0].is_finite() {
+        bbox = [entry[0], entry[1], entry[0], entry[1]];
+    }
+    let closed_xy = (pts[0][0] - exit[0]).hypot(pts[0][1] - exit[1]) < 1e-3;
+    let closed =
+        (planar && !cycle && closed_xy && pts.len() >= 4 && area(&pts).abs() > 1e-6).then_some(pts);
+    Ok(GCell {
+        start: s,
+        end: e,
+        prefix: place.prefix,
+        gap_start: place.gap_start,
+        run: 0,
+        lead: false,
+        trail: false,
+        pinned,
+        block: place.block,
+        tool: st.tool,
+        entry,
+        exit,
+        state: st,
+        cycle,
+        bbox,
+        cut_length,
+        depth: if depth.is_finite() { depth } else { entry[2] },
+        closed,
     })
 }
 
