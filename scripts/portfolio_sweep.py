@@ -54,6 +54,9 @@ import sys
 import threading
 import tomllib
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "peers"))
+from sop_common import cellseq_solve  # noqa: E402
+
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 BUILT_IN = os.path.join(ROOT, "src", "solvers", "auto", "portfolio.toml")
 
@@ -284,18 +287,8 @@ class Runs:
 
 
 def solve(binary, file, portfolio, seed, evals):
-    cmd = [binary, "solve", file, "--max-evals", str(evals), "--seed", str(seed), "--json",
-           "--explain", "--no-bound"]
-    if portfolio:
-        cmd += ["--portfolio", portfolio]
-    env = dict(os.environ, RAYON_NUM_THREADS="1")
-    p = subprocess.run(cmd, capture_output=True, text=True, env=env)
-    if p.returncode != 0:
-        raise RuntimeError("%s: %s" % (" ".join(cmd), p.stderr.strip()))
-    r = json.loads(p.stdout)
-    if not r.get("feasible"):
-        raise RuntimeError("%s: infeasible result" % " ".join(cmd))
-    return r
+    return cellseq_solve(binary, file, ["--max-evals", str(evals)], seed, portfolio,
+                         explain=True)
 
 
 def run_all(a, runs, jobs):

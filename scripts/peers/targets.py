@@ -17,25 +17,15 @@ import argparse
 import json
 import os
 import statistics
-import subprocess
 import sys
+
+from sop_common import cellseq_solve
 
 EXTS = (".sop", ".pcglns", ".pcgtsp")
 
 
 def solve(binary, path, limit, seed, portfolio):
-    cmd = [binary, "solve", path, "--json", "--no-bound", "--time-limit", str(limit),
-           "--seed", str(seed)]
-    if portfolio:
-        cmd += ["--portfolio", portfolio]
-    env = dict(os.environ, RAYON_NUM_THREADS="1")
-    p = subprocess.run(cmd, capture_output=True, text=True, env=env)
-    if p.returncode != 0:
-        raise RuntimeError("%s: %s" % (" ".join(cmd), p.stderr.strip()))
-    r = json.loads(p.stdout)
-    if not r.get("feasible"):
-        raise RuntimeError("%s: infeasible" % " ".join(cmd))
-    return r
+    return cellseq_solve(binary, path, ["--time-limit", str(limit)], seed, portfolio)
 
 
 def main():
