@@ -5,12 +5,10 @@
 //! for up to [`EXACT_MAX`] blocks, and nearest neighbour followed by block moves (Or-opt) to a
 //! local optimum beyond.
 
+use crate::io::drawing::dist;
+
 /// Most blocks ordered exactly (2^n · n² work: 12 blocks are about 600 000 steps).
 pub const EXACT_MAX: usize = 12;
-
-fn dist(a: [f64; 2], b: [f64; 2]) -> f64 {
-    (a[0] - b[0]).hypot(a[1] - b[1])
-}
 
 /// Travel of visiting `blocks` (entry, exit) in `order` from `start`, then to `finish`.
 pub fn travel(
