@@ -2,7 +2,7 @@
 
 use crate::cost::CostModel;
 use crate::engine::atsp::free_density;
-use crate::engine::{Costs, lk};
+use crate::engine::{Costs, large, lk};
 use crate::model::CostMatrix;
 use crate::precedence::closure_density;
 use serde::Serialize;
@@ -22,7 +22,10 @@ pub struct Features {
     /// True for geometric instances (costs from points and tools), false for cost matrices.
     pub geometric: bool,
     /// True when the costs read the same backwards (every arc costs what the reverse arc
-    /// does, cell directions flipped); see [`crate::engine::lk::symmetric`].
+    /// does, cell directions flipped): on a cost matrix tested arc by arc
+    /// ([`crate::engine::lk::symmetric`]); on a geometric instance known from how its links
+    /// are costed (the air length, or time with no linking at cutting feed:
+    /// [`crate::engine::large::applies`]), at any size.
     pub symmetric: bool,
     /// Ordered pairs of the precedence closure over n(n−1)/2
     /// ([`crate::precedence::closure_density`]).
@@ -61,7 +64,11 @@ impl Features {
             cells: m.n(),
             modes: m.nodes() as f64 / m.n().max(1) as f64,
             geometric,
-            symmetric: lk::symmetric(&Costs::open(m)),
+            symmetric: if geometric {
+                large::applies(&Costs::open(m))
+            } else {
+                lk::symmetric(&Costs::open(m))
+            },
             closure_density: closure,
             free_density: free,
             widest_level: widest_level(m),

@@ -386,6 +386,9 @@ pub struct Explanation {
     pub phases: String,
     /// The phases after a beam phase that ran, when they differ.
     pub after_beam: Option<String>,
+    /// Wall-clock seconds the features and the rule selection took on their own (the model
+    /// built, before any phase; `auto` spends the same at the start of its budget).
+    pub features_seconds: f64,
     /// The same as lines of text.
     #[serde(skip)]
     pub lines: Vec<String>,
@@ -401,7 +404,13 @@ pub fn explain(
     let params = Params::new(INFO.name, INFO.params, given)?;
     let auto = Auto::from_params(&params)?;
     let model = CostModel::new(instance, objective);
+    let clock = std::time::Instant::now();
     let c = auto.choose(&model);
+    let features_seconds = clock.elapsed().as_secs_f64();
+    let mut lines = c.lines(&auto.portfolio.source);
+    lines.push(format!(
+        "feature time {features_seconds:.3} s (features and rule selection alone)"
+    ));
     Ok(Explanation {
         portfolio: auto.portfolio.source.clone(),
         rule: c.rule.to_string(),
@@ -411,6 +420,7 @@ pub fn explain(
         beam_min_seconds: c.beam.min_seconds,
         phases: plan_text(c.phases),
         after_beam: c.after_beam.map(plan_text),
-        lines: c.lines(&auto.portfolio.source),
+        features_seconds,
+        lines,
     })
 }
