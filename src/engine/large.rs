@@ -28,6 +28,11 @@ use std::collections::VecDeque;
 /// the kicks gain more with the evaluations saved.
 pub const OR_K: usize = 5;
 
+/// Steps of each random walk of a random-walk kick ([`Large::walk`]): the cut points stay
+/// within a few candidate-list hops of the first, so the kick reconnects parts of the path
+/// that are close in the plane but may lie far apart along it.
+pub const WALK_STEPS: usize = 8;
+
 /// True when the search applies: open-loop costs on a geometric instance whose links cost
 /// the same read backwards (air length, or time with no linking at cutting feed).
 pub fn applies(c: &Costs) -> bool {
@@ -68,6 +73,11 @@ pub struct Large<'a> {
     pub rev_max: usize,
     /// Candidates per list tried as Or-opt insertion points.
     pub or_k: usize,
+    /// Share of the kicks that are random-walk double bridges ([`Large::walk_cuts`]; on
+    /// instances where every reversal is allowed), the rest local ones.
+    pub walk: f64,
+    /// Steps of each random walk of a random-walk kick.
+    pub walk_steps: usize,
     queue: VecDeque<u32>,
     on: Vec<bool>,
     log: Vec<Op>,
@@ -87,6 +97,8 @@ impl<'a> Large<'a> {
             free,
             rev_max: 1000,
             or_k: OR_K,
+            walk: 0.0,
+            walk_steps: WALK_STEPS,
             queue: VecDeque::new(),
             on: vec![false; s.n()],
             log: Vec::new(),
@@ -487,11 +499,21 @@ impl<'a> Large<'a> {
         while !ctx.exhausted() && fails < patience {
             kicks += 1;
             ctx.count(1);
-            let l1 = rng.random_range(1..=block.min(n / 2 - 1).max(1));
-            let l2 = rng.random_range(1..=block.min(n / 2 - 1).max(1));
-            let h = rng.random_range(0..(n - l1 - l2) as i64) as isize - 1;
-            let i = (h + l1 as isize) as usize;
-            let j = i + l2;
+            let (h, i, j) = if self.free && self.walk > 0.0 && rng.random_bool(self.walk) {
+                match self.walk_cuts(&mut rng) {
+                    Some(cuts) => cuts,
+                    None => {
+                        fails += 1;
+                        continue;
+                    }
+                }
+            } else {
+                let l1 = rng.random_range(1..=block.min(n / 2 - 1).max(1));
+                let l2 = rng.random_range(1..=block.min(n / 2 - 1).max(1));
+                let h = rng.random_range(0..(n - l1 - l2) as i64) as isize - 1;
+                let i = (h + l1 as isize) as usize;
+                (h, i, i + l2)
+            };
             if !self.free && !self.swappable(h, i, j) {
                 fails += 1;
                 continue;
@@ -531,6 +553,29 @@ impl<'a> Large<'a> {
         while let Some(x) = self.queue.pop_front() {
             self.on[x as usize] = false;
         }
+    }
+
+    /// The cuts of a random-walk double bridge (Applegate, Cook and Rohe's kick for large
+    /// instances): a random cell and the ends of two random walks of [`Large::walk_steps`]
+    /// hops over the candidate lists from it, sorted along the path, cut after each; `None`
+    /// when two of them coincide.
+    fn walk_cuts(&self, rng: &mut ChaCha8Rng) -> Option<(isize, usize, usize)> {
+        let n = self.t.n();
+        let start = self.t.cell_at(rng.random_range(0..n));
+        let mut walk = || {
+            let mut x = start;
+            for _ in 0..self.walk_steps {
+                let out = &self.nb.out[x as usize];
+                if out.is_empty() {
+                    break;
+                }
+                x = out[rng.random_range(0..out.len())];
+            }
+            self.t.pos(x)
+        };
+        let mut p = [self.t.pos(start), walk(), walk()];
+        p.sort_unstable();
+        (p[0] < p[1] && p[1] < p[2]).then_some((p[0] as isize, p[1], p[2]))
     }
 
     /// True when blocks `[h+1..=i]` and `[i+1..=j]` may swap: no cell of the first block

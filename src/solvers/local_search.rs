@@ -63,6 +63,12 @@ pub static INFO: SolverInfo = SolverInfo {
             help: "two-level search: longest block of a local double-bridge kick",
         },
         ParamSpec {
+            name: "walk-kicks",
+            default: "0",
+            kind: ParamKind::Float,
+            help: "two-level search without precedence: share of the kicks that are random-walk double bridges (cut points a few candidate-list hops apart in the plane, far apart along the path), the rest local ones",
+        },
+        ParamSpec {
             name: "max-block",
             default: "0",
             kind: ParamKind::Int,
@@ -84,6 +90,7 @@ pub static INFO: SolverInfo = SolverInfo {
             vnd: p.bool("vnd"),
             two_level: p.switch("two-level"),
             kick_block: p.int("kick-block").max(1) as usize,
+            walk_kicks: p.float("walk-kicks").clamp(0.0, 1.0),
         }))
     },
 };
@@ -111,6 +118,8 @@ pub struct LocalSearch {
     pub two_level: Option<bool>,
     /// Longest block of the two-level search's kicks.
     pub kick_block: usize,
+    /// Share of the two-level search's kicks that are random-walk double bridges.
+    pub walk_kicks: f64,
 }
 
 /// From this many cells on (parameter `two-level=auto`), instances without precedence where
@@ -149,6 +158,7 @@ impl Solver for LocalSearch {
         if two_level {
             // 2-opt and Or-opt with O(sqrt n) moves to a local optimum, then local kicks
             let mut l = Large::new(c, &search.nb, &s);
+            l.walk = self.walk_kicks;
             l.optimize(ctx);
             ctx.report(l.t.cost + m.constant());
             if self.kicks > 0 {

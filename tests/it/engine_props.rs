@@ -360,11 +360,13 @@ proptest! {
     }
 
     /// The two-level search keeps an exact cost and a feasible permutation, with and without
-    /// precedence, through the descent and the kicks with their undo.
+    /// precedence, through the descent and the kicks (local and random-walk ones) with their
+    /// undo.
     #[test]
     fn two_level_search_is_exact(seed in 0u64..1000, n in 2usize..60, modes in 1usize..4, tools in 1usize..3,
                                  density in prop_oneof![Just(0.0), 0.0f64..0.1], reversible in any::<bool>(),
                                  rh in any::<bool>(), k in 1usize..8, rev_max in 1usize..20,
+                                 walk in prop_oneof![Just(0.0), Just(0.5), Just(1.0)],
                                  shuffle in prop::collection::vec(any::<u64>(), 60)) {
         use cellseq::engine::{Neighbours, large::{self, Large}};
         let inst = instance(seed, n, modes, tools, density, reversible, rh);
@@ -384,6 +386,7 @@ proptest! {
         let mut ctx = fx.ctx(&inst, &m, 400_000);
         let mut l = Large::new(c, &nb, &s);
         l.rev_max = rev_max;
+        l.walk = walk;
         l.optimize(&mut ctx);
         l.write(&mut s);
         prop_assert!(close(s.cost, s.evaluate(&c)), "descent: tracked {} vs evaluated {}", s.cost, s.evaluate(&c));
