@@ -6,9 +6,10 @@ A documented sweep with a held-back part (notes/portfolio.md has the method and 
 1. **Instances.** `scripts/families.sh OUT/families` writes the training part (seeds 1, 2)
    and the held-back part (seeds 1001, 1002). The sweep keeps the matrix families
    (`random-sop`, `atsp`, `symmetric`, `near-symmetric`, `compiler-dag`, `generalized`) with
-   n <= --max-n (500 by default, for time). `geometric-sparse` is left out: every rule of the
-   portfolio but the catch-all asks for `geometric = false`, so geometric instances always get
-   the catch-all and there is nothing to choose for them here.
+   n <= --max-n (500 by default, for time). `geometric-sparse` is left out: the geometric rules
+   (`geometric-free` and the catch-all) were chosen by timed races of their plans on the
+   `uniform` family (`scripts/plan_race.py`, notes/portfolio.md), since an evaluation count
+   means different work in the two-level search and in the array phases.
 2. **Plan portfolios.** Every rule of the built-in portfolio (`src/solvers/auto/portfolio.toml`)
    becomes a one-rule portfolio file `OUT/cand/plan-NAME.toml` (its beam and phases as a
    catch-all), plus plan variants defined below (`VARIANTS`); all but the catch-all's plan
@@ -124,6 +125,13 @@ def load_plans():
     return doc["beam"], plans, doc["rule"]
 
 
+def geometric_rules(rules):
+    """The built-in's rules for geometric instances (`when.geometric = true`), kept as they
+    are in every candidate: no matrix instance reaches them, so the sweep cannot choose them."""
+    return [(r["name"], {k: r[k] for k in ("beam", "phases", "after_beam") if k in r}, r["when"])
+            for r in rules if r.get("when", {}).get("geometric") is True]
+
+
 # ---- candidates ----
 
 # The built-in rules' shape. `medium` and `large-medium` (split <= closure_density < DENSE)
@@ -158,7 +166,7 @@ def choose(c, f):
     return c["plans"].get(r, r)
 
 
-def candidate_rules(c, plans):
+def candidate_rules(c, plans, geometric=()):
     pl = lambda r: plans[c["plans"][r]]  # noqa: E731
     rules = []
     if c["sym"]:
@@ -177,6 +185,7 @@ def candidate_rules(c, plans):
                                          "cells": {"max": 300}}))
     rules.append(("large-dense", pl("large-dense"),
                   {"geometric": False, "closure_density": {"min": DENSE}}))
+    rules.extend(geometric)
     rules.append(("default", plans["default"], None))
     return rules
 
@@ -377,15 +386,17 @@ def main():
     os.makedirs(os.path.join(a.out, "cand"), exist_ok=True)
     os.environ.setdefault("CELLSEQ", a.cellseq)
 
-    beam, plans, _ = load_plans()
+    beam, plans, built_in_rules = load_plans()
+    geometric = geometric_rules(built_in_rules)
     plan_files = {}
     for name, rule in plans.items():
         path = os.path.abspath(os.path.join(a.out, "cand", "plan-%s.toml" % name))
         with open(path, "w") as f:
             f.write(portfolio_text(beam, [(name, rule, None)]))
         plan_files[name] = path
-    # the catch-all's plan is left out: no matrix instance reaches it
-    names = sorted(p for p in plans if p != "default")
+    # the catch-all's and the geometric rules' plans are left out: no matrix instance
+    # reaches them
+    names = sorted(p for p in plans if p != "default" and p not in {g[0] for g in geometric})
     parts = instances(a.out, a.max_n, a.families)
     runs = Runs(os.path.join(a.out, "runs.jsonl"))
     jobs = [(f, p, plan_files[p], s) for part in ("train", "heldback") for f in parts[part]
@@ -404,14 +415,14 @@ def main():
     pick = min(ties, key=lambda t: (t[1], abs(t[2]["free"] - 0.001), abs(t[2]["split"] - 0.8),
                                     abs(t[2]["cells"] - 300)))[2]
     pick_path = os.path.join(a.out, "pick.toml")
-    pick_text = portfolio_text(beam, candidate_rules(pick, plans))
+    pick_text = portfolio_text(beam, candidate_rules(pick, plans, geometric))
     with open(pick_path, "w") as f:
         f.write("# chosen by scripts/portfolio_sweep.py on the training families\n" + pick_text)
     # runs of the pick's file are cached under a label naming its content
     pick_label = "file:pick-" + hashlib.sha1(pick_text.encode()).hexdigest()[:12]
     builtin_path = os.path.join(a.out, "cand", "built-in.toml")
     with open(builtin_path, "w") as f:
-        f.write(portfolio_text(beam, candidate_rules(BUILT_IN_CAND, plans)))
+        f.write(portfolio_text(beam, candidate_rules(BUILT_IN_CAND, plans, geometric)))
 
     # held back: composed, then both portfolio files for real
     hb_sc, hb_ft = scores_of(parts["heldback"], names, runs, a)

@@ -34,9 +34,11 @@ precedence apart from a fixed start and end (`atsp`); **sparse** precedence (a s
 `local-search`, a colony run backwards, `ils` in a 1 % then a 3 % acceptance band with the \
 bounded-shift DP ending every repair, window re-optimization of the best); **dense** \
 precedence on few cells (half the budget for the beam, then the default phases); **large \
-dense** (no beam; `ils` with kicks that reorder up to 45 cells); and the catch-all \
-**default**, geometric instances among them (`local-search`, an `eacs` colony of its own, \
-`ils` from the best so far).
+dense** (no beam; `ils` with kicks that reorder up to 45 cells); **geometric free** \
+instances (geometric, no or very sparse precedence, links that cost the same both ways: \
+`local-search` on the two-level list with local and random-walk double-bridge kicks for the \
+whole budget); and the catch-all **default**, the other geometric instances among them \
+(`local-search`, an `eacs` colony of its own, `ils` from the best so far).
 
 `cellseq solve F --explain` prints the features, the rule and its plan before solving; \
 `CELLSEQ_TRACE=1` prints them and one line per phase on stderr. `--param plan=...` skips the \

@@ -220,16 +220,28 @@ fn auto_picks_its_rule_by_symmetry_and_precedence_density() {
     }
     // beam-share replaces the rule's share
     assert_eq!(auto(&[("beam-share", "0")]).choose(&p42).beam.share, 0.0);
-    // geometric instances get the catch-all rule
-    let kv: BTreeMap<String, String> = [("n", "30"), ("modes", "2"), ("reversible", "true")]
-        .into_iter()
-        .map(|(k, v)| (k.to_string(), v.to_string()))
-        .collect();
-    let inst = cellseq::generate::generate("uniform", &kv, 3).unwrap();
-    let m = CostModel::new(&inst, inst.default_objective());
-    let c = a.choose(&m);
+    // geometric instances: without precedence and with links that cost the same both ways,
+    // the two-level local search; with precedence, the catch-all rule
+    let geo = |pairs: &[(&str, &str)]| {
+        let kv: BTreeMap<String, String> = pairs
+            .iter()
+            .map(|(k, v)| (k.to_string(), v.to_string()))
+            .collect();
+        let inst = cellseq::generate::generate("uniform", &kv, 3).unwrap();
+        CostModel::new(&inst, inst.default_objective())
+    };
+    let free = geo(&[("n", "30"), ("modes", "2"), ("reversible", "true")]);
+    let c = a.choose(&free);
+    assert_eq!(c.rule, "geometric-free");
+    assert!(c.features.geometric && c.features.symmetric);
+    assert_eq!(
+        plan_text(c.plan(true)),
+        "local-search[two-level=on;walk-kicks=0.3]:1"
+    );
+    let ordered = geo(&[("n", "30"), ("preds", "1")]);
+    let c = a.choose(&ordered);
     assert_eq!(c.rule, "default");
-    assert!(c.features.geometric);
+    assert!(c.features.geometric && c.features.free_density > 0.001);
     assert_eq!(plan_text(c.plan(true)), "local-search:0.3,eacs:0.5,ils*:1");
 }
 
@@ -302,6 +314,7 @@ fn the_built_in_portfolio_parses_validates_and_ends_with_a_catch_all() {
             "sparse",
             "dense",
             "large-dense",
+            "geometric-free",
             "default"
         ]
     );
