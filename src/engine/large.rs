@@ -73,8 +73,8 @@ pub struct Large<'a> {
     pub rev_max: usize,
     /// Candidates per list tried as Or-opt insertion points.
     pub or_k: usize,
-    /// Share of the kicks that are random-walk double bridges ([`Large::walk_cuts`]; on
-    /// instances where every reversal is allowed), the rest local ones.
+    /// Share of the kicks that are random-walk double bridges (cuts a few candidate-list
+    /// hops apart; on instances where every reversal is allowed), the rest local ones.
     pub walk: f64,
     /// Steps of each random walk of a random-walk kick.
     pub walk_steps: usize,
