@@ -4,7 +4,7 @@
 #
 # usage: scripts/families.sh OUTDIR [--quick]
 #   CELLSEQ=path/to/cellseq (default target/release/cellseq)
-#   --quick: only n <= 500 and one seed per part (68 files per part, about 135 MB in all)
+#   --quick: only n <= 500 and one seed per part (86 files per part, about 135 MB in all)
 #
 # SOP-shaped matrix families are written as TSPLIB SOP (.sop, readable by LKH-3 through
 # scripts/peers/lkh_sop.py); geometric-sparse and generalized as cellseq JSON.
@@ -48,6 +48,14 @@ part() { # part seeds
     done
     for n in 100 200 300 435; do
       for ch in 2 3 4; do gen "$part" "$s" compiler-dag sop n=$n chains=$ch; done
+    done
+    # small asymmetric instances with medium and dense precedence (closure density 0.3-0.9,
+    # n <= 60: a region the families above leave empty)
+    for n in 20 40 60; do
+      for p in 30 60 85; do
+        gen "$part" "$s" near-symmetric sop n=$n c=1000 p=$p asym=5
+        gen "$part" "$s" random-sop sop n=$n c=10 p=$p
+      done
     done
     for n in 50 100 200; do
       for p in 0 15; do gen "$part" "$s" generalized json n=$n p=$p modes=4; done

@@ -20,8 +20,9 @@ A documented sweep with a held-back part (notes/portfolio.md has the method and 
 3. **Candidate portfolios** are decision lists in the built-in's shape: a symmetric rule (on
    or off), a free rule (`free_density <= F`), a sparse rule (`closure_density < D`), a
    medium rule (`D <= closure_density < 0.8`, `cells <= K`) and a large-medium one (more
-   cells), the built-in's dense and large-dense rules (closure density >= 0.8: no asymmetric
-   training instance lies there, so the sweep keeps them as they are) and the catch-all.
+   cells), the built-in's dense and large-dense rules (closure density >= 0.8: the only asymmetric
+   training instances there are small ones on which every plan ties at a sweep budget, so the
+   sweep keeps them as they are) and the catch-all.
    The threshold values tried are the built-in's and the midpoints between consecutive
    feature values seen on the training part; for each set of thresholds every rule gets the plan (of all plan portfolios) with the
    least total score over the training instances it takes (ties: the built-in's plan). As every rule's plan has been run on every instance, a candidate's
