@@ -244,16 +244,7 @@ pub fn parse_pcglns(file: &str, text: &str) -> Result<Instance> {
     let (dim_line, dim) = positive(file, &h, "DIMENSION")?;
     let (sets_line, ngroups) = positive(file, &h, "GTSP_SETS")?;
     // sizes from the header, checked before the per-node and per-group tables are allocated
-    let limit = max_nodes();
-    if dim > limit {
-        return Err(Error::parse(
-            file,
-            dim_line,
-            format!(
-                "DIMENSION {dim} is above the limit of {limit} nodes; set {MAX_NODES_ENV} to raise it"
-            ),
-        ));
-    }
+    check_dimension(file, dim_line, dim)?;
     if ngroups > dim {
         return Err(Error::parse(
             file,
