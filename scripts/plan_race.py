@@ -11,24 +11,23 @@ the best cost of that row. Used to choose the `geometric-free` rule on the gener
         --objective air --tsv out.tsv --out out.md
 """
 import argparse
-import json
 import os
-import subprocess
 import sys
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "peers"))
+from sop_common import cellseq_solve  # noqa: E402
 
 
 def run(cellseq, path, plan, limit, objective, seed):
-    cmd = [cellseq, "solve", path, "--time-limit", str(limit), "--seed", str(seed),
-           "--json", "--no-bound"]
+    budget = ["--time-limit", str(limit)]
     if objective:
-        cmd += ["--objective", objective]
+        budget += ["--objective", objective]
     if plan:
-        cmd += ["--param", "plan=" + plan]
-    env = dict(os.environ, RAYON_NUM_THREADS="1")
-    out = subprocess.run(cmd, capture_output=True, text=True, env=env)
-    if out.returncode != 0:
-        sys.exit(f"{path}: cellseq failed: {out.stderr.strip()}")
-    d = json.loads(out.stdout)
+        budget += ["--param", "plan=" + plan]
+    try:
+        d = cellseq_solve(cellseq, path, budget, seed)
+    except RuntimeError as e:
+        sys.exit(str(e))
     return d["cost"], d["evaluations"], d["elapsed_s"]
 
 

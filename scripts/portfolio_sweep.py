@@ -117,11 +117,15 @@ def portfolio_text(beam, rules):
     return head + "".join("\n" + rule_text(n, r, w) for n, r, w in rules)
 
 
+def plan_of(rule):
+    """A rule's plan: its beam, phases and after-beam phases."""
+    return {k: rule[k] for k in ("beam", "phases", "after_beam") if k in rule}
+
+
 def load_plans():
     with open(BUILT_IN, "rb") as f:
         doc = tomllib.load(f)
-    plans = {r["name"]: {k: r[k] for k in ("beam", "phases", "after_beam") if k in r}
-             for r in doc["rule"]}
+    plans = {r["name"]: plan_of(r) for r in doc["rule"]}
     plans.update(VARIANTS)
     return doc["beam"], plans, doc["rule"]
 
@@ -129,7 +133,7 @@ def load_plans():
 def geometric_rules(rules):
     """The built-in's rules for geometric instances (`when.geometric = true`), kept as they
     are in every candidate: no matrix instance reaches them, so the sweep cannot choose them."""
-    return [(r["name"], {k: r[k] for k in ("beam", "phases", "after_beam") if k in r}, r["when"])
+    return [(r["name"], plan_of(r), r["when"])
             for r in rules if r.get("when", {}).get("geometric") is True]
 
 
