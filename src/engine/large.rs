@@ -1,8 +1,10 @@
 //! Local search for large instances on the [`TwoLevel`] list: 2-opt with mode flip, Or-opt
 //! (segments of 1–3 cells, kept or reversed) and single-cell mode changes, with candidate
-//! lists and don't-look bits, each applied move O(√n); then an iterated local search whose
-//! kicks are local double bridges (two adjacent short blocks swap places), each followed by
-//! the local search from the kick's cells and undone unless the path got no worse.
+//! lists and don't-look bits, each applied move O(√n), and optionally ([`Large::three`])
+//! sequential 3-opt moves (segment insertion of any length, see `three_opt`); then an
+//! iterated local search whose kicks are local double bridges (two adjacent short blocks swap
+//! places, or with 3-opt on three blocks come back in reverse order), each followed by the
+//! local search from the kick's cells and undone unless the path got no worse.
 //!
 //! A 2-opt delta is read off the two boundary links only, which needs costs that read the same
 //! backwards (the reversed link between the turned modes costs what the link forwards does):
@@ -12,6 +14,11 @@
 //! cells hold no precedence pair, checked over the segment for stretches up to
 //! [`Large::rev_max`] cells (longer ones are skipped when the instance has precedence); kicks
 //! check their blocks the same way.
+
+mod three_opt;
+
+pub use three_opt::THREE_K;
+use three_opt::Three;
 
 use super::moves::or_as_swap;
 use super::search::improves;
@@ -58,6 +65,8 @@ enum Move {
     Rev(usize, usize),
     /// Mode change of a cell.
     Mode(u32, u32),
+    /// A sequential 3-opt move.
+    Three(Three),
 }
 
 /// The large-instance search state.
@@ -78,6 +87,11 @@ pub struct Large<'a> {
     pub walk: f64,
     /// Steps of each random walk of a random-walk kick.
     pub walk_steps: usize,
+    /// Also try sequential 3-opt moves from every looked-at cell (the best of all moves is
+    /// applied), and kick with three blocks where there is no precedence.
+    pub three: bool,
+    /// Candidates per list tried for the 3-opt moves' added links.
+    pub three_k: usize,
     queue: VecDeque<u32>,
     on: Vec<bool>,
     log: Vec<Op>,
@@ -99,6 +113,8 @@ impl<'a> Large<'a> {
             or_k: OR_K,
             walk: 0.0,
             walk_steps: WALK_STEPS,
+            three: false,
+            three_k: THREE_K,
             queue: VecDeque::new(),
             on: vec![false; s.n()],
             log: Vec::new(),
@@ -202,7 +218,13 @@ impl<'a> Large<'a> {
         self.mode_moves(x, &mut best, &mut evals);
         let lx = self.link(self.sl(self.t.prev(x)), self.sl(Some(x)));
         self.two_opt_moves(x, lx, &mut best, &mut evals);
-        self.or_moves(x, lx, &mut best, &mut evals);
+        if !(self.three && self.free) {
+            // without precedence, segment insertions are among the 3-opt moves
+            self.or_moves(x, lx, &mut best, &mut evals);
+        }
+        if self.three {
+            self.three_opt_moves(x, &mut best, &mut evals);
+        }
         (best.0, best.1, evals)
     }
 
@@ -432,6 +454,7 @@ impl<'a> Large<'a> {
                 }
             }
             Move::Rev(i, j) => self.apply_reverse(i, j, d),
+            Move::Three(mv) => self.apply_three(mv, d),
             Move::Or(i, len, p, rev) => {
                 // the cells next to the insertion point (they get new links)
                 let v = (p >= 0).then(|| self.t.cell_at(p as usize));
@@ -492,44 +515,18 @@ impl<'a> Large<'a> {
             return 0;
         }
         let mut rng = ChaCha8Rng::seed_from_u64(seed);
-        let m = self.c.m;
         let mut kicks = 0u64;
         let mut fails = 0u64;
         self.logging = true;
         while !ctx.exhausted() && fails < patience {
             kicks += 1;
             ctx.count(1);
-            let (h, i, j) = if self.free && self.walk > 0.0 && rng.random_bool(self.walk) {
-                match self.walk_cuts(&mut rng) {
-                    Some(cuts) => cuts,
-                    None => {
-                        fails += 1;
-                        continue;
-                    }
-                }
-            } else {
-                let l1 = rng.random_range(1..=block.min(n / 2 - 1).max(1));
-                let l2 = rng.random_range(1..=block.min(n / 2 - 1).max(1));
-                let h = rng.random_range(0..(n - l1 - l2) as i64) as isize - 1;
-                let i = (h + l1 as isize) as usize;
-                (h, i, i + l2)
-            };
-            if !self.free && !self.swappable(h, i, j) {
+            let before = self.t.cost;
+            self.log.clear();
+            if !self.kick(&mut rng, block) {
                 fails += 1;
                 continue;
             }
-            let at = |p: isize| self.t.at(m, p);
-            let ii = i as isize;
-            let jj = j as isize;
-            let d = self.link(at(h), at(ii + 1))
-                + self.link(at(jj), at(h + 1))
-                + self.link(at(ii), at(jj + 1))
-                - self.link(at(h), at(h + 1))
-                - self.link(at(ii), at(ii + 1))
-                - self.link(at(jj), at(jj + 1));
-            let before = self.t.cost;
-            self.log.clear();
-            self.apply_swap(h, i, j, d);
             self.descend(ctx);
             if self.t.cost <= before {
                 if improves(self.t.cost - before, before) {
@@ -548,6 +545,67 @@ impl<'a> Large<'a> {
         kicks
     }
 
+    /// Applies one kick (logged): with [`Large::three`] on an instance without precedence,
+    /// three adjacent blocks B C D come back as D C B (four links change, so a 3-opt move
+    /// cannot simply take it back); else two adjacent blocks swap. The cuts are a random
+    /// walk's ([`Large::walk`]) or blocks of 1..=`block` cells at a random place. False
+    /// when no kick was applied (cuts coinciding, precedence).
+    fn kick(&mut self, rng: &mut ChaCha8Rng, block: usize) -> bool {
+        let n = self.t.n();
+        let m = self.c.m;
+        let blocks = if self.three && self.free && n >= 6 {
+            3
+        } else {
+            2
+        };
+        let mut cuts = [0isize; 4];
+        if self.free && self.walk > 0.0 && rng.random_bool(self.walk) {
+            if !self.walk_cuts(rng, &mut cuts[..=blocks]) {
+                return false;
+            }
+        } else {
+            let most = block.min(n / (blocks + 1)).max(1);
+            let mut lens = [0usize; 3];
+            for l in &mut lens[..blocks] {
+                *l = rng.random_range(1..=most);
+            }
+            let total: usize = lens.iter().sum();
+            cuts[0] = rng.random_range(0..(n - total) as i64) as isize - 1;
+            for b in 0..blocks {
+                cuts[b + 1] = cuts[b] + lens[b] as isize;
+            }
+        }
+        let at = |p: isize| self.t.at(m, p);
+        let removed: f64 = cuts[..=blocks]
+            .iter()
+            .map(|&c| self.link(at(c), at(c + 1)))
+            .sum();
+        if blocks == 2 {
+            let [h, i, j, _] = cuts;
+            if !self.free && !self.swappable(h, i as usize, j as usize) {
+                return false;
+            }
+            let d = self.link(at(h), at(i + 1))
+                + self.link(at(j), at(h + 1))
+                + self.link(at(i), at(j + 1))
+                - removed;
+            self.apply_swap(h, i as usize, j as usize, d);
+        } else {
+            // A B C D E → A D C B E
+            let [h, i, j, k] = cuts;
+            let d = self.link(at(h), at(j + 1))
+                + self.link(at(k), at(i + 1))
+                + self.link(at(j), at(h + 1))
+                + self.link(at(i), at(k + 1))
+                - removed;
+            let (lc, ld) = ((j - i) as usize, (k - j) as usize);
+            self.apply_swap(h, i as usize, k as usize, d);
+            let c_end = h as usize + lc;
+            self.apply_swap(h, c_end, c_end + ld, 0.0);
+        }
+        true
+    }
+
     /// Leaves no cell queued.
     fn clear_queue(&mut self) {
         while let Some(x) = self.queue.pop_front() {
@@ -555,14 +613,15 @@ impl<'a> Large<'a> {
         }
     }
 
-    /// The cuts of a random-walk double bridge (Applegate, Cook and Rohe's kick for large
-    /// instances): a random cell and the ends of two random walks of [`Large::walk_steps`]
-    /// hops over the candidate lists from it, sorted along the path, cut after each; `None`
-    /// when two of them coincide.
-    fn walk_cuts(&self, rng: &mut ChaCha8Rng) -> Option<(isize, usize, usize)> {
+    /// The cuts of a random-walk kick (after Applegate, Cook and Rohe's kick for large
+    /// instances), into `cuts` (3 or 4 of them): a random cell and the ends of random walks of
+    /// [`Large::walk_steps`] hops over the candidate lists from it, sorted along the path, cut
+    /// after each; false when two of them coincide.
+    fn walk_cuts(&self, rng: &mut ChaCha8Rng, cuts: &mut [isize]) -> bool {
         let n = self.t.n();
         let start = self.t.cell_at(rng.random_range(0..n));
-        let mut walk = || {
+        cuts[0] = self.t.pos(start) as isize;
+        for c in cuts[1..].iter_mut() {
             let mut x = start;
             for _ in 0..self.walk_steps {
                 let out = &self.nb.out[x as usize];
@@ -571,11 +630,10 @@ impl<'a> Large<'a> {
                 }
                 x = out[rng.random_range(0..out.len())];
             }
-            self.t.pos(x)
-        };
-        let mut p = [self.t.pos(start), walk(), walk()];
-        p.sort_unstable();
-        (p[0] < p[1] && p[1] < p[2]).then_some((p[0] as isize, p[1], p[2]))
+            *c = self.t.pos(x) as isize;
+        }
+        cuts.sort_unstable();
+        cuts.windows(2).all(|w| w[0] < w[1])
     }
 
     /// True when blocks `[h+1..=i]` and `[i+1..=j]` may swap: no cell of the first block

@@ -69,6 +69,12 @@ pub static INFO: SolverInfo = SolverInfo {
             help: "two-level search without precedence: share of the kicks that are random-walk double bridges (cut points a few candidate-list hops apart in the plane, far apart along the path), the rest local ones",
         },
         ParamSpec {
+            name: "three-opt",
+            default: "false",
+            kind: ParamKind::Bool,
+            help: "two-level search: also try sequential 3-opt moves (segment insertion of any length, turned or not; double reversal) from every looked-at cell, and kick with three blocks (A B C D E -> A D C B E) where there is no precedence",
+        },
+        ParamSpec {
             name: "max-block",
             default: "0",
             kind: ParamKind::Int,
@@ -91,6 +97,7 @@ pub static INFO: SolverInfo = SolverInfo {
             two_level: p.switch("two-level"),
             kick_block: p.int("kick-block").max(1) as usize,
             walk_kicks: p.float("walk-kicks").clamp(0.0, 1.0),
+            three_opt: p.bool("three-opt"),
         }))
     },
 };
@@ -120,6 +127,8 @@ pub struct LocalSearch {
     pub kick_block: usize,
     /// Share of the two-level search's kicks that are random-walk double bridges.
     pub walk_kicks: f64,
+    /// The two-level search also tries sequential 3-opt moves.
+    pub three_opt: bool,
 }
 
 /// From this many cells on (parameter `two-level=auto`), instances without precedence where
@@ -159,6 +168,7 @@ impl Solver for LocalSearch {
             // 2-opt and Or-opt with O(sqrt n) moves to a local optimum, then local kicks
             let mut l = Large::new(c, &search.nb, &s);
             l.walk = self.walk_kicks;
+            l.three = self.three_opt;
             l.optimize(ctx);
             ctx.report(l.t.cost + m.constant());
             if self.kicks > 0 {

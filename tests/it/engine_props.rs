@@ -360,13 +360,13 @@ proptest! {
     }
 
     /// The two-level search keeps an exact cost and a feasible permutation, with and without
-    /// precedence, through the descent and the kicks (local and random-walk ones) with their
-    /// undo.
+    /// precedence, through the descent (with and without 3-opt moves) and the kicks (local and
+    /// random-walk ones, two or three blocks) with their undo.
     #[test]
     fn two_level_search_is_exact(seed in 0u64..1000, n in 2usize..60, modes in 1usize..4, tools in 1usize..3,
                                  density in prop_oneof![Just(0.0), 0.0f64..0.1], reversible in any::<bool>(),
                                  rh in any::<bool>(), k in 1usize..8, rev_max in 1usize..20,
-                                 walk in prop_oneof![Just(0.0), Just(0.5), Just(1.0)],
+                                 walk in prop_oneof![Just(0.0), Just(0.5), Just(1.0)], three in any::<bool>(),
                                  shuffle in prop::collection::vec(any::<u64>(), 60)) {
         use cellseq::engine::{Neighbours, large::{self, Large}};
         let inst = instance(seed, n, modes, tools, density, reversible, rh);
@@ -387,6 +387,8 @@ proptest! {
         let mut l = Large::new(c, &nb, &s);
         l.rev_max = rev_max;
         l.walk = walk;
+        l.three = three;
+        l.three_k = k;
         l.optimize(&mut ctx);
         l.write(&mut s);
         prop_assert!(close(s.cost, s.evaluate(&c)), "descent: tracked {} vs evaluated {}", s.cost, s.evaluate(&c));
@@ -400,6 +402,44 @@ proptest! {
         prop_assert!(s.feasible(&m));
         let r = cellseq::check(&inst, &s.sequence(), inst.default_objective()).unwrap();
         prop_assert!(close(r.cost, s.cost + m.constant()));
+    }
+}
+
+/// From a local optimum of 2-opt, Or-opt and mode moves, the two-level descent with 3-opt
+/// moves still finds improvements (uniform points, air, greedy start): they reach what the
+/// other moves cannot, and the tracked cost stays exact.
+#[test]
+fn three_opt_improves_a_two_opt_or_opt_optimum() {
+    use cellseq::engine::{Neighbours, large::Large};
+    for seed in 1..=4u64 {
+        let kv: BTreeMap<String, String> = [
+            ("n", "2000"),
+            ("closed", "1"),
+            ("length", "0"),
+            ("lift", "0"),
+        ]
+        .into_iter()
+        .map(|(k, v)| (k.to_string(), v.to_string()))
+        .collect();
+        let inst = generate("uniform", &kv, seed).unwrap();
+        let m = CostModel::new(&inst, cellseq::model::Objective::Air);
+        let c = Costs::open(&m);
+        let mut s = Solution::new(&c, &greedy::geometric(&m, &mut |_| {}));
+        let nb = Neighbours::new(&m, 8);
+        let mut fx = Ctx::new();
+        let mut ctx = fx.ctx(&inst, &m, 1_000_000_000);
+        let mut l = Large::new(c, &nb, &s);
+        l.optimize(&mut ctx);
+        let without = l.t.cost;
+        l.three = true;
+        l.optimize(&mut ctx);
+        let with = l.t.cost;
+        l.write(&mut s);
+        assert!(close(s.cost, s.evaluate(&c)));
+        assert!(
+            with < without * 0.995,
+            "seed {seed}: with 3-opt {with}, without {without}"
+        );
     }
 }
 
