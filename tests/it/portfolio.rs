@@ -236,7 +236,7 @@ fn auto_picks_its_rule_by_symmetry_and_precedence_density() {
     assert!(c.features.geometric && c.features.symmetric);
     assert_eq!(
         plan_text(c.plan(true)),
-        "local-search[two-level=on;walk-kicks=0.3]:1"
+        "local-search[three-opt=true;two-level=on;walk-kicks=0.3]:1"
     );
     let ordered = geo(&[("n", "30"), ("preds", "1")]);
     let c = a.choose(&ordered);
