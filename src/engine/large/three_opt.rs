@@ -82,16 +82,15 @@ impl<'a> Large<'a> {
         }
     }
 
-    /// Estimate of a new link between `u` and `v` for the partial gains (the direction of
-    /// their current order; the dummy's cheaper end).
+    /// Estimate of a new link between cells `u` and `v` for the partial gains (in the
+    /// direction of their current order).
     #[inline]
-    fn estimate(&self, u: Node, v: Node) -> f64 {
-        match (u, v) {
-            (Some(a), Some(b)) if self.t.pos(a) < self.t.pos(b) => {
-                self.link(self.sl(u), self.sl(v))
-            }
-            (Some(_), Some(_)) => self.link(self.sl(v), self.sl(u)),
-            (None, w) | (w, None) => self.link(None, self.sl(w)).min(self.link(self.sl(w), None)),
+    fn estimate(&self, u: u32, v: u32) -> f64 {
+        let (a, b) = (Some(u), Some(v));
+        if self.t.pos(u) < self.t.pos(v) {
+            self.link(self.sl(a), self.sl(b))
+        } else {
+            self.link(self.sl(b), self.sl(a))
         }
     }
 
@@ -107,13 +106,13 @@ impl<'a> Large<'a> {
             let Some(c2) = t2 else { continue };
             let g0 = self.current(t1, fwd1, t2);
             *evals += self.tried(c2);
-            for (t3, g1) in self.added(t2, c2, t1, g0) {
+            for (t3, g1) in self.added(c2, t1, g0) {
                 for fwd3 in [true, false] {
                     let t4 = self.step(t3, fwd3);
                     let Some(c4) = t4 else { continue };
                     let l34 = self.current(t3, fwd3, t4);
                     *evals += self.tried(c4);
-                    for (t5, _) in self.added(t4, c4, t4, g1 + l34) {
+                    for (t5, _) in self.added(c4, t4, g1 + l34) {
                         for fwd5 in [true, false] {
                             let t6 = self.step(t5, fwd5);
                             let ts = [t1, t2, t3, t4, t5, t6];
@@ -144,10 +143,11 @@ impl<'a> Large<'a> {
         self.three_k.min(self.nb.out[c as usize].len()) as u64
     }
 
-    /// The next added link's far ends: candidates `v` of cell `c` (= `u`) among its
-    /// [`Large::three_k`] nearest, neither `skip` nor a path neighbour of `u`, whose partial
-    /// gain `g` − estimate(u, v) stays positive, each with that gain.
-    fn added(&self, u: Node, c: u32, skip: Node, g: f64) -> impl Iterator<Item = (Node, f64)> {
+    /// The next added link's far ends: candidates `v` of cell `c` among its
+    /// [`Large::three_k`] nearest, neither `skip` nor a path neighbour of `c`, whose partial
+    /// gain `g` − estimate(c, v) stays positive, each with that gain.
+    fn added(&self, c: u32, skip: Node, g: f64) -> impl Iterator<Item = (Node, f64)> {
+        let u = Some(c);
         let (s, p) = (self.succ(u), self.pred(u));
         let list = &self.nb.out[c as usize];
         list[..self.three_k.min(list.len())]
@@ -157,7 +157,7 @@ impl<'a> Large<'a> {
                 if t == skip || t == s || t == p {
                     return None;
                 }
-                let g1 = g - self.estimate(u, t);
+                let g1 = g - self.estimate(c, v);
                 (g1 > 0.0).then_some((t, g1))
             })
     }
