@@ -1,10 +1,12 @@
-//! Engine benchmarks: delta evaluations per second, one local-search pass on 10k cells, one
-//! SA chain, one tabu iteration, one ant construction.
+//! Engine benchmarks: delta evaluations per second, one local-search pass on 10k cells, the
+//! two-level descent on 10k points (with and without 3-opt), one SA chain, one tabu iteration,
+//! one ant construction.
 
 use cellseq::cost::CostModel;
+use cellseq::engine::large::Large;
 use cellseq::engine::moves::sop3_delta;
 use cellseq::engine::search::Search;
-use cellseq::engine::{Costs, Solution};
+use cellseq::engine::{Costs, Neighbours, Solution};
 use cellseq::generate::generate;
 use cellseq::model::Instance;
 use cellseq::solvers::aco::{Aco, Pheromone};
@@ -88,6 +90,29 @@ fn benches(cr: &mut Criterion) {
             black_box(s.cost)
         })
     });
+
+    // the two-level list's descent from the greedy start on 10k points (air): 2-opt and
+    // Or-opt, and with the sequential 3-opt moves in place of Or-opt
+    let pts = uniform(10_000, &[("closed", "1"), ("length", "0"), ("lift", "0")]);
+    let pm = CostModel::new(&pts, cellseq::model::Objective::Air);
+    let pc = Costs::open(&pm);
+    let ps = Solution::new(&pc, &greedy::geometric(&pm, &mut |_| {}));
+    let pnb = Neighbours::new(&pm, 8);
+    for (name, three) in [
+        ("two-level descent, 2-opt + Or-opt (10k points)", false),
+        ("two-level descent, 2-opt + 3-opt (10k points)", true),
+    ] {
+        g.bench_function(name, |b| {
+            b.iter(|| {
+                let mut obs = NoObserver;
+                let mut ctx = Context::new(&pts, &pm, &params, 1, Budget::default(), &mut obs);
+                let mut l = Large::new(pc, &pnb, &ps);
+                l.three = three;
+                l.optimize(&mut ctx);
+                black_box(l.t.cost)
+            })
+        });
+    }
 
     let anneal = Anneal {
         chain: 1.0,
