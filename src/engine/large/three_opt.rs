@@ -112,7 +112,7 @@ impl<'a> Large<'a> {
                     let Some(c4) = t4 else { continue };
                     let l34 = self.current(t3, fwd3, t4);
                     *evals += self.tried(c4);
-                    for (t5, _) in self.added(c4, t4, g1 + l34) {
+                    for (t5, _) in self.added(c4, None, g1 + l34) {
                         for fwd5 in [true, false] {
                             let t6 = self.step(t5, fwd5);
                             let ts = [t1, t2, t3, t4, t5, t6];
@@ -144,8 +144,9 @@ impl<'a> Large<'a> {
     }
 
     /// The next added link's far ends: candidates `v` of cell `c` among its
-    /// [`Large::three_k`] nearest, neither `skip` nor a path neighbour of `c`, whose partial
-    /// gain `g` − estimate(c, v) stays positive, each with that gain.
+    /// [`Large::three_k`] nearest (the lists never hold `c` itself), neither `skip` (t1 for
+    /// t3; `None` for t5) nor a path neighbour of `c`, whose partial gain `g` − estimate(c, v)
+    /// stays positive, each with that gain.
     fn added(&self, c: u32, skip: Node, g: f64) -> impl Iterator<Item = (Node, f64)> {
         let u = Some(c);
         let (s, p) = (self.succ(u), self.pred(u));
