@@ -66,22 +66,47 @@ pub struct Lk {
     added: Vec<(u32, u32)>,
     applied: Vec<(usize, usize, f64)>,
     cands: Vec<Step>,
+    /// Per cell t2, the cells t3 a step may link it to: its out-neighbours, then the
+    /// in-neighbours not among them (built from the first [`Neighbours`] a search gets; on
+    /// symmetric costs the two lists mostly hold the same cells, which would give the same
+    /// steps twice).
+    near: Vec<Vec<u32>>,
 }
 
 /// Precedence pairs out of order after reversing `[i..=j]` of `s`, which has `viol` of them:
 /// every pair with both cells inside the segment changes sides. O(length · out-degree).
-fn viol_after(m: &crate::cost::CostModel, s: &Solution, i: usize, j: usize, viol: u32) -> u32 {
-    let mut v = viol as i64;
+/// Stops early with `cap + 1` once the result must exceed `cap`: the pairs that come back
+/// into order are among the `viol` already out of it, so the result is at least the number
+/// of pairs the reversal puts out of order (a segment holding a cell ordered before or after
+/// every other ends after a few pairs).
+fn viol_after(
+    m: &crate::cost::CostModel,
+    s: &Solution,
+    i: usize,
+    j: usize,
+    viol: u32,
+    cap: u32,
+) -> u32 {
+    let limit = i64::from(cap);
+    let mut out_of_order = 0i64;
+    let mut back = 0i64;
     for p in i..=j {
         let a = s.order[p] as usize;
         for &q in &m.dag.succs[a] {
             let pq = s.pos[q as usize] as usize;
             if pq >= i && pq <= j {
-                v += if pq > p { 1 } else { -1 };
+                if pq > p {
+                    out_of_order += 1;
+                    if out_of_order > limit {
+                        return cap + 1;
+                    }
+                } else {
+                    back += 1;
+                }
             }
         }
     }
-    v.max(0) as u32
+    (i64::from(viol) + out_of_order - back).max(0) as u32
 }
 
 /// True when every cell of `[i..=j]` can be cut the other way.
@@ -170,6 +195,7 @@ impl Lk {
             added: Vec::new(),
             applied: Vec::new(),
             cands: Vec::new(),
+            near: Vec::new(),
         }
     }
 
@@ -251,22 +277,12 @@ impl Lk {
             (t1_after(new_pa - 1), t1_after(new_pa))
         };
         let closing = c.link(x, y);
-        let mut score = new_cum - closing;
-        // gain criterion: without its closing link the chain must still gain (the penalty
-        // below only adds to the score, so a step that fails here fails there too)
+        let score = new_cum - closing;
+        // gain criterion: without its closing link the chain must still gain (the penalty,
+        // charged later by `charge`, only adds to the score, so a step that fails here fails
+        // there too)
         if score >= 0.0 {
             return None;
-        }
-        let mut new_viol = 0;
-        if self.penalty > 0.0 {
-            new_viol = viol_after(c.m, s, i as usize, j as usize, viol);
-            if new_viol > self.max_viol {
-                return None;
-            }
-            score += self.penalty * new_viol as f64;
-            if score >= 0.0 {
-                return None;
-            }
         }
         Some(Step {
             i: i as usize,
@@ -277,8 +293,20 @@ impl Lk {
             dir: new_dir,
             broken: pair(t3, t4),
             added: pair(t2, t3),
-            viol: new_viol,
+            viol,
         })
+    }
+
+    /// Penalty mode: charges `st` (as [`Lk::step`] made it, with the chain's pairs out of
+    /// order so far in `viol`) for the pairs out of order after it. `None` when that breaks
+    /// more than [`Lk::max_viol`] pairs or the charged step no longer gains.
+    fn charge(&self, m: &crate::cost::CostModel, s: &Solution, mut st: Step) -> Option<Step> {
+        st.viol = viol_after(m, s, st.i, st.j, st.viol, self.max_viol);
+        if st.viol > self.max_viol {
+            return None;
+        }
+        st.score += self.penalty * st.viol as f64;
+        (st.score < 0.0).then_some(st)
     }
 
     /// The feasible steps from t1 at `pa` (t2 on side `dir`), best first, at most `want`.
@@ -303,9 +331,18 @@ impl Lk {
         let t2 = s.order[p2 as usize] as usize;
         self.cands.clear();
         let end = if dir > 0 { n } else { -1 };
-        let positions = nb.out[t2]
+        if self.near.len() != n as usize {
+            self.near = (0..n as usize)
+                .map(|x| {
+                    let mut l = nb.out[x].clone();
+                    l.extend(nb.inn[x].iter().filter(|w| !nb.out[x].contains(w)));
+                    l
+                })
+                .collect();
+        }
+        let near = std::mem::take(&mut self.near);
+        let positions = near[t2]
             .iter()
-            .chain(nb.inn[t2].iter())
             .map(|&w| s.pos[w as usize] as isize)
             .chain([end]);
         for pb in positions {
@@ -315,23 +352,43 @@ impl Lk {
                 self.cands.push(st);
             }
         }
-        self.cands
-            .sort_by(|a, b| a.score.total_cmp(&b.score).then(a.i.cmp(&b.i)));
+        self.near = near;
+        let by_score = |a: &Step, b: &Step| a.score.total_cmp(&b.score).then(a.i.cmp(&b.i));
+        self.cands.sort_by(by_score);
         self.cands.dedup_by(|a, b| a.i == b.i && a.j == b.j);
         let m = c.m;
-        let penalty = self.penalty > 0.0;
-        self.cands
-            .iter()
-            .filter(|st| {
-                if penalty {
-                    flippable_segment(m, s, st.i, st.j)
-                } else {
-                    reversible_segment(m, s, st.i, st.j - st.i + 1)
-                }
-            })
-            .take(want)
-            .copied()
-            .collect()
+        if self.penalty <= 0.0 {
+            return self
+                .cands
+                .iter()
+                .filter(|st| reversible_segment(m, s, st.i, st.j - st.i + 1))
+                .take(want)
+                .copied()
+                .collect();
+        }
+        // Penalty mode. Counting the pairs a reversal puts out of order costs O(length ·
+        // out-degree), so it is done lazily: the candidates are in order of their score
+        // before the charge, which only adds to it, so once that score is above the
+        // `want`-th best charged score found so far no later candidate can enter. The result
+        // is the one charging every candidate and sorting would give, but for exact ties of
+        // charged score and position, which go to the lower score before the charge.
+        let mut kept: Vec<Step> = Vec::with_capacity(want + 1);
+        for &st in &self.cands {
+            if kept.len() >= want && st.score > kept[want - 1].score {
+                break;
+            }
+            let Some(st) = self.charge(m, s, st) else {
+                continue;
+            };
+            if !flippable_segment(m, s, st.i, st.j) {
+                continue;
+            }
+            // insert after every kept step that sorts before or level with it
+            let at = kept.partition_point(|k| by_score(k, &st).is_le());
+            kept.insert(at, st);
+            kept.truncate(want);
+        }
+        kept
     }
 
     /// Runs chains from t1 at `pa` towards side `dir`, trying the `breadth` best first
@@ -602,5 +659,112 @@ mod tests {
         let mut lk = Lk::new(&c, 8, 3);
         assert!(!lk.improve_all(&c, &search.nb, &mut s, &mut ctx));
         assert_eq!(s, before);
+    }
+    /// Pairs `(a before b)` of the precedence graph that `order` puts the other way round.
+    fn out_of_order(m: &CostModel, order: &[u32]) -> u32 {
+        let mut pos = vec![0usize; order.len()];
+        for (p, &x) in order.iter().enumerate() {
+            pos[x as usize] = p;
+        }
+        let mut v = 0;
+        for a in 0..order.len() {
+            for &b in &m.dag.succs[a] {
+                v += u32::from(pos[b as usize] < pos[a]);
+            }
+        }
+        v
+    }
+
+    #[test]
+    fn capped_pair_counts_are_exact_up_to_the_cap() {
+        let mut rng = ChaCha8Rng::seed_from_u64(5);
+        let inst = instance(40, 3, true);
+        let m = CostModel::new(&inst, Objective::Matrix);
+        let c = Costs::open(&m);
+        let (mut early, mut back_in_order) = (0, 0);
+        for _ in 0..2000 {
+            // an order a few reversals away from a feasible one (the identity), so that it
+            // breaks a few pairs, and a random segment of it
+            let mut order: Vec<u32> = (0..40).collect();
+            for _ in 0..rng.random_range(0..3) {
+                let a = rng.random_range(0..39);
+                let b = rng.random_range(a + 1..40);
+                order[a..=b].reverse();
+            }
+            let seq: Sequence = order.iter().map(|&x| Visit::new(x as usize, 0)).collect();
+            let s = Solution::new(&c, &seq);
+            let viol = out_of_order(&m, &order);
+            let i = rng.random_range(0..39);
+            let j = rng.random_range(i + 1..40);
+            let mut after = order.clone();
+            after[i..=j].reverse();
+            let truth = out_of_order(&m, &after);
+            back_in_order += u32::from(viol > 0 && truth < viol);
+            for cap in [0, 2, 5, 400] {
+                let got = viol_after(&m, &s, i, j, viol, cap);
+                if truth <= cap {
+                    assert_eq!(got, truth, "cap {cap}");
+                } else {
+                    assert!(got > cap, "cap {cap}: {got} for {truth}");
+                    early += u32::from(got != truth);
+                }
+            }
+        }
+        // the cap does end counts early, and reversals that put broken pairs back in order
+        // occur (else this test would check nothing about either; stopping at `cap` pairs
+        // put out of order instead of `cap + 1` fails it)
+        assert!(early > 0 && back_in_order > 0, "{early} {back_in_order}");
+    }
+
+    #[test]
+    fn lazily_charged_steps_are_the_best_charged_steps() {
+        let mut rng = ChaCha8Rng::seed_from_u64(9);
+        let mut compared = 0;
+        for seed in 0..4 {
+            let inst = instance(60, seed, true);
+            let m = CostModel::new(&inst, Objective::Matrix);
+            let c = Costs::open(&m);
+            let search = Search::new(c, 8);
+            let seq: Sequence = (0..60).map(|x| Visit::new(x, 0)).collect();
+            let s = Solution::new(&c, &seq);
+            let mut lk = Lk::new(&c, 10, 3);
+            lk.penalty = 30.0;
+            lk.max_viol = 2;
+            for _ in 0..200 {
+                let pa = rng.random_range(0..60) as isize;
+                let dir = if rng.random_bool(0.5) { 1 } else { -1 };
+                let want = rng.random_range(1..=3);
+                let mut evals = 0;
+                let got = lk.steps(&c, &search.nb, &s, pa, dir, 0.0, 0, want, &mut evals);
+                // the reference: charge every candidate, sort, keep the flippable best
+                let p2 = pa + dir;
+                if p2 < 0 || p2 >= 60 {
+                    assert!(got.is_empty());
+                    continue;
+                }
+                let t2 = s.order[p2 as usize] as usize;
+                let end = if dir > 0 { 60 } else { -1 };
+                let mut all: Vec<Step> = search.nb.out[t2]
+                    .iter()
+                    .chain(search.nb.inn[t2].iter())
+                    .map(|&w| s.pos[w as usize] as isize)
+                    .chain([end])
+                    .filter_map(|pb| lk.step(&c, &s, pa, dir, pb, 0.0, 0, &mut evals))
+                    .filter_map(|st| lk.charge(&m, &s, st))
+                    .collect();
+                all.sort_by(|a, b| a.score.total_cmp(&b.score).then(a.i.cmp(&b.i)));
+                all.dedup_by(|a, b| a.i == b.i && a.j == b.j);
+                let want_scores: Vec<f64> = all
+                    .iter()
+                    .filter(|st| flippable_segment(&m, &s, st.i, st.j))
+                    .take(want)
+                    .map(|st| st.score)
+                    .collect();
+                let got_scores: Vec<f64> = got.iter().map(|st| st.score).collect();
+                assert_eq!(got_scores, want_scores);
+                compared += usize::from(!got.is_empty());
+            }
+        }
+        assert!(compared > 100, "{compared}");
     }
 }
