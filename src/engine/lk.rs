@@ -738,7 +738,7 @@ mod tests {
                 let got = lk.steps(&c, &search.nb, &s, pa, dir, 0.0, 0, want, &mut evals);
                 // the reference: charge every candidate, sort, keep the flippable best
                 let p2 = pa + dir;
-                if p2 < 0 || p2 >= 60 {
+                if !(0..60).contains(&p2) {
                     assert!(got.is_empty());
                     continue;
                 }
