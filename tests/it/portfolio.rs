@@ -183,7 +183,7 @@ fn auto_picks_its_rule_by_symmetry_and_precedence_density() {
     assert!(c.features.symmetric && !c.features.geometric);
     assert_eq!(
         plan_text(c.plan(false)),
-        "local-search:0.2,eacs*:0.3,ils*:1"
+        "local-search:0.1,ils[accept=0.01]*:1"
     );
     assert_eq!(plan_text(c.plan(true)), "ils[accept=0.01]*:1");
     assert_eq!(c.beam.share, 0.3);
@@ -243,6 +243,20 @@ fn auto_picks_its_rule_by_symmetry_and_precedence_density() {
     assert_eq!(c.rule, "default");
     assert!(c.features.geometric && c.features.free_density > 0.001);
     assert_eq!(plan_text(c.plan(true)), "local-search:0.3,eacs:0.5,ils*:1");
+    // a symmetric matrix with several modes per cell keeps the colony in its plan
+    let kv: BTreeMap<String, String> = [("n", "30"), ("modes", "3")]
+        .iter()
+        .map(|(k, v)| (k.to_string(), v.to_string()))
+        .collect();
+    let inst = cellseq::generate::generate("generalized", &kv, 1).unwrap();
+    let c = a.choose(&CostModel::new(&inst, inst.default_objective()));
+    assert_eq!((c.rule, c.beam.share), ("symmetric-modes", 0.3));
+    assert!(c.features.symmetric && c.features.modes > 1.0);
+    assert_eq!(
+        plan_text(c.plan(false)),
+        "local-search:0.2,eacs*:0.3,ils*:1"
+    );
+    assert_eq!(plan_text(c.plan(true)), "ils[accept=0.01]*:1");
 }
 
 #[test]
@@ -310,6 +324,7 @@ fn the_built_in_portfolio_parses_validates_and_ends_with_a_catch_all() {
         names,
         [
             "symmetric",
+            "symmetric-modes",
             "free",
             "sparse",
             "dense",
