@@ -1,9 +1,10 @@
 //! Engine benchmarks: delta evaluations per second, one local-search pass on 10k cells, the
-//! two-level descent on 10k points (with and without 3-opt), one SA chain, one tabu iteration,
-//! one ant construction.
+//! two-level descent on 10k points (with and without 3-opt), the Lin–Kernighan descent on a
+//! symmetric matrix with precedence, one SA chain, one tabu iteration, one ant construction.
 
 use cellseq::cost::CostModel;
 use cellseq::engine::large::Large;
+use cellseq::engine::lk::Lk;
 use cellseq::engine::moves::sop3_delta;
 use cellseq::engine::search::Search;
 use cellseq::engine::{Costs, Neighbours, Solution};
@@ -113,6 +114,35 @@ fn benches(cr: &mut Criterion) {
             })
         });
     }
+
+    // Lin–Kernighan chains that may pass through broken precedence pairs (the `ils` repair
+    // and polish on symmetric matrices), from the greedy order to an LK optimum: a generated
+    // `symmetric` instance, 200 cells, precedence closure density 5 %
+    let sym = {
+        let kv: BTreeMap<String, String> = [("n", "200"), ("c", "1000"), ("p", "5")]
+            .into_iter()
+            .map(|(k, v)| (k.to_string(), v.to_string()))
+            .collect();
+        generate("symmetric", &kv, 1).unwrap()
+    };
+    let sm = CostModel::new(&sym, sym.default_objective());
+    let sc = Costs::open(&sm);
+    let ss = Solution::new(&sc, &greedy::matrix(&sm, &mut |_| {}));
+    let ssearch = Search::new(sc, 12);
+    g.bench_function(
+        "Lin-Kernighan descent, penalty chains (symmetric, 200 cells, p = 5 %)",
+        |b| {
+            b.iter(|| {
+                let mut obs = NoObserver;
+                let mut ctx = Context::new(&sym, &sm, &params, 1, Budget::default(), &mut obs);
+                let mut s = ss.clone();
+                let mut lk = Lk::new(&sc, 12, 3);
+                lk.penalty = 2.0 * s.cost / 201.0;
+                while lk.improve_all(&sc, &ssearch.nb, &mut s, &mut ctx) {}
+                black_box(s.cost)
+            })
+        },
+    );
 
     let anneal = Anneal {
         chain: 1.0,

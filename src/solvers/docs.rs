@@ -28,8 +28,9 @@ hold; the built-in file is `src/solvers/auto/portfolio.toml`, `--portfolio FILE`
 its `max_cells` cells and, under a wall-clock budget, only when that budget is at least its \
 `min_seconds`; when it proves the optimum, `auto` stops there.
 2. Then the rule's phases (or its `after_beam` phases after a beam phase that ran). The \
-built-in rules: **symmetric** cost matrices (`ils` with Lin–Kernighan chains gets most of the \
-time, from the beam's sequence when the beam ran); **free** asymmetric matrices with no \
+built-in rules: **symmetric** cost matrices with one mode per cell (a short `local-search`, then \
+`ils` with Lin–Kernighan chains in a 1 % acceptance band, from the beam's sequence when the beam \
+ran) and **symmetric-modes**, several modes per cell (a colony before `ils`); **free** asymmetric matrices with no \
 precedence apart from a fixed start and end (`atsp`); **sparse** precedence (a short \
 `local-search`, a colony run backwards, `ils` in a 1 % then a 3 % acceptance band with the \
 bounded-shift DP ending every repair, window re-optimization of the best); **dense** \
