@@ -20,13 +20,20 @@ use rand_chacha::ChaCha8Rng;
 use std::collections::BTreeMap;
 use std::hint::black_box;
 
+/// A generated instance of `kind` with these parameters, seed 1.
+fn generated(kind: &str, params: &[(&str, &str)]) -> Instance {
+    let kv: BTreeMap<String, String> = params
+        .iter()
+        .map(|(k, v)| (k.to_string(), v.to_string()))
+        .collect();
+    generate(kind, &kv, 1).unwrap()
+}
+
 fn uniform(n: usize, extra: &[(&str, &str)]) -> Instance {
-    let mut kv: BTreeMap<String, String> = BTreeMap::new();
-    kv.insert("n".into(), n.to_string());
-    for (k, v) in extra {
-        kv.insert(k.to_string(), v.to_string());
-    }
-    generate("uniform", &kv, 1).unwrap()
+    let n = n.to_string();
+    let mut params = vec![("n", n.as_str())];
+    params.extend_from_slice(extra);
+    generated("uniform", &params)
 }
 
 fn benches(cr: &mut Criterion) {
@@ -118,13 +125,7 @@ fn benches(cr: &mut Criterion) {
     // Lin–Kernighan chains that may pass through broken precedence pairs (the `ils` repair
     // and polish on symmetric matrices), from the greedy order to an LK optimum: a generated
     // `symmetric` instance, 200 cells, precedence closure density 5 %
-    let sym = {
-        let kv: BTreeMap<String, String> = [("n", "200"), ("c", "1000"), ("p", "5")]
-            .into_iter()
-            .map(|(k, v)| (k.to_string(), v.to_string()))
-            .collect();
-        generate("symmetric", &kv, 1).unwrap()
-    };
+    let sym = generated("symmetric", &[("n", "200"), ("c", "1000"), ("p", "5")]);
     let sm = CostModel::new(&sym, sym.default_objective());
     let sc = Costs::open(&sm);
     let ss = Solution::new(&sc, &greedy::matrix(&sm, &mut |_| {}));

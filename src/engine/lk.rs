@@ -66,10 +66,9 @@ pub struct Lk {
     added: Vec<(u32, u32)>,
     applied: Vec<(usize, usize, f64)>,
     cands: Vec<Step>,
-    /// Per cell t2, the cells t3 a step may link it to: its out-neighbours, then the
-    /// in-neighbours not among them (built from the first [`Neighbours`] a search gets; on
-    /// symmetric costs the two lists mostly hold the same cells, which would give the same
-    /// steps twice).
+    /// Per cell t2, the cells t3 a step may link it to: [`Neighbours::merged`] of the first
+    /// lists [`Lk::improve`] gets (on symmetric costs out- and in-neighbours mostly hold the
+    /// same cells, which would give the same steps twice).
     near: Vec<Vec<u32>>,
 }
 
@@ -297,6 +296,13 @@ impl Lk {
         })
     }
 
+    /// Builds [`Lk::near`] from `nb` for a path of `n` cells, once.
+    fn link_candidates(&mut self, nb: &Neighbours, n: usize) {
+        if self.near.len() != n {
+            self.near = nb.merged();
+        }
+    }
+
     /// Penalty mode: charges `st` (as [`Lk::step`] made it, with the chain's pairs out of
     /// order so far in `viol`) for the pairs out of order after it. `None` when that breaks
     /// more than [`Lk::max_viol`] pairs or the charged step no longer gains.
@@ -314,7 +320,6 @@ impl Lk {
     fn steps(
         &mut self,
         c: &Costs,
-        nb: &Neighbours,
         s: &Solution,
         pa: isize,
         dir: isize,
@@ -331,17 +336,7 @@ impl Lk {
         let t2 = s.order[p2 as usize] as usize;
         self.cands.clear();
         let end = if dir > 0 { n } else { -1 };
-        if self.near.len() != n as usize {
-            self.near = (0..n as usize)
-                .map(|x| {
-                    let mut l = nb.out[x].clone();
-                    l.extend(nb.inn[x].iter().filter(|w| !nb.out[x].contains(w)));
-                    l
-                })
-                .collect();
-        }
-        let near = std::mem::take(&mut self.near);
-        let positions = near[t2]
+        let positions = self.near[t2]
             .iter()
             .map(|&w| s.pos[w as usize] as isize)
             .chain([end]);
@@ -352,7 +347,6 @@ impl Lk {
                 self.cands.push(st);
             }
         }
-        self.near = near;
         let by_score = |a: &Step, b: &Step| a.score.total_cmp(&b.score).then(a.i.cmp(&b.i));
         self.cands.sort_by(by_score);
         self.cands.dedup_by(|a, b| a.i == b.i && a.j == b.j);
@@ -394,11 +388,9 @@ impl Lk {
     /// Runs chains from t1 at `pa` towards side `dir`, trying the `breadth` best first
     /// steps; keeps the best prefix of the first chain that improves `s` (returns true) and
     /// undoes the others. Cells at the ends of the kept reversals go to `touched`.
-    #[allow(clippy::too_many_arguments)]
     fn chain(
         &mut self,
         c: &Costs,
-        nb: &Neighbours,
         s: &mut Solution,
         pa: isize,
         dir: isize,
@@ -409,7 +401,7 @@ impl Lk {
         let m = c.m;
         let start_cost = s.cost;
         self.added.clear();
-        let firsts = self.steps(c, nb, s, pa, dir, 0.0, 0, self.breadth, evals);
+        let firsts = self.steps(c, s, pa, dir, 0.0, 0, self.breadth, evals);
         for first in firsts {
             self.added.clear();
             self.applied.clear();
@@ -428,7 +420,7 @@ impl Lk {
                     break;
                 }
                 match self
-                    .steps(c, nb, s, st.pa, st.dir, cum, st.viol, 1, evals)
+                    .steps(c, s, st.pa, st.dir, cum, st.viol, 1, evals)
                     .first()
                 {
                     Some(&next) => st = next,
@@ -475,6 +467,7 @@ impl Lk {
         if n < 4 {
             return false;
         }
+        self.link_candidates(nb, n);
         let mut on = vec![false; n];
         let mut queue: VecDeque<u32> = VecDeque::with_capacity(seeds.len());
         for &x in seeds {
@@ -495,7 +488,7 @@ impl Lk {
             for dir in [1, -1] {
                 let pa = s.pos[x as usize] as isize;
                 touched.clear();
-                if self.chain(c, nb, s, pa, dir, &mut evals, &mut touched) {
+                if self.chain(c, s, pa, dir, &mut evals, &mut touched) {
                     found = true;
                     break;
                 }
@@ -735,7 +728,8 @@ mod tests {
                 let dir = if rng.random_bool(0.5) { 1 } else { -1 };
                 let want = rng.random_range(1..=3);
                 let mut evals = 0;
-                let got = lk.steps(&c, &search.nb, &s, pa, dir, 0.0, 0, want, &mut evals);
+                lk.link_candidates(&search.nb, 60);
+                let got = lk.steps(&c, &s, pa, dir, 0.0, 0, want, &mut evals);
                 // the reference: charge every candidate, sort, keep the flippable best
                 let p2 = pa + dir;
                 if !(0..60).contains(&p2) {

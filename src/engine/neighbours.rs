@@ -18,6 +18,24 @@ pub struct Neighbours {
 }
 
 impl Neighbours {
+    /// Per cell, its out-neighbours, then the in-neighbours not among them: the cells worth
+    /// linking to it in either direction, each once.
+    pub fn merged(&self) -> Vec<Vec<u32>> {
+        self.out
+            .iter()
+            .zip(&self.inn)
+            .map(|(out, inn)| {
+                let mut v = out.clone();
+                for &x in inn {
+                    if !v.contains(&x) {
+                        v.push(x);
+                    }
+                }
+                v
+            })
+            .collect()
+    }
+
     /// Builds lists of `k` neighbours per cell.
     pub fn new(m: &CostModel, k: usize) -> Self {
         let k = k.min(m.n().saturating_sub(1));

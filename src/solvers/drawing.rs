@@ -74,18 +74,7 @@ impl Solver for Drawing {
         }
         ctx.report(m.evaluate(&start));
         let nb = Neighbours::new(m, self.k);
-        let cands: Vec<Vec<u32>> = (0..m.n())
-            .map(|c| {
-                let mut v = nb.out[c].clone();
-                for &x in &nb.inn[c] {
-                    if !v.contains(&x) {
-                        v.push(x);
-                    }
-                }
-                v
-            })
-            .collect();
-        let mut p = Path::new(m, start, cands);
+        let mut p = Path::new(m, start, nb.merged());
         let all: Vec<u32> = p.t.iter().map(|v| v.cell as u32).collect();
         p.descend(ctx, all);
         ctx.report(m.evaluate(&p.t));

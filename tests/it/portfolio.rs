@@ -222,14 +222,15 @@ fn auto_picks_its_rule_by_symmetry_and_precedence_density() {
     assert_eq!(auto(&[("beam-share", "0")]).choose(&p42).beam.share, 0.0);
     // geometric instances: without precedence and with links that cost the same both ways,
     // the two-level local search; with precedence, the catch-all rule
-    let geo = |pairs: &[(&str, &str)]| {
+    let generated = |kind: &str, pairs: &[(&str, &str)], seed: u64| {
         let kv: BTreeMap<String, String> = pairs
             .iter()
             .map(|(k, v)| (k.to_string(), v.to_string()))
             .collect();
-        let inst = cellseq::generate::generate("uniform", &kv, 3).unwrap();
+        let inst = cellseq::generate::generate(kind, &kv, seed).unwrap();
         CostModel::new(&inst, inst.default_objective())
     };
+    let geo = |pairs: &[(&str, &str)]| generated("uniform", pairs, 3);
     let free = geo(&[("n", "30"), ("modes", "2"), ("reversible", "true")]);
     let c = a.choose(&free);
     assert_eq!(c.rule, "geometric-free");
@@ -244,12 +245,7 @@ fn auto_picks_its_rule_by_symmetry_and_precedence_density() {
     assert!(c.features.geometric && c.features.free_density > 0.001);
     assert_eq!(plan_text(c.plan(true)), "local-search:0.3,eacs:0.5,ils*:1");
     // a symmetric matrix with several modes per cell keeps the colony in its plan
-    let kv: BTreeMap<String, String> = [("n", "30"), ("modes", "3")]
-        .iter()
-        .map(|(k, v)| (k.to_string(), v.to_string()))
-        .collect();
-    let inst = cellseq::generate::generate("generalized", &kv, 1).unwrap();
-    let c = a.choose(&CostModel::new(&inst, inst.default_objective()));
+    let c = a.choose(&generated("generalized", &[("n", "30"), ("modes", "3")], 1));
     assert_eq!((c.rule, c.beam.share), ("symmetric-modes", 0.3));
     assert!(c.features.symmetric && c.features.modes > 1.0);
     assert_eq!(
