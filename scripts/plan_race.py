@@ -1,29 +1,42 @@
 #!/usr/bin/env python3
 """Race `auto` plans on instance files at wall-clock limits, one run at a time.
 
-Each instance runs with every plan (`--param plan=...`; the name `rule` runs the built-in
-portfolio's choice) at every limit, one thread, and the table gives each plan's cost over
-the best cost of that row. Used to choose the `geometric-free` rule on the generated
-`uniform` family (notes/portfolio.md); for timed comparisons run it alone at high priority.
+Each instance runs with every variant at every limit and seed, one thread. A variant is a
+plan (`--plan NAME=PLAN`, run as `--param plan=...`; an empty PLAN runs the built-in
+portfolio's choice) or a whole portfolio file (`--portfolio NAME=FILE`, run as
+`--portfolio FILE`: its rules' beam shares and `after_beam` phases apply). The table gives
+each variant's median cost over the seeds and its ratio to the best median of that row; the
+last rows compare every variant with the first one (the `--plan` variants come first, in
+the order given, then the `--portfolio` ones) (geometric mean of the ratios, and on
+how many rows it is better, worse or equal). Used to choose the `geometric-free` and
+`dense` rules on generated families (notes/portfolio.md); for timed comparisons run it
+alone at high priority.
 
     python3 scripts/plan_race.py FILES... --plan default='local-search:0.3,eacs:0.5,ils*:1' \\
         --plan free='local-search[two-level=on]:1' --plan rule= --limits 1 10 \\
         --objective air --tsv out.tsv --out out.md
+    python3 scripts/plan_race.py FILES... --plan built-in= --portfolio mine=mine.toml \\
+        --limits 10 --seeds 1 2 3
 """
 import argparse
+import math
 import os
+import statistics
 import sys
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "peers"))
 from sop_common import cellseq_solve  # noqa: E402
 
 
-def run(cellseq, path, plan, limit, objective, seed):
+def run(cellseq, path, variant, limit, objective, seed):
+    kind, text = variant
     budget = ["--time-limit", str(limit)]
     if objective:
         budget += ["--objective", objective]
-    if plan:
-        budget += ["--param", "plan=" + plan]
+    if kind == "plan" and text:
+        budget += ["--param", "plan=" + text]
+    if kind == "portfolio":
+        budget += ["--portfolio", text]
     try:
         d = cellseq_solve(cellseq, path, budget, seed)
     except RuntimeError as e:
@@ -34,55 +47,82 @@ def run(cellseq, path, plan, limit, objective, seed):
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("files", nargs="+")
-    ap.add_argument("--plan", action="append", required=True,
+    ap.add_argument("--plan", action="append", default=[],
                     help="NAME=PLAN (an empty PLAN: the portfolio's rule); repeatable")
+    ap.add_argument("--portfolio", action="append", default=[],
+                    help="NAME=FILE: a portfolio file as a variant; repeatable")
     ap.add_argument("--limits", nargs="+", type=float, default=[1.0, 10.0])
     ap.add_argument("--objective", default=None, help="time, air or matrix (default: the file's)")
-    ap.add_argument("--seed", type=int, default=1)
+    ap.add_argument("--seeds", type=int, nargs="+", default=None,
+                    help="solver seeds (the table shows the median cost); default 1")
+    ap.add_argument("--seed", type=int, default=1, help="one solver seed (see --seeds)")
     ap.add_argument("--cellseq", default="target/release/cellseq")
     ap.add_argument("--tsv", help="write every run here")
     ap.add_argument("--out", help="write the markdown table here (default: stdout)")
     a = ap.parse_args()
-    plans = []
-    for p in a.plan:
-        name, _, text = p.partition("=")
-        if not name:
-            sys.exit(f"--plan {p!r}: expected NAME=PLAN")
-        plans.append((name, text))
+    variants = []
+    for kind, given in [("plan", p) for p in a.plan] + [("portfolio", p) for p in a.portfolio]:
+        name, eq, text = given.partition("=")
+        if not name or not eq or (kind == "portfolio" and not text):
+            sys.exit(f"--{kind} {given!r}: expected NAME={kind.upper()}")
+        if any(name == n for n, _ in variants):
+            sys.exit(f"--{kind} {given!r}: the name {name!r} is used twice")
+        variants.append((name, (kind, text)))
+    if not variants:
+        sys.exit("give at least one --plan or --portfolio")
+    seeds = a.seeds or [a.seed]
     rows = []
     for f in a.files:
         for lim in a.limits:
             costs = {}
-            for name, plan in plans:
-                cost, evals, secs = run(a.cellseq, f, plan, lim, a.objective, a.seed)
-                costs[name] = cost
-                rows.append((os.path.basename(f), lim, name, cost, evals, secs))
-                print(f"{os.path.basename(f)} {lim} s {name}: {cost:.3f} ({secs:.2f} s)",
-                      file=sys.stderr, flush=True)
-            rows.append((os.path.basename(f), lim, None, costs, None, None))
+            for seed in seeds:
+                for name, variant in variants:
+                    cost, evals, secs = run(a.cellseq, f, variant, lim, a.objective, seed)
+                    costs.setdefault(name, []).append(cost)
+                    rows.append((os.path.basename(f), lim, name, cost, evals, secs, seed))
+                    print(f"{os.path.basename(f)} {lim} s seed {seed} {name}: {cost:.3f} "
+                          f"({secs:.2f} s)", file=sys.stderr, flush=True)
+            rows.append((os.path.basename(f), lim, None,
+                         {n: statistics.median(c) for n, c in costs.items()}, None, None, None))
     if a.tsv:
         with open(a.tsv, "w") as t:
-            t.write("file\tlimit_s\tplan\tcost\tevaluations\telapsed_s\n")
+            t.write("file\tlimit_s\tplan\tseed\tcost\tevaluations\telapsed_s\n")
             for r in rows:
                 if r[2] is not None:
-                    t.write(f"{r[0]}\t{r[1]}\t{r[2]}\t{r[3]:.6f}\t{r[4]}\t{r[5]:.3f}\n")
-    names = [n for n, _ in plans]
-    lines = ["| instance | limit s | " + " | ".join(names) + " | best |",
-             "|---|---|" + "---|" * len(names) + "---|"]
-    for r in rows:
-        if r[2] is None:
-            costs = r[3]
-            best = min(costs.values())
-            cells = [f"{costs[n]:.1f} ({costs[n] / best:.4f})" if best > 0 else f"{costs[n]:.1f}"
-                     for n in names]
-            winner = min(names, key=lambda n: costs[n])
-            lines.append(f"| {r[0]} | {r[1]:g} | " + " | ".join(cells) + f" | {winner} |")
+                    t.write(f"{r[0]}\t{r[1]}\t{r[2]}\t{r[6]}\t{r[3]:.6f}\t{r[4]}\t{r[5]:.3f}\n")
+    lines = table([n for n, _ in variants], [r for r in rows if r[2] is None])
     text = "\n".join(lines) + "\n"
     if a.out:
         with open(a.out, "w") as o:
             o.write(text)
     else:
         sys.stdout.write(text)
+
+
+def table(names, medians):
+    """The markdown table: per row the medians and their ratio to the row's best, then every
+    variant against the first (geometric mean of the ratios; better / worse / equal rows)."""
+    lines = ["| instance | limit s | " + " | ".join(names) + " | best |",
+             "|---|---|" + "---|" * len(names) + "---|"]
+    logs = {n: [] for n in names}
+    tally = {n: [0, 0, 0] for n in names}
+    for f, lim, _, costs, *_ in medians:
+        best = min(costs.values())
+        cells = [f"{costs[n]:.1f} ({costs[n] / best:.4f})" if best > 0 else f"{costs[n]:.1f}"
+                 for n in names]
+        winner = min(names, key=lambda n: costs[n])
+        lines.append(f"| {f} | {lim:g} | " + " | ".join(cells) + f" | {winner} |")
+        ref = costs[names[0]]
+        for n in names:
+            if ref > 0 and costs[n] > 0:
+                logs[n].append(math.log(costs[n] / ref))
+            tally[n][0 if costs[n] < ref else 1 if costs[n] > ref else 2] += 1
+    if len(names) > 1:
+        gm = [f"{math.exp(sum(v) / len(v)):.4f}" if v else "–" for v in logs.values()]
+        lines.append(f"| geometric mean ÷ {names[0]} | | " + " | ".join(gm) + " | |")
+        lines.append("| better / worse / equal | | –" + "".join(
+            " | {} / {} / {}".format(*tally[n]) for n in names[1:]) + " | |")
+    return lines
 
 
 if __name__ == "__main__":
