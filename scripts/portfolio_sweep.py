@@ -20,9 +20,10 @@ A documented sweep with a held-back part (notes/portfolio.md has the method and 
 3. **Candidate portfolios** are decision lists in the built-in's shape: a symmetric rule (on
    or off), a free rule (`free_density <= F`), a sparse rule (`closure_density < D`), a
    medium rule (`D <= closure_density < 0.8`, `cells <= K`) and a large-medium one (more
-   cells), the built-in's dense and large-dense rules (closure density >= 0.8: the only asymmetric
-   training instances there are small ones on which every plan ties at a sweep budget, so the
-   sweep keeps them as they are) and the catch-all.
+   cells), the built-in's dense rule (closure density >= 0.8: the only asymmetric training
+   instances there are small ones on which every plan ties at a sweep budget, so the sweep
+   keeps it as it is; its plan was chosen by timed races, notes/portfolio.md) and the
+   catch-all.
    The threshold values tried are the built-in's and the midpoints between consecutive
    feature values seen on the training part; for each set of thresholds every rule gets the plan (of all plan portfolios) with the
    least total score over the training instances it takes (ties: the built-in's plan). As every rule's plan has been run on every instance, a candidate's
@@ -146,8 +147,8 @@ DENSE = 0.8
 BUILT_IN_CAND = {"sym": True, "free": 0.001, "split": DENSE, "cells": 300,
                  "plans": {"symmetric": "symmetric", "free": "free", "sparse": "sparse",
                            "medium": "sparse", "large-medium": "sparse",
-                           "dense": "dense", "large-dense": "large-dense"}}
-REGIONS = ("symmetric", "free", "sparse", "medium", "large-medium", "dense", "large-dense")
+                           "dense": "dense"}}
+REGIONS = ("symmetric", "free", "sparse", "medium", "large-medium", "dense")
 
 
 def region(c, f):
@@ -162,7 +163,7 @@ def region(c, f):
         return "sparse"
     if f["closure_density"] < DENSE:
         return "medium" if f["cells"] <= c["cells"] else "large-medium"
-    return "dense" if f["cells"] <= 300 else "large-dense"
+    return "dense"
 
 
 def choose(c, f):
@@ -186,10 +187,7 @@ def candidate_rules(c, plans, geometric=()):
         rules.append(("large-medium", pl("large-medium"),
                       {"geometric": False, "closure_density": {"below": DENSE}}))
     rules.append(("dense", pl("dense"), {"geometric": False,
-                                         "closure_density": {"min": DENSE},
-                                         "cells": {"max": 300}}))
-    rules.append(("large-dense", pl("large-dense"),
-                  {"geometric": False, "closure_density": {"min": DENSE}}))
+                                         "closure_density": {"min": DENSE}}))
     rules.extend(geometric)
     rules.append(("default", plans["default"], None))
     return rules

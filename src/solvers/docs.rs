@@ -34,8 +34,9 @@ ran) and **symmetric-modes**, several modes per cell (a colony before `ils`); **
 precedence apart from a fixed start and end (`atsp`); **sparse** precedence (a short \
 `local-search`, a colony run backwards, `ils` in a 1 % then a 3 % acceptance band with the \
 bounded-shift DP ending every repair, window re-optimization of the best); **dense** \
-precedence on few cells (half the budget for the beam, then the default phases); **large \
-dense** (no beam; `ils` with kicks that reorder up to 45 cells); **geometric free** \
+precedence (a short `local-search`, then `ils` with kicks that reorder up to 45 cells; on up \
+to 300 cells, when the beam runs, half the budget for the beam, then the default phases); \
+**geometric free** \
 instances (geometric, no or very sparse precedence, links that cost the same both ways: \
 `local-search` on the two-level list with local and random-walk double-bridge kicks for the \
 whole budget); and the catch-all **default**, the other geometric instances among them \

@@ -198,16 +198,21 @@ fn auto_picks_its_rule_by_symmetry_and_precedence_density() {
              ils[accept=0.03;shift-repair=2]*:0.85,reopt[window=16]*:1"
         );
     }
-    let c = a.choose(&rbg);
-    assert_eq!((c.rule, c.beam.share), ("dense", 0.5));
-    assert_eq!(plan_text(c.plan(true)), "local-search:0.3,eacs:0.5,ils*:1");
-    // larger dense instances: ils with longer kicks and no beam phase
-    let c = a.choose(&big);
-    assert_eq!((c.rule, c.beam.share), ("large-dense", 0.0));
-    assert_eq!(
-        plan_text(c.plan(false)),
-        "local-search:0.1,ils[max-seg=45]*:1"
-    );
+    // dense instances: ils with longer kicks; after a beam phase (up to 300 cells) a colony
+    for m in [&rbg, &big] {
+        let c = a.choose(m);
+        assert_eq!(
+            (c.rule, c.beam.share, c.beam.max_cells),
+            ("dense", 0.5, 300)
+        );
+        assert_eq!(
+            plan_text(c.plan(false)),
+            "local-search:0.1,ils[max-seg=45]*:1"
+        );
+        assert_eq!(plan_text(c.plan(true)), "local-search:0.3,eacs:0.5,ils*:1");
+    }
+    // the larger one is above the beam's bound: it gets no beam phase
+    assert!(rbg.n() <= 300 && big.n() > 300);
     // a plan the user chose replaces the rules, with the catch-all rule's beam share
     let own = "local-search:0.5,ils*:1";
     let mine = auto(&[("plan", own)]);
@@ -324,7 +329,6 @@ fn the_built_in_portfolio_parses_validates_and_ends_with_a_catch_all() {
             "free",
             "sparse",
             "dense",
-            "large-dense",
             "geometric-free",
             "default"
         ]
