@@ -4,7 +4,7 @@
 #
 # usage: scripts/families.sh OUTDIR [--quick]
 #   CELLSEQ=path/to/cellseq (default target/release/cellseq)
-#   --quick: only n <= 500 and one seed per part (86 files per part, about 135 MB in all)
+#   --quick: only n <= 500 and one seed per part (98 files per part, about 155 MB in all)
 #
 # SOP-shaped matrix families are written as TSPLIB SOP (.sop, readable by LKH-3 through
 # scripts/peers/lkh_sop.py); geometric-sparse and generalized as cellseq JSON.
@@ -55,6 +55,15 @@ part() { # part seeds
       for p in 30 60 85; do
         gen "$part" "$s" near-symmetric sop n=$n c=1000 p=$p asym=5
         gen "$part" "$s" random-sop sop n=$n c=10 p=$p
+      done
+    done
+    # asymmetric instances with dense precedence (closure density 0.8-0.95), where the
+    # `dense` rule's plan was raced (notes/lab/dense-race.md); c alternates between 1000 and 100
+    local i=0
+    for n in 150 250 350 450; do
+      for p in 80 90 95; do
+        i=$((i + 1))
+        gen "$part" "$s" random-sop sop n=$n c=$(( i % 2 ? 1000 : 100 )) p=$p
       done
     done
     for n in 50 100 200; do
