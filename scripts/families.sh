@@ -4,7 +4,7 @@
 #
 # usage: scripts/families.sh OUTDIR [--quick]
 #   CELLSEQ=path/to/cellseq (default target/release/cellseq)
-#   --quick: only n <= 500 and one seed per part (98 files per part, about 155 MB in all)
+#   --quick: only n <= 500 and one seed per part (106 files per part, about 170 MB in all)
 #
 # SOP-shaped matrix families are written as TSPLIB SOP (.sop, readable by LKH-3 through
 # scripts/peers/lkh_sop.py); geometric-sparse and generalized as cellseq JSON.
@@ -65,6 +65,12 @@ part() { # part seeds
         i=$((i + 1))
         gen "$part" "$s" random-sop sop n=$n c=$(( i % 2 ? 1000 : 100 )) p=$p
       done
+    done
+    # crane jobs in time windows (precedence an interval order, closure density 0.7-0.99):
+    # the dense rule's beam bound was raced here (notes/lab/time-window-race.md)
+    for n in 150 250 350 450 600 800 1000; do
+      [ "$QUICK" = "--quick" ] && [ "$n" -gt 500 ] && continue
+      for w in 5 20; do gen "$part" "$s" time-window sop n=$n w=$w c=100; done
     done
     for n in 50 100 200; do
       for p in 0 15; do gen "$part" "$s" generalized json n=$n p=$p modes=4; done

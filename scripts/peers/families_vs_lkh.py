@@ -8,7 +8,8 @@ The table gives per instance and time limit the median cost of each over the see
 best known value (a bks.csv beside the instance, see sop_common.best_known) or else
 cellseq's lower bound (computed after its search), and cellseq / LKH-3.
 
-The family, n and p columns come from the COMMENT line `cellseq generate` writes.
+The family, n and p columns (p: closure density %, or w= the window length of
+`time-window`) come from the COMMENT line `cellseq generate` writes.
 
 usage: families_vs_lkh.py FILE.sop... --lkh PATH [--cellseq PATH] [--time-limit 1 10]
                           [--seeds 1 2 3] [--out notes.md] [--jsonl runs.jsonl]
@@ -50,7 +51,9 @@ def describe(path):
                 break
     if family is None:
         return sc.instance_name(path), (dim or 2) - 2, ""
-    return family, int(params.get("n", (dim or 2) - 2)), params.get("p", "-")
+    # the precedence parameter: p (closure density %) or, for time-window, w (window length)
+    prec = params.get("p") or (f"w={params['w']}" if "w" in params else "-")
+    return family, int(params.get("n", (dim or 2) - 2)), prec
 
 
 def run_cellseq(binary, path, limit, seed, bound=True):

@@ -81,6 +81,12 @@ pub static KINDS: &[GeneratorInfo] = &[
         generate: families::matrix::near_symmetric,
     },
     GeneratorInfo {
+        name: "time-window",
+        summary: "storage crane jobs in time windows: interval-order precedence (dense when windows are short), asymmetric Chebyshev travel costs",
+        params: families::time_window::SPECS,
+        generate: families::time_window::generate,
+    },
+    GeneratorInfo {
         name: "compiler-dag",
         summary: "instruction block: Hamming switching costs of 32-bit words, register/flag/memory dependences (sparse, not closed)",
         params: families::compiler::SPECS,

@@ -7,6 +7,7 @@
 //! | `atsp` | random asymmetric costs without precedence (`class=amat`), or their shortest-path closure (`tmat`, costs that satisfy the triangle inequality) |
 //! | `symmetric` | symmetric integer costs uniform in [0, c], precedence density p % |
 //! | `near-symmetric` | symmetric costs plus an asymmetric part uniform in [0, asym % of c] |
+//! | `time-window` | storage crane jobs in time windows: precedence an interval order (transitively closed, dense when windows are short), asymmetric Chebyshev travel costs |
 //! | `compiler-dag` | straight-line instruction blocks: switching costs (Hamming distance of 32-bit instruction words), register and memory dependencies (sparse, not transitively closed) |
 //! | `geometric-sparse` | geometric CNC part: pockets cut in layers (roughing, then a finishing contour) and spot-drilled holes, sparse precedence, 10³–10⁵ cells |
 //! | `generalized` | matrix instance whose cells have several modes (nodes near each other in the plane), precedence density p % |
@@ -22,6 +23,7 @@ pub mod dag;
 pub mod geometric;
 pub mod matrix;
 pub mod sop;
+pub mod time_window;
 
 use crate::error::{Error, Result};
 use crate::model::{Cell, CostMatrix, Instance, Mode, Visit};

@@ -14,6 +14,7 @@ const MATRIX_KINDS: &[&str] = &[
     "symmetric",
     "near-symmetric",
     "compiler-dag",
+    "time-window",
     "generalized",
 ];
 
@@ -117,6 +118,37 @@ fn compiler_dag_is_acyclic_sparse_and_not_transitively_closed() {
 }
 
 #[test]
+fn time_window_precedence_is_a_closed_interval_order_denser_for_shorter_windows() {
+    let mut last = 1.0;
+    for w in ["2", "10", "40"] {
+        let inst = gen_("time-window", &[("n", "200"), ("w", w)], 7);
+        let (n, e) = free_edges(&inst);
+        // the numbering follows the releases, so it is a schedule
+        assert!(e.iter().all(|&(a, b)| a < b), "w={w}");
+        // an interval order is its own transitive closure
+        assert_eq!(closure_size(n, &e), e.len(), "w={w}");
+        // an interval order has no 2 + 2: of two ordered pairs a < b, c < d, a < d or c < b
+        let set: std::collections::HashSet<_> = e.iter().copied().collect();
+        for &(a, b) in e.iter().step_by(97) {
+            for &(c, d) in e.iter().step_by(89) {
+                if [a, b].iter().all(|x| ![c, d].contains(x)) {
+                    assert!(
+                        set.contains(&(a, d)) || set.contains(&(c, b)),
+                        "w={w}: 2 + 2 at {a}<{b}, {c}<{d}"
+                    );
+                }
+            }
+        }
+        let d = closure_density(&Dag::new(n, &e));
+        // about 1 - 2w/n of the pairs are ordered
+        let want = 1.0 - 2.0 * w.parse::<f64>().unwrap() / 200.0;
+        assert!((d - want).abs() < 0.08, "w={w}: density {d}, about {want}");
+        assert!(d < last, "w={w}: density {d} not below {last}");
+        last = d;
+    }
+}
+
+#[test]
 fn sop_text_reads_back_as_the_same_instance() {
     for kind in MATRIX_KINDS.iter().filter(|k| **k != "generalized") {
         let inst = gen_(kind, &[("n", "25")], 9);
@@ -198,6 +230,9 @@ fn bad_parameters_are_refused() {
         ("generalized", vec![("modes", "0")]),
         ("generalized", vec![("n", "2000"), ("modes", "4")]),
         ("geometric-sparse", vec![("size", "1")]),
+        ("time-window", vec![("w", "0")]),
+        ("time-window", vec![("n", "20"), ("w", "21")]),
+        ("time-window", vec![("c", "0")]),
     ] {
         assert!(
             generate(kind, &kv(&pairs), 1).is_err(),

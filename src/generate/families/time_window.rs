@@ -1,0 +1,86 @@
+//! `time-window`: jobs of a storage-and-retrieval crane, each released in a time window.
+//!
+//! Each job picks a load up at one rack slot and sets it down at another. A job must come
+//! before another when its window closes before the other's opens, so the precedence is an
+//! interval order: transitively closed, and dense when windows are short against the
+//! horizon (about 1 − 2w/n of the pairs are ordered). The cost of doing job `j` right after
+//! job `i` is the crane's empty move from `i`'s drop-off to `j`'s pick-up plus `j`'s loaded
+//! move, both in the Chebyshev metric (the two axes drive at once) with the vertical axis half
+//! as fast: asymmetric, with the triangle inequality on the empty moves. Unlike
+//! `random-sop`, whose dense precedence is a random DAG over uniform costs, the orders here
+//! come in overlapping windows of about `w` jobs, and nearby jobs are cheap to chain.
+
+use super::{C_SPEC, check_matrix_n, sop_shaped};
+use crate::error::{Error, Result};
+use crate::model::Instance;
+use crate::params::{ParamKind, ParamSpec, Params};
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+/// `time-window` parameters.
+pub static SPECS: &[ParamSpec] = &[
+    super::n_spec("200"),
+    C_SPEC,
+    ParamSpec {
+        name: "w",
+        default: "10",
+        kind: ParamKind::Float,
+        help: "mean window length in jobs: releases are uniform over a horizon of n jobs, \
+               window lengths uniform in [0, 2w] (0 < w <= n)",
+    },
+];
+
+/// A rack slot: column and level.
+type Slot = (i64, i64);
+
+/// The crane's travel time between two slots: both axes at once, the vertical one half as fast.
+fn travel(a: Slot, b: Slot) -> i64 {
+    (a.0 - b.0).abs().max(2 * (a.1 - b.1).abs())
+}
+
+/// `time-window`: n crane jobs in a rack `c` columns wide and `c / 4` levels high, windows of
+/// mean length `w` jobs; job `i` precedes job `j` when `i`'s window closes before `j`'s opens.
+pub fn generate(p: &Params, seed: u64) -> Result<Instance> {
+    let n = p.int("n") as usize;
+    check_matrix_n("time-window", n, 1)?;
+    let c = p.int("c");
+    if c == 0 || c > 1_000_000 {
+        return Err(Error::Param(format!(
+            "time-window: c must lie in 1..=1000000, got {c}"
+        )));
+    }
+    let w = p.float("w");
+    if !(w > 0.0 && w <= n as f64) {
+        return Err(Error::Param(format!(
+            "time-window: w must lie in (0, n] = (0, {n}], got {w}"
+        )));
+    }
+    let (cols, levels) = (c as i64, (c as i64 / 4).max(1));
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let mut jobs: Vec<(f64, f64, Slot, Slot)> = (0..n)
+        .map(|_| {
+            let open = rng.random_range(0.0..n as f64);
+            let close = open + rng.random_range(0.0..=2.0 * w);
+            let pick = (rng.random_range(0..=cols), rng.random_range(0..=levels));
+            let drop = (rng.random_range(0..=cols), rng.random_range(0..=levels));
+            (open, close, pick, drop)
+        })
+        .collect();
+    // cells numbered by release, so the numbering is a schedule
+    jobs.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let mut edges = Vec::new();
+    for (i, a) in jobs.iter().enumerate() {
+        for (j, b) in jobs.iter().enumerate() {
+            if i != j && a.1 < b.0 {
+                edges.push((i, j));
+            }
+        }
+    }
+    let cost = |u: usize, v: usize| {
+        let (_, _, _, drop_u) = jobs[u];
+        let (_, _, pick_v, drop_v) = jobs[v];
+        (travel(drop_u, pick_v) + travel(pick_v, drop_v)) as f64
+    };
+    let name = format!("time-window-n{n}-c{c}-w{w}-s{seed}");
+    Ok(sop_shaped(name, &vec![1; n], cost, &edges))
+}
