@@ -64,7 +64,8 @@ fn symmetric_costs(n: usize, c: u64, rng: &mut ChaCha8Rng) -> Vec<f64> {
     m
 }
 
-fn cost_range(kind: &str, p: &Params) -> Result<u64> {
+/// The `c` parameter, refused outside 1..=1 000 000.
+pub(crate) fn cost_range(kind: &str, p: &Params) -> Result<u64> {
     let c = p.int("c");
     if c == 0 || c > 1_000_000 {
         return Err(Error::Param(format!(

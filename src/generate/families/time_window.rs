@@ -10,7 +10,7 @@
 //! `random-sop`, whose dense precedence is a random DAG over uniform costs, the orders here
 //! come in overlapping windows of about `w` jobs, and nearby jobs are cheap to chain.
 
-use super::{C_SPEC, check_matrix_n, sop_shaped};
+use super::{C_SPEC, check_matrix_n, matrix::cost_range, sop_shaped};
 use crate::error::{Error, Result};
 use crate::model::Instance;
 use crate::params::{ParamKind, ParamSpec, Params};
@@ -43,12 +43,7 @@ fn travel(a: Slot, b: Slot) -> i64 {
 pub fn generate(p: &Params, seed: u64) -> Result<Instance> {
     let n = p.int("n") as usize;
     check_matrix_n("time-window", n, 1)?;
-    let c = p.int("c");
-    if c == 0 || c > 1_000_000 {
-        return Err(Error::Param(format!(
-            "time-window: c must lie in 1..=1000000, got {c}"
-        )));
-    }
+    let c = cost_range("time-window", p)?;
     let w = p.float("w");
     if !(w > 0.0 && w <= n as f64) {
         return Err(Error::Param(format!(
