@@ -63,13 +63,11 @@ pub fn generate(p: &Params, seed: u64) -> Result<Instance> {
         .collect();
     // cells numbered by release, so the numbering is a schedule
     jobs.sort_by(|a, b| a.0.total_cmp(&b.0));
+    // job i precedes exactly the jobs released after its window closes: a suffix of the order
     let mut edges = Vec::new();
     for (i, a) in jobs.iter().enumerate() {
-        for (j, b) in jobs.iter().enumerate() {
-            if i != j && a.1 < b.0 {
-                edges.push((i, j));
-            }
-        }
+        let first = jobs.partition_point(|b| b.0 <= a.1);
+        edges.extend((first..n).map(|j| (i, j)));
     }
     let cost = |u: usize, v: usize| {
         let (_, _, _, drop_u) = jobs[u];
