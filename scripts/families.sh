@@ -4,7 +4,7 @@
 #
 # usage: scripts/families.sh OUTDIR [--quick]
 #   CELLSEQ=path/to/cellseq (default target/release/cellseq)
-#   --quick: only n <= 500 and one seed per part (106 files per part, about 170 MB in all)
+#   --quick: only n <= 500 and one seed per part (118 files per part, about 170 MB in all)
 #
 # SOP-shaped matrix families are written as TSPLIB SOP (.sop, readable by LKH-3 through
 # scripts/peers/lkh_sop.py); geometric-sparse and generalized as cellseq JSON.
@@ -74,6 +74,9 @@ part() { # part seeds
     done
     for n in 50 100 200; do
       for p in 0 15; do gen "$part" "$s" generalized json n=$n p=$p modes=4; done
+      # half the cells open features cut either way: asymmetric costs, several modes per
+      # cell, sparse precedence (the `sparse` rule's instances with modes > 1)
+      for p in 1 5 15 30; do gen "$part" "$s" generalized json n=$n p=$p modes=4 open=0.5; done
     done
     for n in 1000 10000; do gen "$part" "$s" geometric-sparse json n=$n; done
     [ "$QUICK" = "--quick" ] || gen "$part" "$s" geometric-sparse json n=100000

@@ -62,6 +62,12 @@ pub static GENERALIZED_SPECS: &[ParamSpec] = &[
         kind: ParamKind::Float,
         help: "a cell's nodes lie within spread % of c of its centre",
     },
+    ParamSpec {
+        name: "open",
+        default: "0",
+        kind: ParamKind::Float,
+        help: "share of cells that are open features: two modes, entered at one end and left at the other (asymmetric costs)",
+    },
 ];
 
 const STEP: f64 = 2.0;
@@ -202,16 +208,26 @@ pub fn geometric_sparse(p: &Params, seed: u64) -> Result<Instance> {
 
 /// `generalized`: cells of 1..=modes nodes each, the nodes of a cell near its centre in a
 /// square of side c; costs are rounded distances between nodes; precedence of closure
-/// density p %. SOP-shaped (dummy start and end cells).
+/// density p %. SOP-shaped (dummy start and end cells). With `open` > 0 that share of the
+/// cells are open features instead (a slot, a line, an open contour): two modes, the same
+/// stroke cut one way or the other, so a mode is entered at one end and left at the other
+/// and the cost of u then v is the distance from u's exit to v's entry (asymmetric).
 pub fn generalized(p: &Params, seed: u64) -> Result<Instance> {
     let n = p.int("n") as usize;
     let modes = p.int("modes") as usize;
+    let open = p.float("open");
     if !(1..=64).contains(&modes) {
         return Err(Error::Param(format!(
             "generalized: modes must lie in 1..=64, got {modes}"
         )));
     }
-    check_matrix_n("generalized", n, modes)?;
+    if !(0.0..=1.0).contains(&open) {
+        return Err(Error::Param(format!(
+            "generalized: open is a share in 0..=1, got {open}"
+        )));
+    }
+    let most = if open > 0.0 { modes.max(2) } else { modes };
+    check_matrix_n("generalized", n, most)?;
     let c = p.int("c");
     if c == 0 || c > 1_000_000 {
         return Err(Error::Param(format!(
@@ -228,23 +244,51 @@ pub fn generalized(p: &Params, seed: u64) -> Result<Instance> {
     let side = c as f64;
     let radius = spread / 100.0 * side;
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    let counts: Vec<usize> = (0..n).map(|_| rng.random_range(1..=modes)).collect();
-    let mut pts = Vec::new();
+    let mut counts: Vec<usize> = (0..n).map(|_| rng.random_range(1..=modes)).collect();
+    // (entry, exit) of every node, cell by cell.
+    let mut ends: Vec<Vec<(f64, f64)>> = Vec::with_capacity(n);
     for &k in &counts {
         let (cx, cy) = (rng.random_range(0.0..side), rng.random_range(0.0..side));
-        for _ in 0..k {
-            let a = rng.random_range(0.0..TAU);
-            let r = radius * rng.random_range(0.0f64..1.0).sqrt();
-            pts.push((cx + r * a.cos(), cy + r * a.sin()));
-        }
+        let pts: Vec<(f64, f64)> = (0..k)
+            .map(|_| {
+                let a = rng.random_range(0.0..TAU);
+                let r = radius * rng.random_range(0.0f64..1.0).sqrt();
+                (cx + r * a.cos(), cy + r * a.sin())
+            })
+            .collect();
+        ends.push(pts);
     }
     let edges = random_dag(n, density, &mut rng);
+    // Open features come from a stream of their own, so `open = 0` writes the same bytes
+    // as before the parameter existed.
+    let mut nodes: Vec<((f64, f64), (f64, f64))> = Vec::new();
+    let mut side_rng = ChaCha8Rng::seed_from_u64(seed);
+    side_rng.set_stream(1);
+    for (cell, pts) in ends.iter().enumerate() {
+        if open > 0.0 && side_rng.random_bool(open) {
+            // a stroke from the cell's first point, up to twice the spread radius long
+            let a = pts[0];
+            let t = side_rng.random_range(0.0..TAU);
+            let len = 2.0 * radius * side_rng.random_range(0.0f64..1.0);
+            let b = (a.0 + len * t.cos(), a.1 + len * t.sin());
+            nodes.push((a, b));
+            nodes.push((b, a));
+            counts[cell] = 2;
+        } else {
+            nodes.extend(pts.iter().map(|&q| (q, q)));
+        }
+    }
     let name = format!("generalized-n{n}-c{c}-p{}-s{seed}", p.float("p"));
+    let name = if open > 0.0 {
+        format!("{name}-open{open}")
+    } else {
+        name
+    };
     Ok(sop_shaped(
         name,
         &counts,
         |u, v| {
-            let (a, b) = (pts[u], pts[v]);
+            let (a, b) = (nodes[u].1, nodes[v].0);
             ((a.0 - b.0).hypot(a.1 - b.1)).round()
         },
         &edges,

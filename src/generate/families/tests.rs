@@ -149,6 +149,36 @@ fn time_window_precedence_is_a_closed_interval_order_denser_for_shorter_windows(
 }
 
 #[test]
+fn generalized_open_features_cut_either_way_with_asymmetric_costs() {
+    let inst = gen_("generalized", &[("n", "30"), ("open", "1"), ("p", "0")], 3);
+    let m = inst.matrix.as_ref().unwrap();
+    // node index of every cell's first mode (the dummies have one node each)
+    let mut first = vec![0usize];
+    for c in &inst.cells {
+        first.push(first.last().unwrap() + c.modes.len());
+    }
+    let free = 1..inst.n() - 1;
+    assert!(free.clone().all(|i| inst.cells[i].modes.len() == 2));
+    let mut asymmetric = 0;
+    for x in free.clone() {
+        for y in free.clone().filter(|&y| y != x) {
+            let (fx, rx, fy, ry) = (first[x], first[x] + 1, first[y], first[y] + 1);
+            // u then v costs u's exit to v's entry: a stroke cut backwards swaps its ends
+            assert_eq!(m.get(fx, fy), m.get(ry, rx), "cells {x}, {y}");
+            assert_eq!(m.get(rx, fy), m.get(ry, fx), "cells {x}, {y}");
+            asymmetric += usize::from(m.get(fx, fy) != m.get(fy, fx));
+        }
+    }
+    assert!(asymmetric > 0, "open features give asymmetric costs");
+    let some = gen_("generalized", &[("n", "200"), ("open", "0.5")], 3);
+    let two = some.cells.iter().filter(|c| c.modes.len() == 2).count();
+    assert!(
+        (80..=160).contains(&two),
+        "about half open: {two} of 200 have two modes"
+    );
+}
+
+#[test]
 fn sop_text_reads_back_as_the_same_instance() {
     for kind in MATRIX_KINDS.iter().filter(|k| **k != "generalized") {
         let inst = gen_(kind, &[("n", "25")], 9);
@@ -229,6 +259,8 @@ fn bad_parameters_are_refused() {
         ("compiler-dag", vec![("regs", "1")]),
         ("generalized", vec![("modes", "0")]),
         ("generalized", vec![("n", "2000"), ("modes", "4")]),
+        ("generalized", vec![("open", "1.5")]),
+        ("generalized", vec![("open", "nan")]),
         ("geometric-sparse", vec![("size", "1")]),
         ("time-window", vec![("w", "0")]),
         ("time-window", vec![("n", "20"), ("w", "21")]),
