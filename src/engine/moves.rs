@@ -134,6 +134,28 @@ impl SegmentMove {
     }
 }
 
+impl SegmentMove {
+    /// For a one-cell segment: the delta of inserting its cell between positions `p` and
+    /// `p + 1` in the mode that is cheapest there, and that mode (a cell of several modes
+    /// moved elsewhere is often best entered another way; kept in its mode, the move may
+    /// not pay and the better mode is never tried there).
+    #[inline]
+    pub fn delta_best_mode(&self, c: &Costs, s: &Solution, p: isize) -> (f64, usize) {
+        let (a, b) = (s.at(p), s.at(p + 1));
+        let cell = s.order[self.first as usize] as usize;
+        let base = self.close - c.link(a, b);
+        let mut best = (f64::INFINITY, 0);
+        for md in 0..c.m.modes(cell) {
+            let x = Some((cell, md));
+            let d = base + c.link(a, x) + c.link(x, b);
+            if d < best.0 {
+                best = (d, md);
+            }
+        }
+        best
+    }
+}
+
 /// Applies [`segment_delta`]'s move.
 pub fn apply_segment(
     m: &CostModel,
