@@ -132,9 +132,7 @@ impl SegmentMove {
             self.close + c.link(a, s.at(self.first)) + c.link(s.at(self.last), b) - open
         }
     }
-}
 
-impl SegmentMove {
     /// For a one-cell segment: the delta of inserting its cell between positions `p` and
     /// `p + 1` in the mode that is cheapest there, and that mode (a cell of several modes
     /// moved elsewhere is often best entered another way; kept in its mode, the move may

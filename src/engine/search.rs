@@ -125,7 +125,7 @@ impl<'a> Search<'a> {
             let mut best = (0.0, 0usize, 0isize, false);
             // with several modes, a single cell goes in the mode that is cheapest where it lands
             let mut best_mode = None;
-            let moded = m.modes(x as usize) > 1;
+            let modes = m.modes(x as usize);
             let mut evals = 0u64;
             for len in 1..=3usize.min(n - i) {
                 let (lo, hi) = window(m, s, i, len);
@@ -157,8 +157,8 @@ impl<'a> Search<'a> {
                     if p >= i as isize - 1 && p <= (i + len - 1) as isize || p < lo || p >= hi {
                         continue;
                     }
-                    if moded && len == 1 {
-                        evals += m.modes(x as usize) as u64;
+                    if modes > 1 && len == 1 {
+                        evals += modes as u64;
                         let (d, md) = mv.delta_best_mode(&c, s, p);
                         if d < best.0 {
                             best = (d, 1, p, false);

@@ -245,8 +245,8 @@ pub fn generalized(p: &Params, seed: u64) -> Result<Instance> {
     let radius = spread / 100.0 * side;
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let mut counts: Vec<usize> = (0..n).map(|_| rng.random_range(1..=modes)).collect();
-    // (entry, exit) of every node, cell by cell.
-    let mut ends: Vec<Vec<(f64, f64)>> = Vec::with_capacity(n);
+    // the start points of every cell, near its centre
+    let mut points: Vec<Vec<(f64, f64)>> = Vec::with_capacity(n);
     for &k in &counts {
         let (cx, cy) = (rng.random_range(0.0..side), rng.random_range(0.0..side));
         let pts: Vec<(f64, f64)> = (0..k)
@@ -256,15 +256,16 @@ pub fn generalized(p: &Params, seed: u64) -> Result<Instance> {
                 (cx + r * a.cos(), cy + r * a.sin())
             })
             .collect();
-        ends.push(pts);
+        points.push(pts);
     }
     let edges = random_dag(n, density, &mut rng);
     // Open features come from a stream of their own, so `open = 0` writes the same bytes
     // as before the parameter existed.
+    // (entry, exit) of every node, cell by cell
     let mut nodes: Vec<((f64, f64), (f64, f64))> = Vec::new();
     let mut side_rng = ChaCha8Rng::seed_from_u64(seed);
     side_rng.set_stream(1);
-    for (cell, pts) in ends.iter().enumerate() {
+    for (cell, pts) in points.iter().enumerate() {
         if open > 0.0 && side_rng.random_bool(open) {
             // a stroke from the cell's first point, up to twice the spread radius long
             let a = pts[0];
