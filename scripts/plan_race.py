@@ -3,20 +3,23 @@
 
 Each instance runs with every variant at every limit and seed, one thread. A variant is a
 plan (`--plan NAME=PLAN`, run as `--param plan=...`; an empty PLAN runs the built-in
-portfolio's choice) or a whole portfolio file (`--portfolio NAME=FILE`, run as
-`--portfolio FILE`: its rules' beam shares and `after_beam` phases apply). The table gives
-each variant's median cost over the seeds and its ratio to the best median of that row; the
-last rows compare every variant with the first one (the `--plan` variants come first, in
-the order given, then the `--portfolio` ones) (geometric mean of the ratios, and on
-how many rows it is better, worse or equal). Used to choose the `geometric-free` and
-`dense` rules on generated families (notes/portfolio.md); for timed comparisons run it
-alone at high priority.
+portfolio's choice), a whole portfolio file (`--portfolio NAME=FILE`, run as
+`--portfolio FILE`: its rules' beam shares and `after_beam` phases apply) or another cellseq
+binary with its built-in portfolio (`--bin NAME=PATH`: a solver before and after a change
+inside it). The table gives each variant's median cost over the seeds and its ratio to the
+best median of that row; the last rows compare every variant with the first one (the
+`--plan` variants come first, in the order given, then the `--portfolio` ones, then the
+`--bin` ones) (geometric mean of the ratios, and on how many rows it is better, worse or
+equal). Used to choose the `geometric-free` and `dense` rules on generated families
+(notes/portfolio.md); for timed comparisons run it alone at high priority.
 
     python3 scripts/plan_race.py FILES... --plan default='local-search:0.3,eacs:0.5,ils*:1' \\
         --plan free='local-search[two-level=on]:1' --plan rule= --limits 1 10 \\
         --objective air --tsv out.tsv --out out.md
     python3 scripts/plan_race.py FILES... --plan built-in= --portfolio mine=mine.toml \\
         --limits 10 --seeds 1 2 3
+    python3 scripts/plan_race.py FILES... --bin before=/tmp/cellseq-before \\
+        --bin after=target/release/cellseq --limits 10 --seeds 1 2 3
 """
 import argparse
 import math
@@ -30,6 +33,8 @@ from sop_common import cellseq_solve  # noqa: E402
 
 def run(cellseq, path, variant, limit, objective, seed):
     kind, text = variant
+    if kind == "bin":
+        cellseq = text
     budget = ["--time-limit", str(limit)]
     if objective:
         budget += ["--objective", objective]
@@ -51,6 +56,8 @@ def main():
                     help="NAME=PLAN (an empty PLAN: the portfolio's rule); repeatable")
     ap.add_argument("--portfolio", action="append", default=[],
                     help="NAME=FILE: a portfolio file as a variant; repeatable")
+    ap.add_argument("--bin", action="append", default=[],
+                    help="NAME=PATH: a cellseq binary (its built-in portfolio) as a variant; repeatable")
     ap.add_argument("--limits", nargs="+", type=float, default=[1.0, 10.0])
     ap.add_argument("--objective", default=None, help="time, air or matrix (default: the file's)")
     ap.add_argument("--seeds", type=int, nargs="+", default=None,
@@ -61,15 +68,19 @@ def main():
     ap.add_argument("--out", help="write the markdown table here (default: stdout)")
     a = ap.parse_args()
     variants = []
-    for kind, given in [("plan", p) for p in a.plan] + [("portfolio", p) for p in a.portfolio]:
+    given_all = ([("plan", p) for p in a.plan] + [("portfolio", p) for p in a.portfolio]
+                 + [("bin", p) for p in a.bin])
+    for kind, given in given_all:
         name, eq, text = given.partition("=")
-        if not name or not eq or (kind == "portfolio" and not text):
-            sys.exit(f"--{kind} {given!r}: expected NAME={kind.upper()}")
+        if not name or not eq or (kind != "plan" and not text):
+            sys.exit(f"--{kind} {given!r}: expected NAME={'PATH' if kind == 'bin' else kind.upper()}")
+        if kind == "bin" and not os.access(text, os.X_OK):
+            sys.exit(f"--bin {given!r}: {text} is not an executable file")
         if any(name == n for n, _ in variants):
             sys.exit(f"--{kind} {given!r}: the name {name!r} is used twice")
         variants.append((name, (kind, text)))
     if not variants:
-        sys.exit("give at least one --plan or --portfolio")
+        sys.exit("give at least one --plan, --portfolio or --bin")
     seeds = a.seeds or [a.seed]
     rows = []
     for f in a.files:
