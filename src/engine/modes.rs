@@ -19,33 +19,16 @@ impl ModeLayers {
     /// the arc evaluations between layers and whether it ran to the last cell: it gives up
     /// as soon as every partial path costs at least a finite `cap`.
     pub fn run(&mut self, c: &Costs, cells: &[u32], left: Slot, cap: f64) -> (u64, bool) {
-        let first = cells[0] as usize;
-        self.dist.clear();
-        self.dist
-            .extend((0..c.m.modes(first)).map(|k| c.link(left, Some((first, k)))));
-        self.layers(c, cells, cap)
-    }
-
-    /// The cheapest cost of the links inside `cells` (from the first to the last) over all
-    /// their modes, and the arc evaluations made. Leaves no path to trace.
-    pub fn inside(&mut self, c: &Costs, cells: &[u32]) -> (f64, u64) {
-        self.dist.clear();
-        self.dist.resize(c.m.modes(cells[0] as usize), 0.0);
-        let (evals, _) = self.layers(c, cells, f64::INFINITY);
-        (
-            self.dist.iter().copied().fold(f64::INFINITY, f64::min),
-            evals,
-        )
-    }
-
-    /// The layers after the first (whose costs are in `dist`), as in [`ModeLayers::run`].
-    fn layers(&mut self, c: &Costs, cells: &[u32], cap: f64) -> (u64, bool) {
         let m = c.m;
         let len = cells.len();
         let mut evals = 0u64;
         if self.back.len() < len {
             self.back.resize_with(len, Vec::new);
         }
+        let first = cells[0] as usize;
+        self.dist.clear();
+        self.dist
+            .extend((0..m.modes(first)).map(|k| c.link(left, Some((first, k)))));
         for p in 1..len {
             let (a, b) = (cells[p - 1] as usize, cells[p] as usize);
             let kb = m.modes(b);

@@ -3,7 +3,6 @@
 //! Positions are `isize` so that −1 (home) and n (path end) can be named; [`Solution::link`]
 //! turns them into start and finish costs.
 
-use super::modes::ModeLayers;
 use super::solution::flip_mode;
 use super::{Costs, Slot, Solution};
 use crate::cost::CostModel;
@@ -152,47 +151,6 @@ impl SegmentMove {
             }
         }
         best
-    }
-
-    /// For a segment of several cells, some of several modes: the delta of inserting it
-    /// between positions `p` and `p + 1` with `cells` (the segment's cells in the order they
-    /// will run: as they are, or reversed) each in the mode that makes the segment cheapest
-    /// there, by a layered shortest path over their modes (the ends' modes are coupled
-    /// through the links inside). Also returns the arc evaluations made. Infinity when the
-    /// delta cannot fall below `bound`: links are never negative, so the path is not run
-    /// when the cheapest entry and exit links with `inside` (the cheapest links inside
-    /// `cells` in any modes, [`ModeLayers::inside`]) already reach it, and gives up as soon
-    /// as every partial path is too dear. The modes are then in `layers`
-    /// ([`ModeLayers::close`], [`ModeLayers::trace`]).
-    #[allow(clippy::too_many_arguments)]
-    pub fn delta_modes(
-        &self,
-        c: &Costs,
-        s: &Solution,
-        layers: &mut ModeLayers,
-        cells: &[u32],
-        inside: f64,
-        p: isize,
-        bound: f64,
-    ) -> (f64, u64) {
-        let (a, b) = (s.at(p), s.at(p + 1));
-        // the path over the segment replaces its links inside as well as the two outside
-        let base = self.close - s.links(c, self.first, self.last) - c.link(a, b);
-        let (first, last) = (cells[0] as usize, cells[cells.len() - 1] as usize);
-        let (kf, kl) = (c.m.modes(first), c.m.modes(last));
-        let enter = (0..kf).fold(f64::INFINITY, |v, k| v.min(c.link(a, Some((first, k)))));
-        let leave = (0..kl).fold(f64::INFINITY, |v, k| v.min(c.link(Some((last, k)), b)));
-        let screen = (1 + kf + kl) as u64;
-        if base + enter + inside + leave >= bound {
-            return (f64::INFINITY, screen);
-        }
-        let (inner, complete) = layers.run(c, cells, a, bound - base);
-        let evals = screen + kf as u64 + inner;
-        if !complete {
-            return (f64::INFINITY, evals);
-        }
-        let (v, _) = layers.close(c, last, b);
-        (base + v, evals + layers.last_modes() as u64)
     }
 }
 

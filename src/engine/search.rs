@@ -1,6 +1,6 @@
 //! Local search passes with candidate lists and don't-look bits, and the VND over them.
 
-use super::modes::{ModeLayers, mode_dp};
+use super::modes::mode_dp;
 use super::moves::{
     LAZY_REACH_CELLS, Reversal, SegmentMove, apply_segment, mode_delta, reversible_segment, window,
 };
@@ -70,20 +70,6 @@ pub struct Search<'a> {
     pub mode_window: ModeWindow,
     labels: Labels,
     rev: Reversal,
-    /// Or-opt's mode path over a segment of several cells, and its reversed cells.
-    seg_layers: ModeLayers,
-    seg_cells: Vec<u32>,
-}
-
-/// `cells` in the order a segment runs after its move: as they are, or reversed (into
-/// `buf`).
-fn run_order<'b>(cells: &'b [u32], reversed: bool, buf: &'b mut Vec<u32>) -> &'b [u32] {
-    if !reversed {
-        return cells;
-    }
-    buf.clear();
-    buf.extend(cells.iter().rev());
-    buf
 }
 
 /// Window length of [`ModeWindow`] moves on instances with several modes per cell.
@@ -110,15 +96,11 @@ impl<'a> Search<'a> {
             }),
             labels: Labels::default(),
             rev: Reversal::default(),
-            seg_layers: ModeLayers::default(),
-            seg_cells: Vec::new(),
         }
     }
 
     /// Or-opt to a local optimum: segments of 1–3 cells starting at a looked-at cell move
-    /// next to a candidate neighbour (kept or reversed). Cells of several modes land in
-    /// the modes cheapest there (a layered shortest path over a segment's modes). Returns
-    /// true on any improvement.
+    /// next to a candidate neighbour (kept or reversed). Returns true on any improvement.
     pub fn or_opt(&mut self, s: &mut Solution, ctx: &mut Context) -> bool {
         let queue = Queue::all(s.n());
         self.or_opt_from(s, ctx, queue)
@@ -143,7 +125,6 @@ impl<'a> Search<'a> {
             let mut best = (0.0, 0usize, 0isize, false);
             // with several modes, a single cell goes in the mode that is cheapest where it lands
             let mut best_mode = None;
-            let mut seg_best = false;
             let modes = m.modes(x as usize);
             let mut evals = 0u64;
             for len in 1..=3usize.min(n - i) {
@@ -152,19 +133,6 @@ impl<'a> Search<'a> {
                 let mv = SegmentMove::new(&c, s, i, len, rev_ok);
                 let first = s.order[i];
                 let last = s.order[i + len - 1];
-                // a segment holding a cell of several modes lands with every cell's mode
-                // re-chosen for the new place
-                let seg_modes = len > 1 && (i..i + len).any(|q| m.modes(s.order[q] as usize) > 1);
-                // the cheapest links inside the segment in any modes, as it is and reversed
-                let mut inside = [0.0; 2];
-                if seg_modes {
-                    for r in [false, true].into_iter().filter(|&r| !r || rev_ok) {
-                        let cells = run_order(&s.order[i..i + len], r, &mut self.seg_cells);
-                        let (v, e) = self.seg_layers.inside(&c, cells);
-                        inside[r as usize] = v;
-                        evals += e;
-                    }
-                }
                 let cands = self.nb.inn[first as usize]
                     .iter()
                     .map(|&v| s.pos[v as usize] as isize)
@@ -198,24 +166,6 @@ impl<'a> Search<'a> {
                         }
                         continue;
                     }
-                    if seg_modes {
-                        for r in [false, true] {
-                            if r && !rev_ok {
-                                continue;
-                            }
-                            let cells = run_order(&s.order[i..i + len], r, &mut self.seg_cells);
-                            let layers = &mut self.seg_layers;
-                            let inside = inside[r as usize];
-                            let (d, e) = mv.delta_modes(&c, s, layers, cells, inside, p, best.0);
-                            evals += e;
-                            if d < best.0 {
-                                best = (d, len, p, r);
-                                best_mode = None;
-                                seg_best = true;
-                            }
-                        }
-                        continue;
-                    }
                     for r in [false, true] {
                         if r && !rev_ok {
                             continue;
@@ -225,7 +175,6 @@ impl<'a> Search<'a> {
                         if d < best.0 {
                             best = (d, len, p, r);
                             best_mode = None;
-                            seg_best = false;
                         }
                     }
                 }
@@ -240,7 +189,6 @@ impl<'a> Search<'a> {
                         apply_segment(m, s, i, 1, p, false, keep);
                         s.set_mode(x as usize, md, d - keep);
                     }
-                    None if seg_best => self.apply_segment_modes(s, i, len, p, r, d),
                     None => apply_segment(m, s, i, len, p, r, d),
                 }
                 improved = true;
@@ -250,36 +198,6 @@ impl<'a> Search<'a> {
             }
         }
         improved
-    }
-
-    /// Applies an Or-opt move of the segment of `len` cells at `i` to after `p` (reversed
-    /// or not) found by [`SegmentMove::delta_modes`] with delta `d`: the cells take the
-    /// modes of the cheapest path over them there, traced again (the layers hold a later
-    /// trial's).
-    fn apply_segment_modes(
-        &mut self,
-        s: &mut Solution,
-        i: usize,
-        len: usize,
-        p: isize,
-        r: bool,
-        d: f64,
-    ) {
-        let c = self.c;
-        let mv = SegmentMove::new(&c, s, i, len, r);
-        let cells = run_order(&s.order[i..i + len], r, &mut self.seg_cells);
-        let layers = &mut self.seg_layers;
-        let (again, _) = mv.delta_modes(&c, s, layers, cells, 0.0, p, f64::INFINITY);
-        debug_assert_eq!(again, d);
-        let (_, k) = layers.close(&c, cells[len - 1] as usize, s.at(p + 1));
-        let mut modes = [0u32; 3];
-        layers.trace(len, k, |q, md| modes[q] = md);
-        let mut run = [0u32; 3];
-        run[..len].copy_from_slice(cells);
-        apply_segment(c.m, s, i, len, p, r, d);
-        for (&cell, &md) in run[..len].iter().zip(&modes) {
-            s.mode[cell as usize] = md;
-        }
     }
 
     /// 2-opt with mode flip to a local optimum (segments without internal precedence pairs
@@ -447,20 +365,18 @@ impl<'a> Search<'a> {
 mod tests {
     use super::*;
     use crate::cost::CostModel;
-    use crate::engine::moves::{SegmentMove, reversible_segment, window};
+    use crate::engine::moves::{SegmentMove, window};
     use crate::model::Objective;
     use crate::params::Params;
     use crate::search::{Budget, NoObserver};
 
-    /// With candidate lists holding every cell, Or-opt ends where no single cell, and no
-    /// segment of two or three (kept or reversed), can move to any place its precedence
-    /// allows, in any of its modes, for less: cells of several modes land in the modes that
-    /// are cheapest there. Generalized instances with open features (asymmetric costs, two
-    /// modes per open cell).
+    /// With candidate lists holding every cell, Or-opt ends where no single cell can move
+    /// to any place its precedence allows, in any of its modes, for less: cells of several
+    /// modes are inserted in the mode that is cheapest where they land. Generalized
+    /// instances with open features (asymmetric costs, two modes per open cell).
     #[test]
     fn or_opt_ends_where_no_cell_moves_for_less_in_any_mode() {
         let mut moved_in_other_mode = false;
-        let mut segment_landings = 0;
         for seed in 1..=6 {
             let kv = [("n", "30"), ("open", "0.6"), ("p", "10")]
                 .iter()
@@ -493,32 +409,7 @@ mod tests {
                     assert!(!improves(d, s.cost), "seed {seed}: cell at {i} to {p}: {d}");
                 }
             }
-            // nor a segment of two or three cells, kept or reversed, each cell in any mode
-            let mut layers = ModeLayers::default();
-            for len in 2..=3 {
-                for i in 0..=s.n() - len {
-                    let (lo, hi) = window(&m, &s, i, len);
-                    let mv = SegmentMove::new(&c, &s, i, len, false);
-                    let mut cells = s.order[i..i + len].to_vec();
-                    let rev_ok = reversible_segment(&m, &s, i, len);
-                    for r in [false, true].into_iter().filter(|&r| !r || rev_ok) {
-                        if r {
-                            cells.reverse();
-                        }
-                        for p in (lo..hi).filter(|&p| p < i as isize - 1 || p >= (i + len) as isize)
-                        {
-                            let (d, _) = mv.delta_modes(&c, &s, &mut layers, &cells, 0.0, p, 0.0);
-                            assert!(
-                                !improves(d, s.cost),
-                                "seed {seed}: {len} at {i} to {p}: {d}"
-                            );
-                            segment_landings += 1;
-                        }
-                    }
-                }
-            }
         }
-        assert!(segment_landings > 0);
         assert!(
             moved_in_other_mode,
             "some cell changed place and mode at once"
