@@ -9,8 +9,9 @@ binary with its built-in portfolio (`--bin NAME=PATH`: a solver before and after
 inside it). The table gives each variant's median cost over the seeds and its ratio to the
 best median of that row; the last rows compare every variant with the first one (the
 `--plan` variants come first, in the order given, then the `--portfolio` ones, then the
-`--bin` ones) (geometric mean of the ratios, and on how many rows it is better, worse or
-equal). Used to choose the `geometric-free` and `dense` rules on generated families
+`--bin` ones) (geometric mean of the ratios, on how many rows it is better, worse or equal,
+and a sign test on those rows); with several seeds a last row gives each variant's spread
+between seeds, the noise a difference has to beat. Used to choose the `geometric-free` and `dense` rules on generated families
 (notes/portfolio.md); for timed comparisons run it alone at high priority.
 
     python3 scripts/plan_race.py FILES... --plan default='local-search:0.3,eacs:0.5,ils*:1' \\
@@ -94,7 +95,7 @@ def main():
                     print(f"{os.path.basename(f)} {lim} s seed {seed} {name}: {cost:.3f} "
                           f"({secs:.2f} s)", file=sys.stderr, flush=True)
             rows.append((os.path.basename(f), lim, None,
-                         {n: statistics.median(c) for n, c in costs.items()}, None, None, None))
+                         {n: statistics.median(c) for n, c in costs.items()}, costs, None, None))
     if a.tsv:
         with open(a.tsv, "w") as t:
             t.write("file\tlimit_s\tplan\tseed\tcost\tevaluations\telapsed_s\n")
@@ -110,9 +111,29 @@ def main():
         sys.stdout.write(text)
 
 
+def sign_test_p(better, worse):
+    """Two-sided sign test: the chance of a split at least this uneven between `better` and
+    `worse` rows if either were as likely (ties left out); 1 when there is nothing to split."""
+    n = better + worse
+    k = min(better, worse)
+    return min(1.0, 2 * sum(math.comb(n, i) for i in range(k + 1)) / 2 ** n) if n else 1.0
+
+
+def seed_spread(names, medians):
+    """Per variant: the median over rows of (max − min) ÷ median of its costs over the
+    seeds, the noise a difference between variants has to beat."""
+    spread = {n: [] for n in names}
+    for _, _, _, med, costs, *_ in medians:
+        for n in names:
+            if len(costs[n]) > 1 and med[n] > 0:
+                spread[n].append((max(costs[n]) - min(costs[n])) / med[n])
+    return {n: statistics.median(v) if v else None for n, v in spread.items()}
+
+
 def table(names, medians):
     """The markdown table: per row the medians and their ratio to the row's best, then every
-    variant against the first (geometric mean of the ratios; better / worse / equal rows)."""
+    variant against the first (geometric mean of the ratios; better / worse / equal rows and
+    the sign test's p on them) and, with several seeds, each variant's spread between seeds."""
     lines = ["| instance | limit s | " + " | ".join(names) + " | best |",
              "|---|---|" + "---|" * len(names) + "---|"]
     logs = {n: [] for n in names}
@@ -133,6 +154,12 @@ def table(names, medians):
         lines.append(f"| geometric mean ÷ {names[0]} | | " + " | ".join(gm) + " | |")
         lines.append("| better / worse / equal | | –" + "".join(
             " | {} / {} / {}".format(*tally[n]) for n in names[1:]) + " | |")
+        lines.append("| sign test p (two-sided, ties left out) | | –" + "".join(
+            f" | {sign_test_p(tally[n][0], tally[n][1]):.3f}" for n in names[1:]) + " | |")
+    spread = seed_spread(names, medians)
+    if any(v is not None for v in spread.values()):
+        lines.append("| spread between seeds (median of (max − min) ÷ median) | | " + " | ".join(
+            f"{spread[n]:.4f}" if spread[n] is not None else "–" for n in names) + " | |")
     return lines
 
 
