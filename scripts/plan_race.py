@@ -11,8 +11,9 @@ best median of that row; the last rows compare every variant with the first one 
 `--plan` variants come first, in the order given, then the `--portfolio` ones, then the
 `--bin` ones) (geometric mean of the ratios, on how many rows it is better, worse or equal,
 and a sign test on those rows); with several seeds a last row gives each variant's spread
-between seeds, the noise a difference has to beat. Used to choose the `geometric-free` and `dense` rules on generated families
-(notes/portfolio.md); for timed comparisons run it alone at high priority.
+between seeds, the noise a difference has to beat. Used to choose the `geometric-free` and
+`dense` rules on generated families (notes/portfolio.md); for timed comparisons run it alone
+at high priority.
 
     python3 scripts/plan_race.py FILES... --plan default='local-search:0.3,eacs:0.5,ils*:1' \\
         --plan free='local-search[two-level=on]:1' --plan rule= --limits 1 10 \\
@@ -83,7 +84,8 @@ def main():
     if not variants:
         sys.exit("give at least one --plan, --portfolio or --bin")
     seeds = a.seeds or [a.seed]
-    rows = []
+    runs = []  # (file, limit, variant, cost, evaluations, seconds, seed)
+    summary = []  # (file, limit, {variant: median cost}, {variant: [cost per seed]})
     for f in a.files:
         for lim in a.limits:
             costs = {}
@@ -91,18 +93,17 @@ def main():
                 for name, variant in variants:
                     cost, evals, secs = run(a.cellseq, f, variant, lim, a.objective, seed)
                     costs.setdefault(name, []).append(cost)
-                    rows.append((os.path.basename(f), lim, name, cost, evals, secs, seed))
+                    runs.append((os.path.basename(f), lim, name, cost, evals, secs, seed))
                     print(f"{os.path.basename(f)} {lim} s seed {seed} {name}: {cost:.3f} "
                           f"({secs:.2f} s)", file=sys.stderr, flush=True)
-            rows.append((os.path.basename(f), lim, None,
-                         {n: statistics.median(c) for n, c in costs.items()}, costs, None, None))
+            summary.append((os.path.basename(f), lim,
+                            {n: statistics.median(c) for n, c in costs.items()}, costs))
     if a.tsv:
         with open(a.tsv, "w") as t:
             t.write("file\tlimit_s\tplan\tseed\tcost\tevaluations\telapsed_s\n")
-            for r in rows:
-                if r[2] is not None:
-                    t.write(f"{r[0]}\t{r[1]}\t{r[2]}\t{r[6]}\t{r[3]:.6f}\t{r[4]}\t{r[5]:.3f}\n")
-    lines = table([n for n, _ in variants], [r for r in rows if r[2] is None])
+            for r in runs:
+                t.write(f"{r[0]}\t{r[1]}\t{r[2]}\t{r[6]}\t{r[3]:.6f}\t{r[4]}\t{r[5]:.3f}\n")
+    lines = table([n for n, _ in variants], summary)
     text = "\n".join(lines) + "\n"
     if a.out:
         with open(a.out, "w") as o:
@@ -123,7 +124,7 @@ def seed_spread(names, medians):
     """Per variant: the median over rows of (max − min) ÷ median of its costs over the
     seeds, the noise a difference between variants has to beat."""
     spread = {n: [] for n in names}
-    for _, _, _, med, costs, *_ in medians:
+    for _, _, med, costs in medians:
         for n in names:
             if len(costs[n]) > 1 and med[n] > 0:
                 spread[n].append((max(costs[n]) - min(costs[n])) / med[n])
@@ -138,7 +139,7 @@ def table(names, medians):
              "|---|---|" + "---|" * len(names) + "---|"]
     logs = {n: [] for n in names}
     tally = {n: [0, 0, 0] for n in names}
-    for f, lim, _, costs, *_ in medians:
+    for f, lim, costs, _ in medians:
         best = min(costs.values())
         cells = [f"{costs[n]:.1f} ({costs[n] / best:.4f})" if best > 0 else f"{costs[n]:.1f}"
                  for n in names]
