@@ -258,6 +258,30 @@ fn auto_picks_its_rule_by_symmetry_and_precedence_density() {
         "local-search:0.2,eacs*:0.3,ils*:1"
     );
     assert_eq!(plan_text(c.plan(true)), "ils[accept=0.01]*:1");
+    // an asymmetric matrix with sparse precedence and several modes per cell (open features
+    // cut either way) gets three colony rounds, each polished by `ils`
+    let c = a.choose(&generated(
+        "generalized",
+        &[("n", "40"), ("modes", "3"), ("open", "0.5"), ("p", "5")],
+        1,
+    ));
+    assert_eq!((c.rule, c.beam.share), ("sparse-modes", 0.1));
+    assert!(!c.features.symmetric && c.features.modes > 1.0);
+    assert!(c.features.closure_density < 0.8);
+    assert_eq!(
+        plan_text(c.plan(false)),
+        "local-search:0.04,~eacs:0.07,ils[accept=0.01;shift-repair=2]+:0.2,eacs:0.09,\
+         ils[accept=0.01;shift-repair=2]+:0.25,~eacs:0.12,ils[accept=0.01;shift-repair=2]+:0.33,\
+         ils[accept=0.03;shift-repair=2]*:0.8,reopt[window=16]*:1"
+    );
+    // the rounds need time to settle: larger instances of the same family stay with `sparse`
+    let c = a.choose(&generated(
+        "generalized",
+        &[("n", "320"), ("modes", "3"), ("open", "0.5"), ("p", "5")],
+        1,
+    ));
+    assert_eq!(c.rule, "sparse");
+    assert!(c.features.modes > 1.0 && c.features.cells > 300);
 }
 
 #[test]
@@ -327,6 +351,7 @@ fn the_built_in_portfolio_parses_validates_and_ends_with_a_catch_all() {
             "symmetric",
             "symmetric-modes",
             "free",
+            "sparse-modes",
             "sparse",
             "dense",
             "geometric-free",
