@@ -28,21 +28,21 @@ hold; the built-in file is `src/solvers/auto/portfolio.toml`, `--portfolio FILE`
 its `max_cells` cells and, under a wall-clock budget, only when that budget is at least its \
 `min_seconds`; when it proves the optimum, `auto` stops there.
 2. Then the rule's phases (or its `after_beam` phases after a beam phase that ran). The \
-built-in rules: **symmetric** cost matrices with one mode per cell (a short `local-search`, then \
-`ils` with Lin–Kernighan chains in a 1 % acceptance band, from the beam's sequence when the beam \
-ran) and **symmetric-modes**, several modes per cell (a colony before `ils`); **free** asymmetric matrices with no \
-precedence apart from a fixed start and end (`atsp`); **sparse** precedence (a short \
-`local-search`, a colony run backwards, `ils` in a 1 % then a 3 % acceptance band with the \
-bounded-shift DP ending every repair, window re-optimization of the best), and with several \
-modes per cell on up to 300 cells **sparse-modes** (three rounds of a fresh colony, each \
-polished by `ils` in the 1 % band, then `ils` in the 3 % band from the best of the three and \
-window re-optimization); **dense** precedence (a short `local-search`, then `ils` with kicks that reorder up to 45 cells; on up \
-to 300 cells, when the beam runs, half the budget for the beam, then the default phases); \
-**geometric free** \
-instances (geometric, no or very sparse precedence, links that cost the same both ways: \
-`local-search` on the two-level list with local and random-walk double-bridge kicks for the \
-whole budget); and the catch-all **default**, the other geometric instances among them \
-(`local-search`, an `eacs` colony of its own, `ils` from the best so far).
+built-in rules: **symmetric** cost matrices with one mode per cell (a short `local-search`, \
+then `ils` with Lin–Kernighan chains in a 1 % acceptance band, from the beam's sequence when \
+the beam ran) and **symmetric-modes**, several modes per cell (a colony before `ils`); \
+**free** asymmetric matrices with no precedence apart from a fixed start and end (`atsp`); \
+**sparse** precedence (a short `local-search`, a colony run backwards, `ils` in a 1 % then a 3 \
+% acceptance band with the bounded-shift DP ending every repair, window re-optimization of the \
+best), and with several modes per cell on up to 300 cells **sparse-modes** (three rounds of a \
+fresh colony, each polished by `ils` in the 1 % band, then `ils` in the 3 % band from the best \
+of the three and window re-optimization); **dense** precedence (a short `local-search`, then \
+`ils` with kicks that reorder up to 45 cells; on up to 300 cells, when the beam runs, half the \
+budget for the beam, then the default phases); **geometric free** instances (geometric, no or \
+very sparse precedence, links that cost the same both ways: `local-search` on the two-level \
+list with local and random-walk double-bridge kicks for the whole budget); and the catch-all \
+**default**, the other geometric instances among them (`local-search`, an `eacs` colony of its \
+own, `ils` from the best so far).
 
 `cellseq solve F --explain` prints the features, the rule and its plan before solving; \
 `CELLSEQ_TRACE=1` prints them and one line per phase on stderr. `--param plan=...` skips the \
