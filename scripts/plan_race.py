@@ -120,18 +120,18 @@ def sign_test_p(better, worse):
     return min(1.0, 2 * sum(math.comb(n, i) for i in range(k + 1)) / 2 ** n) if n else 1.0
 
 
-def seed_spread(names, medians):
+def seed_spread(names, summary):
     """Per variant: the median over rows of (max − min) ÷ median of its costs over the
     seeds, the noise a difference between variants has to beat."""
     spread = {n: [] for n in names}
-    for _, _, med, costs in medians:
+    for _, _, med, costs in summary:
         for n in names:
             if len(costs[n]) > 1 and med[n] > 0:
                 spread[n].append((max(costs[n]) - min(costs[n])) / med[n])
     return {n: statistics.median(v) if v else None for n, v in spread.items()}
 
 
-def table(names, medians):
+def table(names, summary):
     """The markdown table: per row the medians and their ratio to the row's best, then every
     variant against the first (geometric mean of the ratios; better / worse / equal rows and
     the sign test's p on them) and, with several seeds, each variant's spread between seeds."""
@@ -139,7 +139,7 @@ def table(names, medians):
              "|---|---|" + "---|" * len(names) + "---|"]
     logs = {n: [] for n in names}
     tally = {n: [0, 0, 0] for n in names}
-    for f, lim, costs, _ in medians:
+    for f, lim, costs, _ in summary:
         best = min(costs.values())
         cells = [f"{costs[n]:.1f} ({costs[n] / best:.4f})" if best > 0 else f"{costs[n]:.1f}"
                  for n in names]
@@ -157,7 +157,7 @@ def table(names, medians):
             " | {} / {} / {}".format(*tally[n]) for n in names[1:]) + " | |")
         lines.append("| sign test p (two-sided, ties left out) | | –" + "".join(
             f" | {sign_test_p(tally[n][0], tally[n][1]):.3f}" for n in names[1:]) + " | |")
-    spread = seed_spread(names, medians)
+    spread = seed_spread(names, summary)
     if any(v is not None for v in spread.values()):
         lines.append("| spread between seeds (median of (max − min) ÷ median) | | " + " | ".join(
             f"{spread[n]:.4f}" if spread[n] is not None else "–" for n in names) + " | |")
