@@ -59,6 +59,23 @@ impl<'a> Costs<'a> {
         }
     }
 
+    /// The cheapest way to put `cell` between `a` and `b`: the least `base + link(a, x) +
+    /// link(x, b)` over the cell's modes x, and that mode (the first of equal ones). `base`
+    /// is what the caller's delta adds to the two links (summed first, so that every caller
+    /// rounds alike). The caller charges the evaluations (one per mode).
+    #[inline]
+    pub fn cheapest_between(&self, base: f64, a: Slot, cell: usize, b: Slot) -> (f64, usize) {
+        let mut best = (f64::INFINITY, 0);
+        for md in 0..self.m.modes(cell) {
+            let x = Some((cell, md));
+            let d = base + self.link(a, x) + self.link(x, b);
+            if d < best.0 {
+                best = (d, md);
+            }
+        }
+        best
+    }
+
     /// Cost of ending the path with (a, ma), with the closed loop's return home.
     #[inline]
     fn finish(&self, a: usize, ma: usize) -> f64 {

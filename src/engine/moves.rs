@@ -141,16 +141,7 @@ impl SegmentMove {
     pub fn delta_best_mode(&self, c: &Costs, s: &Solution, p: isize) -> (f64, usize) {
         let (a, b) = (s.at(p), s.at(p + 1));
         let cell = s.order[self.first as usize] as usize;
-        let base = self.close - c.link(a, b);
-        let mut best = (f64::INFINITY, 0);
-        for md in 0..c.m.modes(cell) {
-            let x = Some((cell, md));
-            let d = base + c.link(a, x) + c.link(x, b);
-            if d < best.0 {
-                best = (d, md);
-            }
-        }
-        best
+        c.cheapest_between(self.close - c.link(a, b), a, cell, b)
     }
 }
 

@@ -228,12 +228,10 @@ impl Ruin {
             let try_gap = |g: usize, best: &mut (f64, usize, u32), evals: &mut u64| {
                 let (l, r) = (prev(g), slot(g));
                 let open = c.link(l, r);
-                for md in 0..m.modes(xs) {
-                    *evals += 1;
-                    let d = c.link(l, Some((xs, md))) + c.link(Some((xs, md)), r) - open;
-                    if d < best.0 {
-                        *best = (d, g, md as u32);
-                    }
+                *evals += m.modes(xs) as u64;
+                let (d, md) = c.cheapest_between(-open, l, xs, r);
+                if d < best.0 {
+                    *best = (d, g, md as u32);
                 }
             };
             if hi - lo <= FULL_SCAN {
