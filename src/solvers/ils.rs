@@ -142,6 +142,12 @@ pub static INFO: SolverInfo = SolverInfo {
             help: "every kick's repair ends with the bounded-shift DP (engine::shift, Balas-Simonetti: the best reorder of the kicked span, with modes, in which no cell passes one that lay this many places or more after it) over the kicked span and this many cells either side (0: off)",
         },
         ParamSpec {
+            name: "walks",
+            default: "1",
+            kind: ParamKind::Int,
+            help: "record-to-record walks kicked in turn, each in its own band above its own record and restarted from its own record; every repaired kick is crossed with the best of all walks, so walks in different basins exchange segments (walks after the first start from the first's local optimum scattered by random feasible reorders over the whole path)",
+        },
+        ParamSpec {
             name: "stall",
             default: "20000",
             kind: ParamKind::Int,
@@ -182,6 +188,7 @@ pub fn from_params(p: &Params) -> Ils {
         cross: p.bool("cross"),
         window_repair: p.bool("window-repair"),
         shift_repair: p.int("shift-repair") as usize,
+        walks: p.int("walks").max(1) as usize,
     }
 }
 
@@ -225,6 +232,16 @@ pub struct Ils {
     pub window_repair: bool,
     /// Largest shift of the bounded-shift DP in every kick's repair (0: off).
     pub shift_repair: usize,
+    /// Record-to-record walks kicked in turn.
+    pub walks: usize,
+}
+
+/// One record-to-record walk of [`Ils`]: its current solution, its record and the kicks since
+/// the record last improved.
+struct Walk {
+    cur: Solution,
+    record: Solution,
+    since: u64,
 }
 
 /// The kick of [`Ils`].
@@ -415,12 +432,29 @@ impl Ils {
         let mut label = 0u32;
         let mut seeds: Vec<u32> = Vec::new();
         let mut scratch = Shuffle::default();
+        let mut walks = vec![Walk {
+            record: cur.clone(),
+            cur,
+            since: 0,
+        }];
+        while walks.len() < self.walks && !ctx.exhausted() {
+            let mut s = walks[0].record.clone();
+            self.scatter(ctx, (&mut search, lk.as_mut()), &mut s, &mut rng, max_seg);
+            if s.cost < best.cost - 1e-9 * best.cost.abs().max(1.0) {
+                best.clone_from(&s);
+                ctx.report(best.cost + m.constant());
+            }
+            walks.push(Walk {
+                record: s.clone(),
+                cur: s,
+                since: 0,
+            });
+        }
         let mut ruin = Ruin::new(self.ruin_size, self.ruin_string, 0.01);
         let mut w = TwoWay::default();
         let bounded = ctx.budget.max_evals.is_some() || ctx.budget.time_limit.is_some();
         let mut since_best = 0u64;
-        let mut since_restart = 0u64;
-        let mut trial = cur.clone();
+        let mut trial = best.clone();
         let mut px = Crossover::default();
         let mut crosses = 0u64;
         let mut kicks_done = 0u64;
@@ -431,7 +465,9 @@ impl Ils {
             if !bounded && since_best >= self.stall {
                 break;
             }
-            trial.clone_from(&cur);
+            let at = (kicks_done % walks.len() as u64) as usize;
+            let walk = &mut walks[at];
+            trial.clone_from(&walk.cur);
             seeds.clear();
             let mut kicked = false;
             for _ in 0..self.kicks {
@@ -467,43 +503,47 @@ impl Ils {
                 &seeds,
             );
             since_best += 1;
-            since_restart += 1;
+            walk.since += 1;
             // a repaired kick that does not beat the best may still hold better segments:
             // the partition crossover takes each segment from the cheaper of the two
-            let mut improved = trial.cost < best.cost - 1e-9 * best.cost.abs().max(1.0);
-            if !improved && self.cross {
+            let mut crossed = false;
+            if self.cross && trial.cost >= best.cost - 1e-9 * best.cost.abs().max(1.0) {
                 // every attempt is charged its O(n), whether it gives a child or not
                 ctx.count(n as u64);
                 if let Some(child) = px.cross(&c, &trial, &best) {
                     crosses += 1;
                     trial = child;
-                    improved = true;
+                    crossed = true;
                 }
             }
-            if improved {
-                // polish a new best with the full descent before keeping it
+            let record = walk.record.cost;
+            if crossed || trial.cost < record - 1e-9 * record.abs().max(1.0) {
+                // polish a new record with the full descent before keeping it
                 search.vnd(&mut trial, ctx);
                 if let Some(lk) = lk.as_mut() {
                     lk.alternate_with_vnd(&mut search, &mut trial, ctx);
                 }
-                best.clone_from(&trial);
-                ctx.report(best.cost + m.constant());
-                if trace {
-                    eprintln!(
-                        "ils: best {} at kick {kicks_done}, {:.2} s",
-                        best.cost + m.constant(),
-                        ctx.elapsed()
-                    );
+                walk.record.clone_from(&trial);
+                walk.since = 0;
+                if crossed || trial.cost < best.cost - 1e-9 * best.cost.abs().max(1.0) {
+                    best.clone_from(&trial);
+                    ctx.report(best.cost + m.constant());
+                    if trace {
+                        eprintln!(
+                            "ils: best {} at kick {kicks_done}, {:.2} s",
+                            best.cost + m.constant(),
+                            ctx.elapsed()
+                        );
+                    }
+                    since_best = 0;
                 }
-                since_best = 0;
-                since_restart = 0;
             }
-            if trial.cost <= best.cost + self.accept * best.cost.abs() {
-                std::mem::swap(&mut cur, &mut trial);
+            if trial.cost <= walk.record.cost + self.accept * walk.record.cost.abs() {
+                std::mem::swap(&mut walk.cur, &mut trial);
             }
-            if since_restart >= self.restart {
-                cur.clone_from(&best);
-                since_restart = 0;
+            if walk.since >= self.restart {
+                walk.cur.clone_from(&walk.record);
+                walk.since = 0;
             }
         }
         if trace {
@@ -512,6 +552,31 @@ impl Ils {
             );
         }
         Ok(outcome(m, &best))
+    }
+
+    /// Starts another walk: `s` (a local optimum) gets random feasible reorders of windows
+    /// spread over the whole path, about two per window length, and descends again with the
+    /// full search (and Lin–Kernighan when it runs).
+    fn scatter(
+        &self,
+        ctx: &mut Context,
+        moves: (&mut Search, Option<&mut Lk>),
+        s: &mut Solution,
+        rng: &mut ChaCha8Rng,
+        max_seg: usize,
+    ) {
+        let (search, lk) = moves;
+        let c = search.c;
+        let mut scratch = Shuffle::default();
+        let mut seeds = Vec::new();
+        for _ in 0..(2 * s.n() / max_seg.max(1)).max(1) {
+            shuffle(&c, s, rng, max_seg, &mut scratch, &mut seeds);
+        }
+        ctx.count(seeds.len() as u64 + 1);
+        search.vnd(s, ctx);
+        if let Some(lk) = lk {
+            lk.alternate_with_vnd(search, s, ctx);
+        }
     }
 
     /// Repairs a kicked `trial` around the kicked cells `seeds`: Or-opt, SOP-3-exchange and

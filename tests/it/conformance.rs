@@ -66,8 +66,8 @@ fn budget(evals: u64) -> Budget {
     }
 }
 
-/// Every failure of solver `name` on the fixtures, as messages.
-fn failures(name: &str) -> Vec<String> {
+/// Every failure of solver `name` with parameters `params` on the fixtures, as messages.
+fn failures(name: &str, params: &BTreeMap<String, String>) -> Vec<String> {
     let caps = caps(name);
     let none = BTreeMap::new();
     let max = 200_000u64;
@@ -82,7 +82,7 @@ fn failures(name: &str) -> Vec<String> {
                 solver,
                 inst,
                 obj,
-                &none,
+                if solver == name { params } else { &none },
                 seed,
                 budget(evals),
                 &mut NoObserver,
@@ -124,10 +124,30 @@ fn failures(name: &str) -> Vec<String> {
     out
 }
 
-/// Runs the conformance checks of one solver and fails with all of its failures.
-fn conforms(name: &str) {
-    let f = failures(name);
+/// Runs the conformance checks of one solver with `params` and fails with all of its failures.
+fn conforms_with(name: &str, params: &[(&str, &str)]) {
+    let params = params
+        .iter()
+        .map(|(k, v)| (k.to_string(), v.to_string()))
+        .collect();
+    let f = failures(name, &params);
     assert!(f.is_empty(), "{} failures:\n{}", f.len(), f.join("\n"));
+}
+
+/// Runs the conformance checks of one solver with its default parameters.
+fn conforms(name: &str) {
+    conforms_with(name, &[]);
+}
+
+/// `ils` with several walks (their scattered starts, the turns and the per-walk records):
+/// the same checks as every solver's defaults.
+#[test]
+fn ils_with_walks_conforms() {
+    conforms_with("ils", &[("walks", "3")]);
+    conforms_with(
+        "ils",
+        &[("walks", "4"), ("perturb", "swap"), ("accept", "0.01")],
+    );
 }
 
 /// One test module per registry solver: `conformance::<solver>::conforms`.
