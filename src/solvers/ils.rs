@@ -11,7 +11,9 @@
 //! whose costs read the same backwards (`lk=auto`; TSPLIB's prob.100) the repair and the
 //! polish of a new best also run Lin–Kernighan chains of feasible reversals
 //! ([`crate::engine::lk`]). Without a budget it stops after `stall` kicks without a new
-//! best.
+//! best. With `walks` > 1 several such walks take kicks in turn, each in the band above its
+//! own record, and every repaired kick is crossed with the best of all walks (not in the
+//! built-in portfolio: notes/lab/ils-walks.md).
 
 use super::start::{greedy_solution, outcome};
 use super::{Caps, Context, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo};
