@@ -147,7 +147,7 @@ pub static INFO: SolverInfo = SolverInfo {
             name: "walks",
             default: "1",
             kind: ParamKind::Int,
-            help: "record-to-record walks kicked in turn, each in its own band above its own record and restarted from its own record; every repaired kick is crossed with the best of all walks, so walks in different basins exchange segments (walks after the first start from the first's local optimum scattered by random feasible reorders over the whole path)",
+            help: "record-to-record walks kicked in turn, each in its own band above its own record and restarted from its own record; every repaired kick is crossed with the best of all walks, so walks in different basins exchange segments (walks after the first start from the first's local optimum scattered by random feasible reorders over the whole path; at most 64, more count as 64)",
         },
         ParamSpec {
             name: "stall",
@@ -163,6 +163,9 @@ pub static INFO: SolverInfo = SolverInfo {
     },
     make: |p: &Params| Ok(Box::new(from_params(p))),
 };
+
+/// Most walks kept at once (each holds two solutions, so memory stays bounded).
+const MAX_WALKS: u64 = 64;
 
 /// Builds the solver from validated parameters.
 pub fn from_params(p: &Params) -> Ils {
@@ -190,7 +193,7 @@ pub fn from_params(p: &Params) -> Ils {
         cross: p.bool("cross"),
         window_repair: p.bool("window-repair"),
         shift_repair: p.int("shift-repair") as usize,
-        walks: p.int("walks").max(1) as usize,
+        walks: p.int("walks").clamp(1, MAX_WALKS) as usize,
     }
 }
 
