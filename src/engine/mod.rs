@@ -33,6 +33,13 @@ use crate::cost::CostModel;
 /// A (cell, mode) pair, or `None` for the path's start (home) or end.
 pub type Slot = Option<(usize, usize)>;
 
+/// True when cost `a` is below cost `b` by more than rounding (relative to `b`, the
+/// threshold of the search's improving moves).
+#[inline]
+pub fn cheaper(a: f64, b: f64) -> bool {
+    a < b - 1e-9 * b.abs().max(1.0)
+}
+
 /// Link costs used by the search, with open-loop (path) or closed-loop (tour) evaluation.
 #[derive(Clone, Copy)]
 pub struct Costs<'a> {

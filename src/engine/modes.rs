@@ -2,7 +2,7 @@
 //! shortest path, O(n·k²). [`ModeLayers`] holds the path itself, shared with the window
 //! moves of [`super::window`], which run it over a few cells between two fixed slots.
 
-use super::{Costs, Slot, Solution};
+use super::{Costs, Slot, Solution, cheaper};
 
 /// Scratch space of the layered shortest path over the modes of a run of cells.
 #[derive(Debug, Default)]
@@ -98,7 +98,7 @@ pub fn mode_dp(c: &Costs, s: &mut Solution) -> u64 {
     let mut layers = ModeLayers::default();
     let (evals, _) = layers.run(c, &s.order, None, f64::INFINITY);
     let (best, bm) = layers.close(c, s.order[n - 1] as usize, None);
-    if best < s.cost - 1e-9 * s.cost.abs().max(1.0) {
+    if cheaper(best, s.cost) {
         let order = &s.order;
         let mode = &mut s.mode;
         layers.trace(n, bm, |p, k| mode[order[p] as usize] = k);

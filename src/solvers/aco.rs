@@ -9,7 +9,7 @@ use super::start::{greedy_solution, outcome};
 use super::{Caps, Context, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo};
 use crate::engine::modes::mode_dp;
 use crate::engine::search::Search;
-use crate::engine::{Costs, Solution};
+use crate::engine::{Costs, Solution, cheaper};
 use crate::error::Result;
 use crate::model::{Sequence, Visit};
 use rand::{RngExt, SeedableRng};
@@ -289,7 +289,7 @@ impl Solver for Aco {
             if self.ls == "best" {
                 search.vnd(&mut ib, ctx);
             }
-            if ib.cost < best.cost - 1e-9 * best.cost.abs().max(1.0) {
+            if cheaper(ib.cost, best.cost) {
                 best = ib;
                 last_improve = iter;
                 ctx.report(best.cost + m.constant());

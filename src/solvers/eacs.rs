@@ -29,7 +29,7 @@ use crate::engine::lk::Lk;
 use crate::engine::modes::mode_dp;
 use crate::engine::search::Search;
 use crate::engine::sop3x::{TwoWay, sop3_two_way};
-use crate::engine::{Costs, Solution};
+use crate::engine::{Costs, Solution, cheaper};
 use crate::error::Result;
 use crate::model::{Sequence, Visit};
 use rand::{RngExt, SeedableRng};
@@ -429,7 +429,7 @@ impl Eacs {
                 }
                 // an ant that does not beat the best may still hold better segments: the
                 // partition crossover takes each segment from the cheaper of the two
-                if self.cross && s.cost >= best.cost - 1e-9 * best.cost.abs().max(1.0) {
+                if self.cross && !cheaper(s.cost, best.cost) {
                     // every attempt is charged its O(n), whether it gives a child or not
                     ctx.count(n as u64);
                     if let Some(child) = px.cross(&c, &s, &best) {
@@ -437,7 +437,7 @@ impl Eacs {
                         s = child;
                     }
                 }
-                if s.cost < best.cost - 1e-9 * best.cost.abs().max(1.0) {
+                if cheaper(s.cost, best.cost) {
                     search.vnd(&mut s, ctx);
                     if let Some(lk) = lk.as_mut() {
                         lk.alternate_with_vnd(&mut search, &mut s, ctx);

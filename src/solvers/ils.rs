@@ -24,7 +24,7 @@ use crate::engine::ruin::Ruin;
 use crate::engine::search::Search;
 use crate::engine::shift::ShiftDp;
 use crate::engine::sop3x::{TwoWay, sop3_two_way};
-use crate::engine::{Costs, Solution};
+use crate::engine::{Costs, Solution, cheaper};
 use crate::error::Result;
 use crate::model::Sequence;
 use rand::{RngExt, SeedableRng};
@@ -445,7 +445,7 @@ impl Ils {
         while walks.len() < self.walks && !ctx.exhausted() {
             let mut s = walks[0].record.clone();
             self.scatter(ctx, (&mut search, lk.as_mut()), &mut s, &mut rng, max_seg);
-            if s.cost < best.cost - 1e-9 * best.cost.abs().max(1.0) {
+            if cheaper(s.cost, best.cost) {
                 best.clone_from(&s);
                 ctx.report(best.cost + m.constant());
             }
@@ -512,7 +512,7 @@ impl Ils {
             // a repaired kick that does not beat the best may still hold better segments:
             // the partition crossover takes each segment from the cheaper of the two
             let mut crossed = false;
-            if self.cross && trial.cost >= best.cost - 1e-9 * best.cost.abs().max(1.0) {
+            if self.cross && !cheaper(trial.cost, best.cost) {
                 // every attempt is charged its O(n), whether it gives a child or not
                 ctx.count(n as u64);
                 if let Some(child) = px.cross(&c, &trial, &best) {
@@ -521,8 +521,7 @@ impl Ils {
                     crossed = true;
                 }
             }
-            let record = walk.record.cost;
-            if crossed || trial.cost < record - 1e-9 * record.abs().max(1.0) {
+            if crossed || cheaper(trial.cost, walk.record.cost) {
                 // polish a new record with the full descent before keeping it
                 search.vnd(&mut trial, ctx);
                 if let Some(lk) = lk.as_mut() {
@@ -530,7 +529,7 @@ impl Ils {
                 }
                 walk.record.clone_from(&trial);
                 walk.since = 0;
-                if crossed || trial.cost < best.cost - 1e-9 * best.cost.abs().max(1.0) {
+                if crossed || cheaper(trial.cost, best.cost) {
                     best.clone_from(&trial);
                     ctx.report(best.cost + m.constant());
                     if trace {

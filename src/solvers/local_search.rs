@@ -16,7 +16,7 @@ use super::{Caps, Context, Outcome, ParamKind, ParamSpec, Params, Solver, Solver
 use crate::engine::large::{self, Large};
 use crate::engine::moves::{apply_segment, segment_delta, window};
 use crate::engine::search::Search;
-use crate::engine::{Costs, linked};
+use crate::engine::{Costs, cheaper, linked};
 use crate::error::Result;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -211,7 +211,7 @@ impl Solver for LocalSearch {
             }
             ctx.count(self.strength as u64);
             search.vnd(&mut s, ctx);
-            if s.cost < best.cost - 1e-9 * best.cost.abs().max(1.0) {
+            if cheaper(s.cost, best.cost) {
                 best.clone_from(&s);
                 ctx.report(best.cost + m.constant());
                 fails = 0;

@@ -14,7 +14,7 @@ use crate::engine::moves::{
     apply_segment, reverse_delta_direct, reversible_segment, segment_delta, window,
 };
 use crate::engine::search::Search;
-use crate::engine::{Costs, Solution};
+use crate::engine::{Costs, Solution, cheaper};
 use crate::error::Result;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -180,7 +180,7 @@ impl Anneal {
                     };
                     if d <= 0.0 || rng.random::<f64>() < (-d / t).exp() {
                         mv.apply(m, s, d);
-                        if s.cost < best.cost - 1e-9 * best.cost.abs().max(1.0) {
+                        if cheaper(s.cost, best.cost) {
                             best.clone_from(s);
                             ctx.report(true_cost(c, &best));
                         }
@@ -188,7 +188,7 @@ impl Anneal {
                 }
                 s.cost = s.evaluate(c);
                 t *= self.alpha;
-                if best.cost < before - 1e-9 * before.abs().max(1.0) {
+                if cheaper(best.cost, before) {
                     stall = 0;
                 } else {
                     stall += 1;

@@ -10,7 +10,7 @@ use super::start::{greedy_start, outcome, random_start};
 use super::{Caps, Context, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo};
 use crate::engine::moves::{apply_segment, mode_delta, window};
 use crate::engine::search::Search;
-use crate::engine::{Costs, Solution};
+use crate::engine::{Costs, Solution, cheaper};
 use crate::error::Result;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -112,7 +112,7 @@ pub fn tabu_step(
         let (lo, hi) = window(m, s, i, 1);
         let removal = s.link(c, ii - 1, ii + 1) - s.link(c, ii - 1, ii) - s.link(c, ii, ii + 1);
         let mut consider = |d: f64, p: isize, md: usize| {
-            if is_tabu && s.cost + d >= best_cost - 1e-9 * best_cost.abs().max(1.0) {
+            if is_tabu && !cheaper(s.cost + d, best_cost) {
                 return;
             }
             if best.is_none_or(|b| d < b.0) {
@@ -213,7 +213,7 @@ impl Solver for Tabu {
                 if iter % 64 == 0 {
                     s.cost = s.evaluate(&c);
                 }
-                if s.cost < local_best.cost - 1e-9 * local_best.cost.abs().max(1.0) {
+                if cheaper(s.cost, local_best.cost) {
                     local_best.clone_from(&s);
                     last_improve = iter;
                     if local_best.cost < best.cost {

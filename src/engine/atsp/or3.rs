@@ -23,17 +23,12 @@
 //! an open path, which keeps every block's orientation.
 
 use crate::engine::moves::sop3_delta;
+use crate::engine::search::improves;
 use crate::engine::{Costs, Neighbours, Solution};
 use crate::solvers::Context;
 use rand::RngExt;
 use rand_chacha::ChaCha8Rng;
 use std::collections::VecDeque;
-
-/// True when `delta` improves a solution of cost `cost` beyond rounding.
-#[inline]
-fn improves(delta: f64, cost: f64) -> bool {
-    delta < -1e-9 * cost.abs().max(1.0)
-}
 
 /// The Or-3opt search state: costs, candidate lists and the don't-look queue.
 pub struct Or3<'a> {
