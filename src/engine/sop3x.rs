@@ -33,6 +33,10 @@ pub(crate) struct Labels {
     /// Links of the current path along a scan (`links[k]`: from the k-th scanned position to
     /// the next), filled as the scan first reaches them and reused for every block.
     links: Vec<f64>,
+    /// Along the same scan, the link that joins the scanned position to the block end that
+    /// stays fixed for the whole scan (forward: from the cell at `h+2+k` to the first cell of
+    /// L; backward: from the last cell of R to the cell at `j-1-k`).
+    ends: Vec<f64>,
     /// Union of the closure's descendant rows of the left block (forward) or ancestor rows
     /// of the right block (backward), for the scan's early end.
     reach: Vec<u64>,
@@ -112,6 +116,7 @@ pub(crate) fn forward(
         let old_h = s.link(c, h, h + 1);
         let first_l = s.at(h + 1);
         w.links.clear();
+        w.ends.clear();
         // early end (exact): the highest position in i+2..=imax+1 that may still start R,
         // i.e. whose cell is no descendant of L; none left means no later i has a candidate
         let mut free = imax + 1;
@@ -140,16 +145,16 @@ pub(crate) fn forward(
                     break;
                 }
                 *evals += 1;
-                let (sj, sj1) = (s.at(j), s.at(j + 1));
                 let k = (j - h - 2) as usize;
                 while w.links.len() <= k {
                     let p = h + 2 + w.links.len() as isize;
                     w.links.push(s.link(c, p, p + 1));
+                    w.ends.push(c.link(s.at(p), first_l));
                 }
                 let d = sop3_sum(
                     new_h,
-                    c.link(sj, first_l),
-                    c.link(last_l, sj1),
+                    w.ends[k],
+                    c.link(last_l, s.at(j + 1)),
                     old_h,
                     old_i,
                     w.links[k],
@@ -193,6 +198,7 @@ fn backward(
         let old_j = s.link(c, j, j + 1);
         let last_r = s.at(j);
         w.links.clear();
+        w.ends.clear();
         // early end (exact): the lowest position in imin..=i−1 that may still end L next to
         // R, i.e. whose cell is no ancestor of R; none left means no later i has a candidate
         let mut free = imin;
@@ -225,15 +231,15 @@ fn backward(
                     break;
                 }
                 *evals += 1;
-                let (sh, sh1) = (s.at(h), s.at(h + 1));
                 let k = (j - 2 - h) as usize;
                 while w.links.len() <= k {
                     let p = j - 2 - w.links.len() as isize;
                     w.links.push(s.link(c, p, p + 1));
+                    w.ends.push(c.link(last_r, s.at(p + 1)));
                 }
                 let d = sop3_sum(
-                    c.link(sh, first_r),
-                    c.link(last_r, sh1),
+                    c.link(s.at(h), first_r),
+                    w.ends[k],
                     new_i,
                     w.links[k],
                     old_i,
