@@ -126,6 +126,12 @@ pub static INFO: SolverInfo = SolverInfo {
             help: "the repair runs SOP-3-exchange (off: Or-opt, and LK when on, only)",
         },
         ParamSpec {
+            name: "max-block",
+            default: "0",
+            kind: ParamKind::Int,
+            help: "longest block of SOP-3-exchange in the descent and every repair (0 = the engine's: n up to 120 cells, 64 up to 5000, else 8)",
+        },
+        ParamSpec {
             name: "cross",
             default: "true",
             kind: ParamKind::Bool,
@@ -188,6 +194,7 @@ pub fn from_params(p: &Params) -> Ils {
         lk_depth: p.int("lk-depth").max(1) as usize,
         lk_breadth: p.int("lk-breadth").max(1) as usize,
         sop3: p.bool("sop3"),
+        max_block: p.int("max-block").min(u32::MAX as u64) as usize,
         lk_penalty: p.float("lk-penalty").max(0.0),
         lk_max_viol: p.int("lk-max-viol") as u32,
         cross: p.bool("cross"),
@@ -227,6 +234,8 @@ pub struct Ils {
     pub lk_breadth: usize,
     /// SOP-3-exchange in the repair.
     pub sop3: bool,
+    /// Longest SOP-3-exchange block (0 = the engine's choice).
+    pub max_block: usize,
     /// Penalty per broken precedence pair inside a Lin-Kernighan chain (0: none).
     pub lk_penalty: f64,
     /// Most pairs a Lin-Kernighan chain may break on its way.
@@ -418,6 +427,9 @@ impl Ils {
             None => greedy_solution(ctx, &c),
         };
         let mut search = Search::new(c, self.k);
+        if self.max_block > 0 {
+            search.max_block = self.max_block;
+        }
         search.vnd(&mut cur, ctx);
         let mut lk = Lk::when(self.lk, &c, self.lk_depth, self.lk_breadth);
         if let Some(lk) = lk.as_mut() {

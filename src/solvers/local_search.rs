@@ -92,7 +92,7 @@ pub static INFO: SolverInfo = SolverInfo {
             kicks,
             strength,
             k: p.int("k").max(1) as usize,
-            max_block: p.int("max-block") as usize,
+            max_block: p.int("max-block").min(u32::MAX as u64) as usize,
             vnd: p.bool("vnd"),
             two_level: p.switch("two-level"),
             kick_block: p.int("kick-block").max(1) as usize,

@@ -139,7 +139,8 @@ fn conforms(name: &str) {
     conforms_with(name, &[]);
 }
 
-/// `ils` with several walks (their scattered starts, the turns and the per-walk records):
+/// `ils` with several walks (their scattered starts, the turns and the per-walk records) and
+/// with a set SOP-3-exchange block length:
 /// the same checks as every solver's defaults.
 #[test]
 fn ils_with_walks_conforms() {
@@ -148,6 +149,9 @@ fn ils_with_walks_conforms() {
         "ils",
         &[("walks", "4"), ("perturb", "swap"), ("accept", "0.01")],
     );
+    // a short SOP-3-exchange block, and a huge one (capped to the path)
+    conforms_with("ils", &[("max-block", "3")]);
+    conforms_with("ils", &[("max-block", "18446744073709551615")]);
 }
 
 /// One test module per registry solver: `conformance::<solver>::conforms`.
