@@ -17,11 +17,23 @@
 //! precedence (TSPLIB rbg*: 90–95 % of the pairs ordered) this cuts the blocks that were
 //! grown only to stamp cells, with the same moves found and the same evaluation count.
 //!
+//! Skipped blocks, exact: for one left block (forward) the exchange's cost change is
+//! `link(h, i+1) − link(h, h+1) − link(i, i+1)` plus, for the right block's end j,
+//! `link(j, h+1) − link(j, j+1)` and `link(i, j+1)`. The middle part's minimum over the j in
+//! range is a prefix minimum kept along the scan, and the last part is at least the cheapest
+//! link out of cell i (`Cheapest`, computed once per instance up to a few thousand nodes).
+//! When the sum of the three is not below zero no j improves, and the block's j are not
+//! scanned; the backward scan bounds its h the same way with the cheapest link into the right
+//! block's first cell. The same moves are found (a test compares both ways); each skipped
+//! block costs one evaluation instead of one per j. Near a local optimum most blocks are
+//! skipped: `ils` makes about 40 % more kicks a second on a symmetric 100-cell instance with
+//! sparse precedence, and as many as before on dense precedence, where blocks are short.
+//!
 //! [`CostModel::closure`]: crate::cost::CostModel::closure
 
 use super::moves::sop3_sum;
 use super::search::{Search, improves};
-use super::{Costs, Solution};
+use super::{Costs, Slot, Solution};
 use crate::precedence::Closure;
 use crate::search::Context;
 
@@ -37,6 +49,12 @@ pub(crate) struct Labels {
     /// stays fixed for the whole scan (forward: from the cell at `h+2+k` to the first cell of
     /// L; backward: from the last cell of R to the cell at `j-1-k`).
     ends: Vec<f64>,
+    /// Prefix minima of `ends[k] - links[k]` along the scan (the bound's scan part).
+    least: Vec<f64>,
+    /// The cheapest link out of and into every node (the bound's end parts).
+    cheapest: Cheapest,
+    /// Scans evaluate every block, without the bound (a switch for tests).
+    unbounded: bool,
     /// Union of the closure's descendant rows of the left block (forward) or ancestor rows
     /// of the right block (backward), for the scan's early end.
     reach: Vec<u64>,
@@ -74,6 +92,101 @@ impl Labels {
     }
 }
 
+/// Most nodes for which [`Cheapest`] is computed (O(nodes²) link costs, once per scratch
+/// space): matrix instances and geometric ones, whose links cost more to compute.
+const CHEAPEST_NODES_MATRIX: usize = 2000;
+const CHEAPEST_NODES_GEOMETRIC: usize = 500;
+
+/// The cheapest link out of every node (to another cell's node or the path end) and into
+/// every node (from another cell's node or the path start), for the exact bound that skips
+/// blocks of a scan that cannot hold an improving exchange.
+#[derive(Debug, Default, Clone)]
+struct Cheapest {
+    /// The costs they were computed for (model address, closed loop).
+    key: Option<(usize, bool)>,
+    out: Vec<f64>,
+    inn: Vec<f64>,
+}
+
+impl Cheapest {
+    /// Computes the minima for `c` unless they are there already; false when the instance
+    /// has too many nodes (no bound).
+    fn ready(&mut self, c: &Costs) -> bool {
+        let m = c.m;
+        let key = (m as *const _ as usize, c.closed);
+        if self.key == Some(key) {
+            return !self.out.is_empty();
+        }
+        self.key = Some(key);
+        self.out.clear();
+        self.inn.clear();
+        let cap = if m.is_geometric() {
+            CHEAPEST_NODES_GEOMETRIC
+        } else {
+            CHEAPEST_NODES_MATRIX
+        };
+        if m.nodes() > cap {
+            return false;
+        }
+        self.out.resize(m.nodes(), f64::INFINITY);
+        self.inn.resize(m.nodes(), f64::INFINITY);
+        for a in 0..m.n() {
+            for ma in 0..m.modes(a) {
+                let na = m.node(a, ma);
+                let x = Some((a, ma));
+                self.out[na] = self.out[na].min(c.link(x, None));
+                self.inn[na] = self.inn[na].min(c.link(None, x));
+                for b in (0..m.n()).filter(|&b| b != a) {
+                    for mb in 0..m.modes(b) {
+                        let nb = m.node(b, mb);
+                        let v = c.link(x, Some((b, mb)));
+                        self.out[na] = self.out[na].min(v);
+                        self.inn[nb] = self.inn[nb].min(v);
+                    }
+                }
+            }
+        }
+        true
+    }
+}
+
+impl Labels {
+    /// Forward scan from `h`: fills `links`, `ends` and `least` up to index `k` (position
+    /// `h+2+k`; `first_l` is the cell at `h+1`).
+    #[inline]
+    fn fill_forward(&mut self, c: &Costs, s: &Solution, h: isize, first_l: Slot, k: usize) {
+        while self.links.len() <= k {
+            let p = h + 2 + self.links.len() as isize;
+            self.push(s.link(c, p, p + 1), c.link(s.at(p), first_l));
+        }
+    }
+
+    /// Backward scan from `j`: fills `links`, `ends` and `least` up to index `k` (position
+    /// `j-2-k`; `last_r` is the cell at `j`).
+    #[inline]
+    fn fill_backward(&mut self, c: &Costs, s: &Solution, j: isize, last_r: Slot, k: usize) {
+        while self.links.len() <= k {
+            let p = j - 2 - self.links.len() as isize;
+            self.push(s.link(c, p, p + 1), c.link(last_r, s.at(p + 1)));
+        }
+    }
+
+    #[inline]
+    fn push(&mut self, link: f64, end: f64) {
+        let before = self.least.last().copied().unwrap_or(f64::INFINITY);
+        self.links.push(link);
+        self.ends.push(end);
+        self.least.push(before.min(end - link));
+    }
+
+    /// Starts a scan: empties the scan's links.
+    fn start_scan(&mut self) {
+        self.links.clear();
+        self.ends.clear();
+        self.least.clear();
+    }
+}
+
 /// Scratch space and stack of [`sop3_two_way`].
 #[derive(Debug, Default, Clone)]
 pub struct TwoWay {
@@ -106,6 +219,7 @@ pub(crate) fn forward(
     let m = c.m;
     let n = s.n() as isize;
     let px = s.pos[x as usize] as isize;
+    let bounded = !w.unbounded && w.cheapest.ready(c);
     for h in [px - 1, px] {
         if h + 2 >= n {
             continue;
@@ -115,8 +229,7 @@ pub(crate) fn forward(
         // the links that stay fixed while j (and i) scan; w.links[k] = link(h+2+k, h+3+k)
         let old_h = s.link(c, h, h + 1);
         let first_l = s.at(h + 1);
-        w.links.clear();
-        w.ends.clear();
+        w.start_scan();
         // early end (exact): the highest position in i+2..=imax+1 that may still start R,
         // i.e. whose cell is no descendant of L; none left means no later i has a candidate
         let mut free = imax + 1;
@@ -136,35 +249,46 @@ pub(crate) fn forward(
                 }
             }
             let jmax = (i + max_block as isize).min(n - 1);
-            let mut best = (0.0, 0isize);
             let new_h = s.link(c, h, i + 1);
             let old_i = s.link(c, i, i + 1);
             let last_l = s.at(i);
-            for j in (i + 1)..=jmax {
-                if w.stamp[s.order[j as usize] as usize] == label {
-                    break;
-                }
-                *evals += 1;
-                let k = (j - h - 2) as usize;
-                while w.links.len() <= k {
-                    let p = h + 2 + w.links.len() as isize;
-                    w.links.push(s.link(c, p, p + 1));
-                    w.ends.push(c.link(s.at(p), first_l));
-                }
-                let d = sop3_sum(
-                    new_h,
-                    w.ends[k],
-                    c.link(last_l, s.at(j + 1)),
-                    old_h,
-                    old_i,
-                    w.links[k],
-                );
-                if d < best.0 {
-                    best = (d, j);
-                }
+            // R = [i+1..=j] may end anywhere before the first cell that follows a cell of L
+            let mut jend = i;
+            while jend < jmax && w.stamp[s.order[(jend + 1) as usize] as usize] != label {
+                jend += 1;
             }
-            if improves(best.0, s.cost) {
-                return Some((best.0, h, i, best.1));
+            // exact bound: the exchange adds a link out of the left block's last cell, and
+            // for every j in range the right block's links add at least `least`
+            if jend > i {
+                w.fill_forward(c, s, h, first_l, (jend - h - 2) as usize);
+            }
+            let hopeless = jend == i
+                || bounded && {
+                    let kmax = (jend - h - 2) as usize;
+                    *evals += 1;
+                    let (a, ma) = last_l.expect("a cell of the path");
+                    new_h - old_h - old_i + w.least[kmax] + w.cheapest.out[m.node(a, ma)] >= 0.0
+                };
+            if !hopeless {
+                let mut best = (0.0, 0isize);
+                for j in (i + 1)..=jend {
+                    *evals += 1;
+                    let k = (j - h - 2) as usize;
+                    let d = sop3_sum(
+                        new_h,
+                        w.ends[k],
+                        c.link(last_l, s.at(j + 1)),
+                        old_h,
+                        old_i,
+                        w.links[k],
+                    );
+                    if d < best.0 {
+                        best = (d, j);
+                    }
+                }
+                if improves(best.0, s.cost) {
+                    return Some((best.0, h, i, best.1));
+                }
             }
             if cl.is_some() && free < i + 2 {
                 break;
@@ -188,6 +312,7 @@ fn backward(
     let m = c.m;
     let n = s.n() as isize;
     let px = s.pos[x as usize] as isize;
+    let bounded = !w.unbounded && w.cheapest.ready(c);
     for j in [px, px - 1] {
         if j < 1 || j >= n {
             continue;
@@ -197,8 +322,7 @@ fn backward(
         // the links that stay fixed while h (and i) scan; w.links[k] = link(j-2-k, j-1-k)
         let old_j = s.link(c, j, j + 1);
         let last_r = s.at(j);
-        w.links.clear();
-        w.ends.clear();
+        w.start_scan();
         // early end (exact): the lowest position in imin..=i−1 that may still end L next to
         // R, i.e. whose cell is no ancestor of R; none left means no later i has a candidate
         let mut free = imin;
@@ -224,19 +348,28 @@ fn backward(
             let new_i = s.link(c, i, j + 1);
             let old_i = s.link(c, i, i + 1);
             let first_r = s.at(i + 1);
+            // L = [h+1..=i] may start anywhere after the last cell that precedes a cell of R
+            let mut hlow = i;
+            while hlow > hmin && w.stamp[s.order[hlow as usize] as usize] != label {
+                hlow -= 1;
+            }
+            // exact bound: the exchange adds a link into the right block's first cell, and
+            // for every h in range the left block's links add at least `least`
+            if hlow < i {
+                w.fill_backward(c, s, j, last_r, (j - 2 - hlow) as usize);
+            }
+            let hopeless = hlow == i
+                || bounded && {
+                    let kmax = (j - 2 - hlow) as usize;
+                    *evals += 1;
+                    let (a, ma) = first_r.expect("a cell of the path");
+                    new_i - old_i - old_j + w.least[kmax] + w.cheapest.inn[m.node(a, ma)] >= 0.0
+                };
             // L = [h+1..=i] grows leftwards
-            let mut h = i - 1;
-            while h >= hmin {
-                if w.stamp[s.order[(h + 1) as usize] as usize] == label {
-                    break;
-                }
+            let mut h = if hopeless { hlow - 1 } else { i - 1 };
+            while h >= hlow {
                 *evals += 1;
                 let k = (j - 2 - h) as usize;
-                while w.links.len() <= k {
-                    let p = j - 2 - w.links.len() as isize;
-                    w.links.push(s.link(c, p, p + 1));
-                    w.ends.push(c.link(last_r, s.at(p + 1)));
-                }
                 let d = sop3_sum(
                     c.link(s.at(h), first_r),
                     w.ends[k],
@@ -377,6 +510,58 @@ mod tests {
         }
     }
 
+    /// The bound that skips hopeless blocks changes nothing but the work: from random
+    /// feasible orders and from their local optima, forward and backward searches from every
+    /// cell find the same move with and without it, and it skips blocks near local optima.
+    #[test]
+    fn bound_finds_the_same_moves() {
+        let mut skipped = false;
+        for (seed, p) in [(5, 0.0), (6, 0.05), (7, 0.3), (8, 0.9)] {
+            let n = 50;
+            let inst = instance_with(n, seed, p);
+            let m = CostModel::new(&inst, Objective::Matrix);
+            let c = Costs::open(&m);
+            let cl = m.closure();
+            let params = Params::new("t", &[], &Default::default()).expect("params");
+            let mut obs = NoObserver;
+            let mut ctx = Context::new(&inst, &m, &params, 1, Budget::default(), &mut obs);
+            let mut rng = ChaCha8Rng::seed_from_u64(seed);
+            let mut plain = Labels {
+                unbounded: true,
+                ..Labels::default()
+            };
+            let mut bounded = Labels::default();
+            for round in 0..8 {
+                let rank: Vec<usize> = (0..n).map(|_| rng.random::<u32>() as usize).collect();
+                let seq: crate::model::Sequence =
+                    crate::precedence::ranked_topological_order(&m.dag, &rank)
+                        .expect("acyclic")
+                        .into_iter()
+                        .map(|v| crate::model::Visit::new(v, 0))
+                        .collect();
+                let mut s = Solution::new(&c, &seq);
+                if round % 2 == 1 {
+                    let search = Search::new(c, 8);
+                    let all: Vec<u32> = (0..n as u32).collect();
+                    while sop3_two_way(&search, &mut TwoWay::default(), &mut s, &mut ctx, &all) {}
+                }
+                for x in 0..n as u32 {
+                    for block in [6, n] {
+                        let (mut e1, mut e2) = (0, 0);
+                        let a = forward(&c, cl, &s, &mut plain, x, block, &mut e1);
+                        let b = forward(&c, cl, &s, &mut bounded, x, block, &mut e2);
+                        assert_eq!(a, b, "forward, seed {seed}, cell {x}");
+                        let a = backward(&c, cl, &s, &mut plain, x, block, &mut e1);
+                        let b = backward(&c, cl, &s, &mut bounded, x, block, &mut e2);
+                        assert_eq!(a, b, "backward, seed {seed}, cell {x}");
+                        skipped |= e2 < e1;
+                    }
+                }
+            }
+        }
+        assert!(skipped, "the bound never skipped a block");
+    }
+
     /// The closure's early end changes nothing but the work: on random feasible orders of
     /// instances from sparse to dense precedence, forward and backward searches from every
     /// cell find the same move with the same evaluation count with and without it.
@@ -389,7 +574,12 @@ mod tests {
             let c = Costs::open(&m);
             let cl = m.closure().expect("instance has precedence");
             let mut rng = ChaCha8Rng::seed_from_u64(seed);
-            let (mut w1, mut w2) = (Labels::default(), Labels::default());
+            // without the bound, whose own checks the early end would also cut short
+            let plain = || Labels {
+                unbounded: true,
+                ..Labels::default()
+            };
+            let (mut w1, mut w2) = (plain(), plain());
             for _ in 0..20 {
                 // a random topological order: the ready cell of the lowest random rank first
                 let rank: Vec<usize> = (0..n).map(|_| rng.random::<u32>() as usize).collect();
