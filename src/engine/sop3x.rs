@@ -477,6 +477,26 @@ mod tests {
         crate::formats::tsplib::parse_sop("t.sop", &text).expect("valid instance")
     }
 
+    /// A random topological order: the ready cell of the lowest random rank first.
+    fn random_order(m: &CostModel, c: &Costs, rng: &mut ChaCha8Rng) -> Solution {
+        let rank: Vec<usize> = (0..m.n()).map(|_| rng.random::<u32>() as usize).collect();
+        let seq: crate::model::Sequence =
+            crate::precedence::ranked_topological_order(&m.dag, &rank)
+                .expect("acyclic")
+                .into_iter()
+                .map(|v| crate::model::Visit::new(v, 0))
+                .collect();
+        Solution::new(c, &seq)
+    }
+
+    /// Scratch space whose scans evaluate every block.
+    fn unbounded() -> Labels {
+        Labels {
+            unbounded: true,
+            ..Labels::default()
+        }
+    }
+
     #[test]
     fn two_way_descent_stays_feasible_and_consistent() {
         for seed in 0..6 {
@@ -526,20 +546,10 @@ mod tests {
             let mut obs = NoObserver;
             let mut ctx = Context::new(&inst, &m, &params, 1, Budget::default(), &mut obs);
             let mut rng = ChaCha8Rng::seed_from_u64(seed);
-            let mut plain = Labels {
-                unbounded: true,
-                ..Labels::default()
-            };
+            let mut plain = unbounded();
             let mut bounded = Labels::default();
             for round in 0..8 {
-                let rank: Vec<usize> = (0..n).map(|_| rng.random::<u32>() as usize).collect();
-                let seq: crate::model::Sequence =
-                    crate::precedence::ranked_topological_order(&m.dag, &rank)
-                        .expect("acyclic")
-                        .into_iter()
-                        .map(|v| crate::model::Visit::new(v, 0))
-                        .collect();
-                let mut s = Solution::new(&c, &seq);
+                let mut s = random_order(&m, &c, &mut rng);
                 if round % 2 == 1 {
                     let search = Search::new(c, 8);
                     let all: Vec<u32> = (0..n as u32).collect();
@@ -575,21 +585,9 @@ mod tests {
             let cl = m.closure().expect("instance has precedence");
             let mut rng = ChaCha8Rng::seed_from_u64(seed);
             // without the bound, whose own checks the early end would also cut short
-            let plain = || Labels {
-                unbounded: true,
-                ..Labels::default()
-            };
-            let (mut w1, mut w2) = (plain(), plain());
+            let (mut w1, mut w2) = (unbounded(), unbounded());
             for _ in 0..20 {
-                // a random topological order: the ready cell of the lowest random rank first
-                let rank: Vec<usize> = (0..n).map(|_| rng.random::<u32>() as usize).collect();
-                let seq: crate::model::Sequence =
-                    crate::precedence::ranked_topological_order(&m.dag, &rank)
-                        .expect("acyclic")
-                        .into_iter()
-                        .map(|v| crate::model::Visit::new(v, 0))
-                        .collect();
-                let s = Solution::new(&c, &seq);
+                let s = random_order(&m, &c, &mut rng);
                 assert!(s.feasible(&m));
                 for x in 0..n as u32 {
                     for block in [8, n] {
