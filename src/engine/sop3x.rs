@@ -102,8 +102,10 @@ const CHEAPEST_NODES_GEOMETRIC: usize = 500;
 /// blocks of a scan that cannot hold an improving exchange.
 #[derive(Debug, Default, Clone)]
 struct Cheapest {
-    /// The costs they were computed for (model address, closed loop).
-    key: Option<(usize, bool)>,
+    /// The costs they were computed for: model address, closed loop, nodes and the cost of
+    /// the first node's start and end links (so that another model at the same address is
+    /// told apart).
+    key: Option<(usize, bool, usize, u64, u64)>,
     out: Vec<f64>,
     inn: Vec<f64>,
 }
@@ -113,7 +115,14 @@ impl Cheapest {
     /// has too many nodes (no bound).
     fn ready(&mut self, c: &Costs) -> bool {
         let m = c.m;
-        let key = (m as *const _ as usize, c.closed);
+        let first = (m.n() > 0).then_some((0, 0));
+        let key = (
+            m as *const _ as usize,
+            c.closed,
+            m.nodes(),
+            c.link(None, first).to_bits(),
+            c.link(first, None).to_bits(),
+        );
         if self.key == Some(key) {
             return !self.out.is_empty();
         }
