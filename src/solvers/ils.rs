@@ -426,17 +426,7 @@ impl Ils {
             Some(s) => s,
             None => greedy_solution(ctx, &c),
         };
-        let mut search = Search::new(c, self.k);
-        if self.max_block > 0 {
-            search.max_block = self.max_block;
-        }
-        search.vnd(&mut cur, ctx);
-        let mut lk = Lk::when(self.lk, &c, self.lk_depth, self.lk_breadth);
-        if let Some(lk) = lk.as_mut() {
-            lk.alternate_with_vnd(&mut search, &mut cur, ctx);
-            lk.penalty = self.lk_penalty * cur.cost.abs() / (n as f64 + 1.0);
-            lk.max_viol = self.lk_max_viol;
-        }
+        let (mut search, mut lk) = self.descend(ctx, c, &mut cur);
         let mut best = cur.clone();
         ctx.report(best.cost + m.constant());
         let max_seg = if self.max_seg > 0 {
@@ -568,6 +558,28 @@ impl Ils {
             );
         }
         Ok(outcome(m, &best))
+    }
+
+    /// The search engine and Lin–Kernighan (when it runs) with this solver's settings, and
+    /// `cur` taken to their local optimum: the walk's first solution.
+    fn descend<'a>(
+        &self,
+        ctx: &mut Context,
+        c: Costs<'a>,
+        cur: &mut Solution,
+    ) -> (Search<'a>, Option<Lk>) {
+        let mut search = Search::new(c, self.k);
+        if self.max_block > 0 {
+            search.max_block = self.max_block;
+        }
+        search.vnd(cur, ctx);
+        let mut lk = Lk::when(self.lk, &c, self.lk_depth, self.lk_breadth);
+        if let Some(lk) = lk.as_mut() {
+            lk.alternate_with_vnd(&mut search, cur, ctx);
+            lk.penalty = self.lk_penalty * cur.cost.abs() / (cur.n() as f64 + 1.0);
+            lk.max_viol = self.lk_max_viol;
+        }
+        (search, lk)
     }
 
     /// Starts another walk: `s` (a local optimum) gets random feasible reorders of windows
