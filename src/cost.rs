@@ -36,6 +36,39 @@ struct Geo {
     keep_out: Vec<[f64; 5]>,
 }
 
+/// Most nodes for which [`CostModel::least_arcs`] is computed on a matrix instance.
+pub const LEAST_ARCS_MAX_NODES: usize = 2000;
+
+/// The cheapest arc out of and into every node ([`CostModel::least_arcs`]).
+#[derive(Debug, Clone)]
+pub struct LeastArcs {
+    /// Per node: the cheapest arc to a node of another cell (infinite with one cell).
+    pub out: Vec<f64>,
+    /// Per node: the cheapest arc from a node of another cell.
+    pub inn: Vec<f64>,
+}
+
+impl LeastArcs {
+    fn new(m: &CostModel) -> Self {
+        let mut out = vec![f64::INFINITY; m.nodes()];
+        let mut inn = vec![f64::INFINITY; m.nodes()];
+        for a in 0..m.n() {
+            for ma in 0..m.modes(a) {
+                let na = m.node(a, ma);
+                for b in (0..m.n()).filter(|&b| b != a) {
+                    for mb in 0..m.modes(b) {
+                        let nb = m.node(b, mb);
+                        let v = m.arc(a, ma, b, mb);
+                        out[na] = out[na].min(v);
+                        inn[nb] = inn[nb].min(v);
+                    }
+                }
+            }
+        }
+        LeastArcs { out, inn }
+    }
+}
+
 /// Arc costs, mode layout, tools and precedence of an instance, ready for search.
 #[derive(Debug, Clone)]
 pub struct CostModel {
@@ -66,6 +99,9 @@ pub struct CostModel {
     pub dag: Dag,
     /// the closure of `dag`, built on first use (see [`CostModel::closure`])
     closure: OnceLock<Option<Closure>>,
+    /// the cheapest arcs out of and into every node, built on first use (see
+    /// [`CostModel::least_arcs`])
+    least_arcs: OnceLock<Option<LeastArcs>>,
     /// whether `dag` has a topological order (see [`CostModel::acyclic`])
     acyclic: bool,
 }
@@ -193,6 +229,7 @@ impl CostModel {
             geo,
             dag,
             closure: OnceLock::new(),
+            least_arcs: OnceLock::new(),
             acyclic,
         };
         cm.turn = (0..cm.nodes())
@@ -280,6 +317,22 @@ impl CostModel {
                 (self.n() <= CLOSURE_MAX_CELLS && !self.dag.is_empty())
                     .then(|| Closure::new(&self.dag))
                     .flatten()
+            })
+            .as_ref()
+    }
+    /// The cheapest arc out of and into every node, from and to the nodes of other cells
+    /// (start and finish costs not included), built on first use and shared by every search
+    /// on this model; `None` above [`LEAST_ARCS_MAX_NODES`] nodes (a quarter of that on
+    /// geometric instances, whose arcs cost more to compute). O(nodes²) arc costs.
+    pub fn least_arcs(&self) -> Option<&LeastArcs> {
+        self.least_arcs
+            .get_or_init(|| {
+                let cap = if self.is_geometric() {
+                    LEAST_ARCS_MAX_NODES / 4
+                } else {
+                    LEAST_ARCS_MAX_NODES
+                };
+                (self.nodes() <= cap).then(|| LeastArcs::new(self))
             })
             .as_ref()
     }

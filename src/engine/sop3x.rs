@@ -21,7 +21,8 @@
 //! `link(h, i+1) − link(h, h+1) − link(i, i+1)` plus, for the right block's end j,
 //! `link(j, h+1) − link(j, j+1)` and `link(i, j+1)`. The middle part's minimum over the j in
 //! range is a prefix minimum kept along the scan, and the last part is at least the cheapest
-//! link out of cell i (`Cheapest`, computed once per instance up to a few thousand nodes).
+//! link out of cell i (the cheapest arc out of it, `CostModel::least_arcs`, computed once
+//! per instance up to a few thousand nodes, or its finish cost if lower).
 //! When the sum of the three is not below zero no j improves, and the block's j are not
 //! scanned; the backward scan bounds its h the same way with the cheapest link into the right
 //! block's first cell. The same moves are found (a test compares both ways); each skipped
@@ -51,8 +52,6 @@ pub(crate) struct Labels {
     ends: Vec<f64>,
     /// Prefix minima of `ends[k] - links[k]` along the scan (the bound's scan part).
     least: Vec<f64>,
-    /// The cheapest link out of and into every node (the bound's end parts).
-    cheapest: Cheapest,
     /// Scans evaluate every block, without the bound (a switch for tests).
     unbounded: bool,
     /// Union of the closure's descendant rows of the left block (forward) or ancestor rows
@@ -89,73 +88,6 @@ impl Labels {
             self.label = 1;
         }
         self.label
-    }
-}
-
-/// Most nodes for which [`Cheapest`] is computed (O(nodes²) link costs, once per scratch
-/// space): matrix instances and geometric ones, whose links cost more to compute.
-const CHEAPEST_NODES_MATRIX: usize = 2000;
-const CHEAPEST_NODES_GEOMETRIC: usize = 500;
-
-/// The cheapest link out of every node (to another cell's node or the path end) and into
-/// every node (from another cell's node or the path start), for the exact bound that skips
-/// blocks of a scan that cannot hold an improving exchange.
-#[derive(Debug, Default, Clone)]
-struct Cheapest {
-    /// The costs they were computed for: model address, closed loop, nodes and the cost of
-    /// the first node's start and end links (so that another model at the same address is
-    /// told apart).
-    key: Option<(usize, bool, usize, u64, u64)>,
-    out: Vec<f64>,
-    inn: Vec<f64>,
-}
-
-impl Cheapest {
-    /// Computes the minima for `c` unless they are there already; false when the instance
-    /// has too many nodes (no bound).
-    fn ready(&mut self, c: &Costs) -> bool {
-        let m = c.m;
-        let first = (m.n() > 0).then_some((0, 0));
-        let key = (
-            m as *const _ as usize,
-            c.closed,
-            m.nodes(),
-            c.link(None, first).to_bits(),
-            c.link(first, None).to_bits(),
-        );
-        if self.key == Some(key) {
-            return !self.out.is_empty();
-        }
-        self.key = Some(key);
-        self.out.clear();
-        self.inn.clear();
-        let cap = if m.is_geometric() {
-            CHEAPEST_NODES_GEOMETRIC
-        } else {
-            CHEAPEST_NODES_MATRIX
-        };
-        if m.nodes() > cap {
-            return false;
-        }
-        self.out.resize(m.nodes(), f64::INFINITY);
-        self.inn.resize(m.nodes(), f64::INFINITY);
-        for a in 0..m.n() {
-            for ma in 0..m.modes(a) {
-                let na = m.node(a, ma);
-                let x = Some((a, ma));
-                self.out[na] = self.out[na].min(c.link(x, None));
-                self.inn[na] = self.inn[na].min(c.link(None, x));
-                for b in (0..m.n()).filter(|&b| b != a) {
-                    for mb in 0..m.modes(b) {
-                        let nb = m.node(b, mb);
-                        let v = c.link(x, Some((b, mb)));
-                        self.out[na] = self.out[na].min(v);
-                        self.inn[nb] = self.inn[nb].min(v);
-                    }
-                }
-            }
-        }
-        true
     }
 }
 
@@ -228,7 +160,7 @@ pub(crate) fn forward(
     let m = c.m;
     let n = s.n() as isize;
     let px = s.pos[x as usize] as isize;
-    let bounded = !w.unbounded && w.cheapest.ready(c);
+    let least = m.least_arcs().filter(|_| !w.unbounded);
     for h in [px - 1, px] {
         if h + 2 >= n {
             continue;
@@ -272,12 +204,14 @@ pub(crate) fn forward(
                 w.fill_forward(c, s, h, first_l, (jend - h - 2) as usize);
             }
             let hopeless = jend == i
-                || bounded && {
+                || least.is_some_and(|least| {
                     let kmax = (jend - h - 2) as usize;
                     *evals += 1;
                     let (a, ma) = last_l.expect("a cell of the path");
-                    new_h - old_h - old_i + w.least[kmax] + w.cheapest.out[m.node(a, ma)] >= 0.0
-                };
+                    // j + 1 may be the path's end
+                    let out = least.out[m.node(a, ma)].min(c.link(last_l, None));
+                    new_h - old_h - old_i + w.least[kmax] + out >= 0.0
+                });
             if !hopeless {
                 let mut best = (0.0, 0isize);
                 for j in (i + 1)..=jend {
@@ -321,7 +255,7 @@ fn backward(
     let m = c.m;
     let n = s.n() as isize;
     let px = s.pos[x as usize] as isize;
-    let bounded = !w.unbounded && w.cheapest.ready(c);
+    let least = m.least_arcs().filter(|_| !w.unbounded);
     for j in [px, px - 1] {
         if j < 1 || j >= n {
             continue;
@@ -368,12 +302,14 @@ fn backward(
                 w.fill_backward(c, s, j, last_r, (j - 2 - hlow) as usize);
             }
             let hopeless = hlow == i
-                || bounded && {
+                || least.is_some_and(|least| {
                     let kmax = (j - 2 - hlow) as usize;
                     *evals += 1;
                     let (a, ma) = first_r.expect("a cell of the path");
-                    new_i - old_i - old_j + w.least[kmax] + w.cheapest.inn[m.node(a, ma)] >= 0.0
-                };
+                    // h may be the path's start
+                    let inn = least.inn[m.node(a, ma)].min(c.link(None, first_r));
+                    new_i - old_i - old_j + w.least[kmax] + inn >= 0.0
+                });
             // L = [h+1..=i] grows leftwards
             let mut h = if hopeless { hlow - 1 } else { i - 1 };
             while h >= hlow {
