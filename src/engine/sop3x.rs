@@ -89,9 +89,7 @@ impl Labels {
         }
         self.label
     }
-}
 
-impl Labels {
     /// Forward scan from `h`: fills `links`, `ends` and `least` up to index `k` (position
     /// `h+2+k`; `first_l` is the cell at `h+1`).
     #[inline]
@@ -160,7 +158,7 @@ pub(crate) fn forward(
     let m = c.m;
     let n = s.n() as isize;
     let px = s.pos[x as usize] as isize;
-    let least = m.least_arcs().filter(|_| !w.unbounded);
+    let cheapest = m.least_arcs().filter(|_| !w.unbounded);
     for h in [px - 1, px] {
         if h + 2 >= n {
             continue;
@@ -204,12 +202,12 @@ pub(crate) fn forward(
                 w.fill_forward(c, s, h, first_l, (jend - h - 2) as usize);
             }
             let hopeless = jend == i
-                || least.is_some_and(|least| {
+                || cheapest.is_some_and(|cheapest| {
                     let kmax = (jend - h - 2) as usize;
                     *evals += 1;
                     let (a, ma) = last_l.expect("a cell of the path");
                     // j + 1 may be the path's end
-                    let out = least.out[m.node(a, ma)].min(c.link(last_l, None));
+                    let out = cheapest.out[m.node(a, ma)].min(c.link(last_l, None));
                     new_h - old_h - old_i + w.least[kmax] + out >= 0.0
                 });
             if !hopeless {
@@ -255,7 +253,7 @@ fn backward(
     let m = c.m;
     let n = s.n() as isize;
     let px = s.pos[x as usize] as isize;
-    let least = m.least_arcs().filter(|_| !w.unbounded);
+    let cheapest = m.least_arcs().filter(|_| !w.unbounded);
     for j in [px, px - 1] {
         if j < 1 || j >= n {
             continue;
@@ -302,12 +300,12 @@ fn backward(
                 w.fill_backward(c, s, j, last_r, (j - 2 - hlow) as usize);
             }
             let hopeless = hlow == i
-                || least.is_some_and(|least| {
+                || cheapest.is_some_and(|cheapest| {
                     let kmax = (j - 2 - hlow) as usize;
                     *evals += 1;
                     let (a, ma) = first_r.expect("a cell of the path");
                     // h may be the path's start
-                    let inn = least.inn[m.node(a, ma)].min(c.link(None, first_r));
+                    let inn = cheapest.inn[m.node(a, ma)].min(c.link(None, first_r));
                     new_i - old_i - old_j + w.least[kmax] + inn >= 0.0
                 });
             // L = [h+1..=i] grows leftwards
