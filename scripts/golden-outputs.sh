@@ -57,7 +57,7 @@ for s in 1 2 3; do
     "$B" generate uniform --param n=200 --param tools=3 --seed $s -o "$OUT/generate/uniform-$s.json"
     "$B" generate uniform --param n=100 --param lift=0 --seed $s -o "$OUT/generate/uniform-l0-$s.json"
 done
-"$B" generate panel --param rows=2 --param cols=2 --param tools=instances/tools/default.toml \
+"$B" generate panel --param rows=2 --param cols=2 --param tools=crates/cellseq/src/generate/default-tools.toml \
     --seed 4 -o "$OUT/generate/panel-tools.json"
 
 # --- solve, info, import ---------------------------------------------------------------

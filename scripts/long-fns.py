@@ -3,7 +3,7 @@
 without a stated reason).
 
 usage: python3 scripts/long-fns.py [DIR ...] [--over N] [--top K] [--reasons]
-  DIR       directories searched for *.rs (default: src)
+  DIR       directories searched for *.rs (default: every crates/*/src)
   --over N  list functions with more than N lines (default 150)
   --top K   list the K longest functions instead, whatever their length
   --reasons also show the reason comment of a function kept long on purpose
@@ -141,7 +141,8 @@ def main(argv):
         else:
             dirs.append(a)
     rows = []
-    for d in dirs or ["src"]:
+    default = sorted(os.path.join("crates", c, "src") for c in os.listdir("crates"))
+    for d in dirs or default:
         for root, _, files in os.walk(d):
             for f in sorted(files):
                 if f.endswith(".rs"):

@@ -61,7 +61,7 @@ sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "pee
 from sop_common import cellseq_solve  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-BUILT_IN = os.path.join(ROOT, "src", "solvers", "auto", "portfolio.toml")
+BUILT_IN = os.path.join(ROOT, "crates", "cellseq", "src", "solvers", "auto", "portfolio.toml")
 
 # Plan variants beside the built-in rules' plans (the free/sparse boundary): `atsp` first,
 # then `ils` from its best in the sparse rule's narrow acceptance band.

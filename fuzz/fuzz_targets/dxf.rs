@@ -4,5 +4,5 @@
 use libfuzzer_sys::fuzz_target;
 
 fuzz_target!(|data: &[u8]| {
-    let _ = cellseq::io::dxf::read("fuzz.dxf", data, Default::default());
+    let _ = cellseq_programs::dxf::read("fuzz.dxf", data, Default::default());
 });

@@ -5,5 +5,5 @@ use libfuzzer_sys::fuzz_target;
 
 fuzz_target!(|data: &[u8]| {
     let text = String::from_utf8_lossy(data);
-    let _ = cellseq::io::gcode::parse("fuzz.ngc", &text);
+    let _ = cellseq_programs::gcode::parse("fuzz.ngc", &text);
 });

@@ -20,5 +20,5 @@ fuzz_target!(|data: &[u8]| {
         .replace("..", "._")
         .replace("\"/", "\"_")
         .replace("'/", "'_");
-    let _ = cellseq::harness::plan::Plan::parse("fuzz.toml", &text, base);
+    let _ = cellseq_lab::plan::Plan::parse("fuzz.toml", &text, base);
 });

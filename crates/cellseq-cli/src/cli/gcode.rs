@@ -1,0 +1,333 @@
+//! `optimize`, `import` and `verify-gcode`: real programs in, better programs out.
+
+use super::rows::{Table, say_wrote, write_output};
+use anyhow::bail;
+use cellseq::formats::write::ensure_not_input;
+use cellseq::formats::{read_text, save_instance};
+use cellseq_programs::gcode::{self, Figures};
+use cellseq_programs::pipeline::Allowance;
+use cellseq_programs::pipeline::gcode::{self as gcode_pipeline, Kept, Options};
+use clap::Args;
+use std::path::{Path, PathBuf};
+
+/// Arguments of `optimize`.
+#[derive(Args, Debug)]
+pub struct OptimizeArgs {
+    /// Input program (.ngc, .nc, .gcode, .tap, .gco, …).
+    pub input: PathBuf,
+    /// Output file (default: report only).
+    #[arg(short = 'o', long)]
+    pub output: Option<PathBuf>,
+    /// Allow the output to be the input file itself (by any path or link).
+    #[arg(long)]
+    pub overwrite_input: bool,
+    /// Solver from the registry (default for G-code: `auto`, the registry's default portfolio;
+    /// for SVG/DXF `drawing`: greedy, 2-opt/Or-opt with reversal, iterated local search).
+    #[arg(long)]
+    pub solver: Option<String>,
+    /// Time limit in seconds for the whole command (reading, solving, checking, writing);
+    /// the solver's part is shared among groups of cells by size.
+    #[arg(long, value_name = "S")]
+    pub time_limit: Option<f64>,
+    /// Evaluation budget of the solver, shared among groups by size (deterministic results);
+    /// without this or a time limit, each group gets 20 000 evaluations per cell.
+    #[arg(long, value_name = "N")]
+    pub max_evals: Option<u64>,
+    /// Seed.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Allow cutting cells in the opposite direction (default for drawings and 2-D G-code:
+    /// laser, plasma, plotter; off by default for milling, where it swaps climb and
+    /// conventional milling).
+    #[arg(long, conflicts_with = "no_reversible")]
+    pub reversible: bool,
+    /// Never reverse cells (default for G-code with Z moves).
+    #[arg(long)]
+    pub no_reversible: bool,
+    /// Keep tool blocks in their original order (default).
+    #[arg(long, conflicts_with = "merge_tool_blocks")]
+    pub keep_tool_order: bool,
+    /// Merge blocks of the same tool (fewer tool changes).
+    #[arg(long)]
+    pub merge_tool_blocks: bool,
+    /// Print the report as JSON.
+    #[arg(long)]
+    pub json: bool,
+    /// Input format (default: from the extension).
+    #[arg(long, value_name = "gcode|svg|dxf")]
+    pub format: Option<String>,
+    /// XY margin (mm) added to cell footprints for the overlap rule.
+    #[arg(long, default_value_t = 0.5)]
+    pub margin: f64,
+    #[command(flatten)]
+    pub drawing: super::drawing::DrawingArgs,
+}
+
+/// Arguments of `import`.
+#[derive(Args, Debug)]
+pub struct ImportArgs {
+    /// Input program.
+    pub input: PathBuf,
+    /// Instance file to write.
+    #[arg(short = 'o', long)]
+    pub output: PathBuf,
+    /// Allow the output to be the input file itself (by any path or link).
+    #[arg(long)]
+    pub overwrite_input: bool,
+    /// Merge blocks of the same tool.
+    #[arg(long)]
+    pub merge_tool_blocks: bool,
+    /// XY margin (mm) added to cell footprints for the overlap rule.
+    #[arg(long, default_value_t = 0.5)]
+    pub margin: f64,
+    /// Input format (default: from the extension).
+    #[arg(long, value_name = "gcode|svg|dxf")]
+    pub format: Option<String>,
+    /// Never reverse cells (drawings; 2-D G-code).
+    #[arg(long)]
+    pub no_reversible: bool,
+    #[command(flatten)]
+    pub drawing: super::drawing::DrawingArgs,
+}
+
+/// Arguments of `verify-gcode`.
+#[derive(Args, Debug)]
+pub struct VerifyArgs {
+    /// The original program.
+    pub original: PathBuf,
+    /// The program to check against it.
+    pub optimized: PathBuf,
+    /// Print the report as JSON.
+    #[arg(long)]
+    pub json: bool,
+}
+
+pub(super) fn format_of(path: &Path, given: Option<&str>) -> anyhow::Result<&'static str> {
+    let f = match given {
+        Some(g) => g.to_ascii_lowercase(),
+        None => path
+            .extension()
+            .and_then(|e| e.to_str())
+            .unwrap_or("")
+            .to_ascii_lowercase(),
+    };
+    Ok(match f.as_str() {
+        "gcode" | "ngc" | "nc" | "tap" | "gco" | "g" | "cnc" | "txt" => "gcode",
+        "svg" => "svg",
+        "dxf" => "dxf",
+        other => bail!(
+            "{}: cannot tell the format from '{other}' (use --format gcode)",
+            path.display()
+        ),
+    })
+}
+
+fn print_figures(before: &Figures, after: &Figures) {
+    let t = Table::new(16);
+    t.saved("air length mm", before.air_length, after.air_length);
+    t.counts("lifts", before.lifts, after.lifts);
+    t.counts("tool changes", before.tool_changes, after.tool_changes);
+    t.saved("est. time s", before.est_time_s, after.est_time_s);
+    t.values("cut length mm", before.cut_length, after.cut_length);
+}
+
+/// Runs `optimize`.
+pub fn optimize(a: OptimizeArgs) -> anyhow::Result<()> {
+    if let Some(o) = &a.output {
+        ensure_not_input(&a.input, o, a.overwrite_input)?;
+    }
+    let fmt = format_of(&a.input, a.format.as_deref())?;
+    if fmt != "gcode" {
+        return super::drawing::optimize(&a, fmt);
+    }
+    optimize_gcode(&a)
+}
+
+/// Output extensions that are not G-code: an optimized program is never written into them.
+fn refuse_non_gcode_output(o: &Path) -> anyhow::Result<()> {
+    let ext = o
+        .extension()
+        .and_then(|e| e.to_str())
+        .unwrap_or("")
+        .to_ascii_lowercase();
+    if matches!(
+        ext.as_str(),
+        "svg" | "dxf" | "png" | "pdf" | "json" | "csv" | "toml"
+    ) {
+        bail!(
+            "{}: an optimized G-code program is not written into a .{ext} file; give a G-code \
+             name (.ngc, .nc, .gcode, …), or draw it with `cellseq plot`",
+            o.display()
+        );
+    }
+    Ok(())
+}
+
+fn optimize_gcode(a: &OptimizeArgs) -> anyhow::Result<()> {
+    let allowance = Allowance::new(a.time_limit, a.max_evals);
+    if let Some(o) = &a.output {
+        refuse_non_gcode_output(o)?;
+    }
+    if let Some(t) = a.time_limit
+        && !(t.is_finite() && t > 0.0)
+    {
+        bail!("--time-limit must be a positive number of seconds (got {t})");
+    }
+    let file = a.input.display().to_string();
+    let t0 = std::time::Instant::now();
+    let text = read_text(&a.input)?;
+    let parsed = gcode::parse(&file, &text)?;
+    let parse_s = t0.elapsed().as_secs_f64();
+    let solver = a
+        .solver
+        .clone()
+        .unwrap_or_else(|| cellseq::solvers::DEFAULT_SOLVER.to_string());
+    let opts = Options {
+        solver: solver.clone(),
+        time_limit: a.time_limit,
+        max_evals: a.max_evals,
+        seed: a.seed,
+        merge: a.merge_tool_blocks,
+        margin: a.margin,
+        reversible: if a.reversible {
+            Some(true)
+        } else if a.no_reversible {
+            Some(false)
+        } else {
+            None
+        },
+    };
+    let mut out = gcode_pipeline::optimize_within(&parsed, &opts, &allowance)?;
+    out.timings.parse_s = parse_s;
+    if a.output.is_some() {
+        let t = std::time::Instant::now();
+        write_output(a.output.as_deref(), &out.text)?;
+        out.timings.write_s += t.elapsed().as_secs_f64();
+    }
+    let reversed = out.reversed.iter().filter(|&&r| r).count();
+    if a.json {
+        let v = serde_json::json!({
+            "input": file,
+            "output": a.output.as_ref().map(|p| p.display().to_string()),
+            "solver": solver,
+            "cells": parsed.layout.cells.len(),
+            "tool_blocks": parsed.layout.blocks.len(),
+            "groups": out.groups,
+            "verified_cutting_moves": out.cuts,
+            "verified_events": out.events,
+            "inner_first_dropped_groups": out.inner_first_dropped,
+            "kept_original_order": out.kept_original(),
+            "kept": out.kept,
+            "kept_note": out.note,
+            "reversal": out.reversal_on,
+            "reversible_cells": out.reversible_cells,
+            "reversed_cells": reversed,
+            "timings": out.timings,
+            "solve_s": out.timings.solve_s,
+            "total_s": allowance.started.elapsed().as_secs_f64(),
+            "before": out.before,
+            "after": out.after,
+        });
+        say!("{}", serde_json::to_string_pretty(&v)?);
+    } else {
+        say!(
+            "{file}: {} cells in {} tool blocks, {} groups; solver {}; {} cutting moves and {} events verified in the same machine state",
+            parsed.layout.cells.len(),
+            parsed.layout.blocks.len(),
+            out.groups,
+            solver,
+            out.cuts,
+            out.events
+        );
+        if out.reversal_on {
+            if out.reversible_cells == 0 {
+                say!("reversal: on, but no cell could be reversed");
+            } else {
+                say!(
+                    "reversal: {reversed} of {} reversible cells cut backwards",
+                    out.reversible_cells
+                );
+            }
+        }
+        match out.kept {
+            Kept::Whole => say!(
+                "note: the program is kept in its original order ({})",
+                out.note
+                    .as_deref()
+                    .unwrap_or("the solver found no better order")
+            ),
+            Kept::Groups(g) => say!(
+                "note: the original order was kept in {g} of {} group(s) (the new order was not better there)",
+                out.groups
+            ),
+            Kept::Nothing => {}
+        }
+        if out.inner_first_dropped > 0 {
+            say!(
+                "note: in {} group(s) inner-first contradicted the original order of overlapping cells; original order kept",
+                out.inner_first_dropped
+            );
+        }
+        print_figures(&out.before, &out.after);
+        let t = &out.timings;
+        say!(
+            "time: parse {:.3} s, solve {:.3} s, verify {:.3} s, write {:.3} s",
+            t.parse_s,
+            t.solve_s,
+            t.verify_s,
+            t.write_s
+        );
+        say_wrote(a.output.as_deref());
+    }
+    Ok(())
+}
+
+/// Runs `import`.
+pub fn import(a: ImportArgs) -> anyhow::Result<()> {
+    ensure_not_input(&a.input, &a.output, a.overwrite_input)?;
+    let fmt = format_of(&a.input, a.format.as_deref())?;
+    if fmt != "gcode" {
+        return super::drawing::import(&a, fmt);
+    }
+    let file = a.input.display().to_string();
+    let text = read_text(&a.input)?;
+    let parsed = gcode::parse(&file, &text)?;
+    let inst = gcode::import(
+        &parsed,
+        a.merge_tool_blocks,
+        a.margin,
+        a.no_reversible.then_some(false),
+    )?;
+    cellseq::validate::validate(&inst, &file)?;
+    save_instance(&a.output, &inst)?;
+    say!(
+        "{}: {} cells, {} precedence edges -> {}",
+        file,
+        inst.n(),
+        inst.precedence.len(),
+        a.output.display()
+    );
+    Ok(())
+}
+
+/// Runs `verify-gcode`.
+pub fn verify(a: VerifyArgs) -> anyhow::Result<()> {
+    let (fa, fb) = (
+        a.original.display().to_string(),
+        a.optimized.display().to_string(),
+    );
+    let ta = read_text(&a.original)?;
+    let tb = read_text(&a.optimized)?;
+    let v = gcode::verify_files(&fa, &ta, &fb, &tb)?;
+    if a.json {
+        say!("{}", serde_json::to_string_pretty(&v)?);
+    } else {
+        say!(
+            "equivalent: {} cutting moves and {} events match, each in the same machine state (in either direction); no new motion",
+            v.cuts,
+            v.events
+        );
+        print_figures(&v.before, &v.after);
+    }
+    Ok(())
+}

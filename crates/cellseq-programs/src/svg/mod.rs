@@ -1,0 +1,290 @@
+//! SVG drawings (pen plotters, lasers): read strokes, write the drawing back in a new order and
+//! verify that it draws exactly the same segments and keeps every element it does not sequence.
+//! Sequencing is in [`crate::pipeline::drawing`]; this codec imports no solver.
+//!
+//! [`read()`] parses the file (every subpath of every shape is one [`Stroke`], curves flattened
+//! within a tolerance, transforms applied), [`write()`] emits one `<path>` per stroke grouped
+//! per layer (kept elements first in their layer), [`verify`] compares the multisets of
+//! segments (direction-insensitive, per layer label, stroke colour and width) and of kept
+//! elements.
+
+pub mod read;
+
+use cellseq::error::{Error, Result};
+use std::fmt::Write as _;
+
+pub use crate::drawing::{Drawing, Layer, PenUp, Stroke, Style, dist, num, pen_up};
+
+pub use read::{ReadOptions, read};
+
+fn esc(s: &str) -> String {
+    s.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+        .replace('"', "&quot;")
+}
+
+/// Writes strokes as an SVG: one `<path>` per stroke, consecutive strokes of one layer in one
+/// Inkscape layer group, stroke colour and width kept, no fill.
+pub fn write(d: &Drawing, strokes: &[Stroke]) -> String {
+    let mut o = String::with_capacity(strokes.len() * 64 + 512);
+    o.push_str("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<svg xmlns=\"http://www.w3.org/2000/svg\" xmlns:inkscape=\"http://www.inkscape.org/namespaces/inkscape\"");
+    for (prefix, uri) in &d.namespaces {
+        if prefix != "inkscape" {
+            let _ = write!(o, " xmlns:{prefix}=\"{}\"", esc(uri));
+        }
+    }
+    for (k, v) in &d.root_attrs {
+        let _ = write!(o, " {k}=\"{}\"", esc(v));
+    }
+    if d.root_attrs.is_empty() {
+        // a page around the drawing, in mm
+        let mut b = [
+            f64::INFINITY,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::NEG_INFINITY,
+        ];
+        for p in strokes.iter().flat_map(|s| &s.points) {
+            let y = if d.flip_y { -p[1] } else { p[1] };
+            b = [b[0].min(p[0]), b[1].min(y), b[2].max(p[0]), b[3].max(y)];
+        }
+        if !b[0].is_finite() {
+            b = [0.0, 0.0, 1.0, 1.0];
+        }
+        let (w, h) = ((b[2] - b[0]).max(1e-9), (b[3] - b[1]).max(1e-9));
+        let _ = write!(
+            o,
+            " width=\"{}mm\" height=\"{}mm\" viewBox=\"{} {} {} {}\"",
+            num(w * d.mm_per_unit),
+            num(h * d.mm_per_unit),
+            num(b[0]),
+            num(b[1]),
+            num(w),
+            num(h)
+        );
+    }
+    o.push_str(">\n");
+    if d.flip_y {
+        o.push_str("<g transform=\"scale(1,-1)\">\n");
+    }
+    // kept elements go first into their layer's first group, in document order
+    let mut kept_of: Vec<Vec<&str>> = vec![Vec::new(); d.layers.len()];
+    for k in &d.kept {
+        kept_of[k.layer.min(d.layers.len() - 1)].push(&k.xml);
+    }
+    let mut opened = vec![false; d.layers.len()];
+    let mut open_layer = |o: &mut String, layer: usize, kept_of: &mut Vec<Vec<&str>>| {
+        open_group(o, &d.layers[layer], layer == 0, opened[layer]);
+        opened[layer] = true;
+        for x in std::mem::take(&mut kept_of[layer]) {
+            o.push_str(x);
+            o.push('\n');
+        }
+    };
+    let mut cur: Option<usize> = None;
+    for s in strokes {
+        // a dot is a zero-length subpath, which renders only with round or square caps
+        let cap = if s.is_dot() {
+            ";stroke-linecap:round"
+        } else {
+            ""
+        };
+        if cur != Some(s.layer) {
+            if cur.is_some() {
+                o.push_str("</g>\n");
+            }
+            open_layer(&mut o, s.layer, &mut kept_of);
+            cur = Some(s.layer);
+        }
+        let st = &d.styles[s.style];
+        let _ = write!(
+            o,
+            "<path style=\"fill:none;stroke:{};stroke-width:{}{cap}\" d=\"M{},{}",
+            esc(&st.stroke),
+            num(st.width),
+            num(s.points[0][0]),
+            num(s.points[0][1])
+        );
+        if s.is_dot() {
+            let _ = write!(o, " L{},{}", num(s.points[0][0]), num(s.points[0][1]));
+        }
+        for p in &s.points[1..] {
+            let _ = write!(o, " L{},{}", num(p[0]), num(p[1]));
+        }
+        if s.closed {
+            o.push_str(" Z");
+        }
+        o.push_str("\"/>\n");
+    }
+    if cur.is_some() {
+        o.push_str("</g>\n");
+    }
+    for layer in 0..d.layers.len() {
+        if !kept_of[layer].is_empty() {
+            open_layer(&mut o, layer, &mut kept_of);
+            o.push_str("</g>\n");
+        }
+    }
+    if d.flip_y {
+        o.push_str("</g>\n");
+    }
+    o.push_str("</svg>\n");
+    o
+}
+
+/// Opens the group of a layer as the original has it: an Inkscape layer with its label, a
+/// plain group with its id (the root's own elements in an unnamed group). The id is written
+/// only on the layer's first group, so ids stay unique when a layer's strokes are split
+/// (`--no-scopes`); a later group of a plain layer carries its name as `inkscape:label`, which
+/// the reader takes as the layer's label.
+fn open_group(o: &mut String, l: &Layer, root: bool, again: bool) {
+    let id = match (&l.id, again) {
+        (Some(id), false) => format!(" id=\"{}\"", esc(id)),
+        _ => String::new(),
+    };
+    if root {
+        o.push_str("<g>\n");
+    } else if l.inkscape {
+        let _ = writeln!(
+            o,
+            "<g inkscape:groupmode=\"layer\"{id} inkscape:label=\"{}\">",
+            esc(&l.label)
+        );
+    } else if l.label.is_empty() || (!id.is_empty() && l.id.as_deref() == Some(&l.label)) {
+        let _ = writeln!(o, "<g{id}>");
+    } else {
+        let _ = writeln!(o, "<g{id} inkscape:label=\"{}\">", esc(&l.label));
+    }
+}
+
+type SegKey = (u32, [u64; 4]);
+type Interner = std::collections::HashMap<(String, String, u64), u32>;
+
+/// Segment keys, sorted: (layer label, colour, width) interned, endpoints ordered.
+/// `round` applies the writer's 6-decimal rounding (idempotent on written files).
+fn seg_keys(d: &Drawing, strokes: &[Stroke], intern: &mut Interner, round: bool) -> Vec<SegKey> {
+    let r = |v: f64| {
+        // + 0.0 turns -0 into +0, so that keys compare by value
+        if round {
+            num(v).parse::<f64>().unwrap_or(v) + 0.0
+        } else {
+            v + 0.0
+        }
+    };
+    let mut v = Vec::new();
+    for s in strokes {
+        let st = &d.styles[s.style];
+        let k = (
+            d.layers[s.layer].label.clone(),
+            st.stroke.clone(),
+            num(st.width).parse::<f64>().unwrap_or(st.width).to_bits(),
+        );
+        let next = intern.len() as u32;
+        let id = *intern.entry(k).or_insert(next);
+        for (a, b) in s.segments() {
+            let (a, b) = ([r(a[0]), r(a[1])], [r(b[0]), r(b[1])]);
+            let (a, b) = if (a[0], a[1]) <= (b[0], b[1]) {
+                (a, b)
+            } else {
+                (b, a)
+            };
+            v.push((
+                id,
+                [
+                    a[0].to_bits(),
+                    a[1].to_bits(),
+                    b[0].to_bits(),
+                    b[1].to_bits(),
+                ],
+            ));
+        }
+    }
+    v.sort_unstable();
+    v
+}
+
+/// Checks that `written` (an SVG text) draws the same multiset of segments as `orig`
+/// (direction-insensitive; per layer label, colour and width; coordinates compared after the
+/// writer's 6-decimal rounding). Returns the number of segments.
+pub fn verify(orig: &Drawing, written_name: &str, written: &str) -> Result<usize> {
+    let mut w = read(written_name, written, ReadOptions::default())?;
+    if orig.flip_y {
+        // the writer mirrors y-up drawings with scale(1,-1); mirror back (exact)
+        for s in &mut w.strokes {
+            for p in &mut s.points {
+                p[1] = -p[1] + 0.0;
+            }
+        }
+    }
+    let mut intern = Interner::default();
+    let a = seg_keys(orig, &orig.strokes, &mut intern, false);
+    let b = seg_keys(&w, &w.strokes, &mut intern, false);
+    let names: Vec<String> = {
+        let mut v = vec![String::new(); intern.len()];
+        for ((l, c, _), &i) in &intern {
+            v[i as usize] = format!("layer '{l}' {c}");
+        }
+        v
+    };
+    // the writer puts each kept element inside its layer's group: one more `<g>` around it
+    fn label(d: &Drawing, l: usize) -> &str {
+        d.layers.get(l).map_or("", |x| x.label.as_str())
+    }
+    let mut ka: Vec<(&str, String)> = orig
+        .kept
+        .iter()
+        .map(|k| (label(orig, k.layer), format!("<g>{}</g>", k.xml)))
+        .collect();
+    let mut kb: Vec<(&str, String)> = w
+        .kept
+        .iter()
+        .map(|k| (label(&w, k.layer), k.xml.clone()))
+        .collect();
+    ka.sort_unstable();
+    kb.sort_unstable();
+    if ka != kb {
+        return Err(Error::invalid(
+            written_name,
+            format!(
+                "not equivalent to {}: {} elements kept as they were vs {}",
+                orig.file,
+                kb.len(),
+                ka.len()
+            ),
+        ));
+    }
+    if a.len() != b.len() {
+        return Err(Error::invalid(
+            written_name,
+            format!(
+                "not equivalent to {}: {} segments vs {}",
+                orig.file,
+                b.len(),
+                a.len()
+            ),
+        ));
+    }
+    if let Some(i) = (0..a.len()).find(|&i| a[i] != b[i]) {
+        let f = |k: &SegKey| {
+            format!(
+                "{} ({},{})-({},{})",
+                names[k.0 as usize],
+                f64::from_bits(k.1[0]),
+                f64::from_bits(k.1[1]),
+                f64::from_bits(k.1[2]),
+                f64::from_bits(k.1[3])
+            )
+        };
+        return Err(Error::invalid(
+            written_name,
+            format!(
+                "not equivalent to {}: segment {} differs from {}",
+                orig.file,
+                f(&b[i]),
+                f(&a[i])
+            ),
+        ));
+    }
+    Ok(a.len())
+}
