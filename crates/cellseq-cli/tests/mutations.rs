@@ -17,9 +17,9 @@
 //! `#[global_allocator]` would otherwise count (and cap) the allocations of every test there.
 
 use cellseq::formats::{self, Format, json};
-use cellseq_lab::plan::Plan;
 use cellseq::model::Instance;
 use cellseq::solvers::{self, Budget, NoObserver};
+use cellseq_lab::plan::Plan;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::alloc::{GlobalAlloc, Layout, System};

@@ -13,7 +13,7 @@ use std::hint::black_box;
 
 fn end_to_end(c: &mut Criterion) {
     // criterion's plots go through plotters, which (ab_glyph feature) needs a registered font
-    cellseq_lab::plots::register();
+    cellseq_lab::plot::register_font();
     let params: BTreeMap<String, String> = [("n", "60"), ("tools", "3"), ("density", "0.02")]
         .into_iter()
         .map(|(k, v)| (k.to_string(), v.to_string()))
@@ -127,7 +127,7 @@ fn inputs(c: &mut Criterion) {
     let d = dxf::read("two.dxf", text.as_bytes(), dxf::ReadOptions::default()).expect("reads");
     let scope: Vec<usize> = (0..d.strokes.len()).collect();
     g.bench_function("containment: the 2 strokes (100k + 160k points)", |b| {
-        b.iter(|| cellseq_programs::pipeline::drawing::containment(black_box(&d), &scope, 1e-3))
+        b.iter(|| cellseq_programs::optimize::strokes::containment(black_box(&d), &scope, 1e-3))
     });
     g.finish();
 }

@@ -1,5 +1,5 @@
 //! The report's figures, computed from `results.csv` and `traces.csv` and drawn by
-//! [`super::plots`]: box plots of the reduction and the lifts, runtime against size, fixed-budget
+//! [`crate::plot::charts`]: box plots of the reduction and the lifts, runtime against size, fixed-budget
 //! convergence (the best few solvers on one plot, every solver in a panel of its own with its
 //! quartile band), the ECDF of the time to reach the best found within 1 %, and the Dolan–Moré
 //! performance profile on a log₂ τ axis with a detail near τ = 1.
@@ -9,9 +9,9 @@
 //! labelled so. Solver `i` of the results (in order of first appearance) has look `i` in every
 //! figure.
 
-use super::plots::{self, Axis, Curve, CurveSpec, Scale};
 use super::results::{Row, TraceRow};
 use super::stats::{mean, quantile};
+use crate::plot::charts::{self, Axis, Curve, CurveSpec, Scale};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
@@ -97,14 +97,14 @@ fn feasible<'a>(d: &'a FigureData, s: &'a str) -> impl Iterator<Item = &'a Row> 
 }
 
 fn boxes(dir: &Path, d: &FigureData) -> Files {
-    let groups = |f: fn(&Row) -> Option<f64>| -> Vec<plots::Group> {
+    let groups = |f: fn(&Row) -> Option<f64>| -> Vec<charts::Group> {
         d.solvers
             .iter()
             .enumerate()
             .map(|(i, s)| (s.clone(), i, feasible(d, s).filter_map(f).collect()))
             .collect()
     };
-    let mut out = plots::box_plot(
+    let mut out = charts::box_plot(
         dir,
         "reduction_box",
         "Reduction of the objective against the as-given order, per trial",
@@ -113,7 +113,7 @@ fn boxes(dir: &Path, d: &FigureData) -> Files {
     )?;
     let lifts = groups(|r| r.lifts.map(|x| x as f64));
     if lifts.iter().any(|g| !g.2.is_empty()) {
-        out.extend(plots::box_plot(
+        out.extend(charts::box_plot(
             dir,
             "lifts_box",
             "Lifts per trial (geometric instances)",
@@ -125,7 +125,7 @@ fn boxes(dir: &Path, d: &FigureData) -> Files {
 }
 
 fn scaling(dir: &Path, d: &FigureData) -> Files {
-    let data: Vec<plots::ScalingSeries> = d
+    let data: Vec<charts::ScalingSeries> = d
         .solvers
         .iter()
         .enumerate()
@@ -143,7 +143,7 @@ fn scaling(dir: &Path, d: &FigureData) -> Files {
             (s.clone(), i, pts)
         })
         .collect();
-    plots::scaling_plot(dir, &data)
+    charts::scaling_plot(dir, &data)
 }
 
 /// Best found cost per instance over every feasible trial.
@@ -310,7 +310,7 @@ fn convergence(dir: &Path, d: &FigureData, clock: Clock) -> Files {
         y: y.clone(),
         step: true,
     };
-    let mut out = plots::curve_plot(dir, "convergence", &spec, &top)?;
+    let mut out = charts::curve_plot(dir, "convergence", &spec, &top)?;
     let ordered: Vec<Curve> = order.iter().map(|&k| curves[k].clone()).collect();
     let facets = CurveSpec {
         title: format!(
@@ -322,7 +322,7 @@ fn convergence(dir: &Path, d: &FigureData, clock: Clock) -> Files {
         y,
         step: true,
     };
-    out.extend(plots::facet_plot(
+    out.extend(charts::facet_plot(
         dir,
         "convergence_facets",
         &facets,
@@ -386,7 +386,7 @@ fn ecdf(dir: &Path, d: &FigureData, clock: Clock) -> Files {
         y: Axis::linear("fraction of runs").with_range(0.0, 1.0),
         step: true,
     };
-    plots::curve_plot(dir, "ecdf_time_to_target", &spec, &curves)
+    charts::curve_plot(dir, "ecdf_time_to_target", &spec, &curves)
 }
 
 /// Performance ratios per solver over (instance, replicate) problems (+∞ where it failed).
@@ -471,7 +471,7 @@ fn profile(dir: &Path, d: &FigureData) -> Files {
         y: Axis::linear("fraction of problems with ratio ≤ τ").with_range(0.0, 1.0),
         step: true,
     };
-    let mut out = plots::curve_plot(
+    let mut out = charts::curve_plot(
         dir,
         "performance_profile",
         &spec,
@@ -493,7 +493,7 @@ fn profile(dir: &Path, d: &FigureData) -> Files {
             y: Axis::linear("fraction of problems with ratio ≤ τ").with_range(0.0, 1.0),
             step: true,
         };
-        out.extend(plots::curve_plot(
+        out.extend(charts::curve_plot(
             dir,
             "performance_profile_detail",
             &detail,

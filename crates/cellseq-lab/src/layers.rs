@@ -44,7 +44,7 @@ fn dist3(a: [f64; 3], b: [f64; 3]) -> f64 {
 }
 
 /// The per-layer breakdown of `seq` on a geometric instance (`None` for matrix instances, which
-/// have no geometry). Same machine model as [`cellseq::check::check`]; cells must be valid indices.
+/// have no geometry). Same machine model as [`cellseq::checker::check`]; cells must be valid indices.
 pub fn breakdown(inst: &Instance, seq: &Sequence) -> Option<Breakdown> {
     if inst.is_matrix() {
         return None;
@@ -93,7 +93,7 @@ pub fn breakdown(inst: &Instance, seq: &Sequence) -> Option<Breakdown> {
                 let planar = ((pexit[0] - entry[0]).powi(2) + (pexit[1] - entry[1]).powi(2)).sqrt();
                 let at_depth =
                     if (pexit[2] - entry[2]).abs() <= 1e-9 && planar <= m.link_distance + 1e-9 {
-                        cellseq::check::at_depth_length(m, pexit, entry)
+                        cellseq::checker::at_depth_length(m, pexit, entry)
                             .filter(|&d| d <= m.link_distance + 1e-9)
                     } else {
                         None
@@ -137,7 +137,7 @@ pub fn breakdown(inst: &Instance, seq: &Sequence) -> Option<Breakdown> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use cellseq::check::check;
+    use cellseq::checker::check;
     use cellseq::model::Objective;
     use std::collections::BTreeMap;
 

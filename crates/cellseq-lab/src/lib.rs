@@ -7,7 +7,6 @@
 //! [`report::report`] turns a results directory into Markdown/CSV tables and PNG/SVG plots.
 //! Everything goes through the solver and generator registries, so new entries just work.
 
-
 // No unsafe code.
 #![forbid(unsafe_code)]
 // Every public item has a doc comment (CI turns this warning into an error).
@@ -23,7 +22,6 @@ pub mod manifest;
 pub mod paper;
 pub mod plan;
 pub mod plot;
-pub mod plots;
 pub mod provenance;
 pub mod report;
 pub mod results;

@@ -151,7 +151,7 @@ pub fn layer_section(
     for r in &table {
         let _ = w.serialize(r);
     }
-    cellseq::formats::write_atomic(&p, &w.into_inner().unwrap_or_default())?;
+    cellseq::files::write_atomic(&p, &w.into_inner().unwrap_or_default())?;
     let mut md = direction_section(rows);
     md.push_str(&sensitivity_section(rows));
     let _ = writeln!(

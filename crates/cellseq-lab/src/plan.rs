@@ -580,7 +580,7 @@ impl Plan {
 
     /// [`Plan::load`] with caps given on the command line.
     pub fn load_with(path: &Path, limits: Limits) -> Result<Plan> {
-        let text = cellseq::formats::read_text(path)?;
+        let text = cellseq::files::read_text(path)?;
         let base = path.parent().unwrap_or(Path::new(".")).to_path_buf();
         Plan::parse_with(&path.display().to_string(), &text, &base, limits)
     }

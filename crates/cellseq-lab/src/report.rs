@@ -136,7 +136,7 @@ fn write_csv<T: serde::Serialize>(path: &Path, rows: &[T]) -> Result<()> {
     let bytes = w
         .into_inner()
         .map_err(|e| Error::invalid(path.display().to_string(), e.to_string()))?;
-    cellseq::formats::write_atomic(path, &bytes)
+    cellseq::files::write_atomic(path, &bytes)
 }
 
 /// One Wilcoxon comparison.
@@ -285,7 +285,7 @@ pub fn report(dir: &Path, out: &Path) -> Result<ReportFiles> {
     latex_section(&mut o)?;
     plots_section(&mut o, &data, &traces)?;
     let md_path = out.join("report.md");
-    cellseq::formats::write_atomic(&md_path, o.md.as_bytes())?;
+    cellseq::files::write_atomic(&md_path, o.md.as_bytes())?;
     o.files.push(md_path.clone());
     Ok(ReportFiles {
         markdown: md_path,
@@ -670,7 +670,7 @@ fn friedman_section(o: &mut Out, d: &Data) -> Result<()> {
             f.p.to_string(),
         ]);
     }
-    cellseq::formats::write_atomic(&p, &w.into_inner().unwrap_or_default())?;
+    cellseq::files::write_atomic(&p, &w.into_inner().unwrap_or_default())?;
     o.files.push(p);
     let _ = writeln!(o.md);
     Ok(())
@@ -744,7 +744,7 @@ fn paper_section(md: &mut String, d: &Data, paper: &Paper) {
 fn latex_section(o: &mut Out) -> Result<()> {
     for (name, t) in &o.tex_tables {
         let p = o.dir.join(name);
-        cellseq::formats::write_atomic(&p, latex::render(t).as_bytes())?;
+        cellseq::files::write_atomic(&p, latex::render(t).as_bytes())?;
         o.files.push(p);
     }
     let _ = writeln!(

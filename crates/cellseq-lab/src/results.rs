@@ -303,7 +303,7 @@ pub fn read_strict<T: for<'de> Deserialize<'de>>(path: &Path) -> Result<Vec<T>> 
 pub fn write_table<T: Serialize + Default>(path: &Path, rows: &[T]) -> Result<()> {
     let mut bytes = header::<T>()?;
     bytes.extend(to_csv_bytes(rows)?);
-    cellseq::formats::write_atomic(path, &bytes)
+    cellseq::files::write_atomic(path, &bytes)
 }
 
 /// An append-only table file: each call writes whole records and flushes.
@@ -317,7 +317,7 @@ impl Appender {
     /// other non-regular file at `path` is refused, never followed.
     pub fn open<T: Serialize + Default>(path: &Path) -> Result<Appender> {
         let name = path.display().to_string();
-        let (mut file, fresh) = cellseq::formats::write::open_append(path)?;
+        let (mut file, fresh) = cellseq::files::open_append(path)?;
         if fresh {
             file.write_all(&header::<T>()?)
                 .map_err(|e| Error::io(&name, e))?;
@@ -434,7 +434,7 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<(usize, usize)> {
             insts.extend(read_lenient::<InstanceRow>(&f)?.0);
         }
         for f in files_matching(d, "manifest", ".json")? {
-            let text = cellseq::formats::read_text(&f)?;
+            let text = cellseq::files::read_text(&f)?;
             let v: serde_json::Value = serde_json::from_str(&text)
                 .map_err(|e| Error::invalid(f.display().to_string(), e.to_string()))?;
             manifests.push(v);
@@ -479,7 +479,7 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<(usize, usize)> {
     if let Some(first) = manifests.first() {
         let mut m = first.clone();
         m["merged_from"] = serde_json::Value::Array(manifests.clone());
-        cellseq::formats::write_atomic(
+        cellseq::files::write_atomic(
             &out.join("manifest.json"),
             serde_json::to_string_pretty(&m)
                 .unwrap_or_default()

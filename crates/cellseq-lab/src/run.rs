@@ -388,7 +388,7 @@ pub fn write_manifest(
         "complete": summary.is_some(),
     });
     super::provenance::stamp(&mut m, &files.manifest, summary.is_some());
-    cellseq::formats::write_atomic(
+    cellseq::files::write_atomic(
         &files.manifest,
         serde_json::to_string_pretty(&m)
             .unwrap_or_default()
@@ -545,7 +545,7 @@ pub fn run_plan(plan: &Plan, opts: &RunOptions) -> Result<RunSummary> {
         )));
     }
     let out = &opts.out;
-    cellseq::formats::write::ensure_not_link_dir(out)?;
+    cellseq::files::ensure_not_link_dir(out)?;
     std::fs::create_dir_all(out).map_err(|e| Error::io(out.display().to_string(), e))?;
     let files = OutFiles::new(out, opts.shard);
     files.refuse_links()?;

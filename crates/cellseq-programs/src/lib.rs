@@ -16,5 +16,5 @@
 pub mod drawing;
 pub mod dxf;
 pub mod gcode;
-pub mod pipeline;
+pub mod optimize;
 pub mod svg;

@@ -2,8 +2,8 @@
 //! asymmetric TSP — with an independent checker, file formats, generators and solvers.
 //!
 //! Data flow: a file or generator gives an [`model::Instance`]; [`cost::CostModel`] flattens it
-//! for search; a [`solvers::Solver`] returns a [`model::Sequence`]; [`check::check`] verifies it
-//! and recomputes the [`check::Report`] from scratch.
+//! for search; a [`solvers::Solver`] returns a [`model::Sequence`]; [`checker::check`] verifies it
+//! and recomputes the [`checker::Report`] from scratch.
 //!
 //! ```
 //! use cellseq::solvers::{self, Budget, NoObserver};
@@ -29,21 +29,22 @@
 #![allow(clippy::needless_range_loop)]
 
 pub mod bound;
-pub mod check;
+pub mod checker;
 pub mod construct;
+pub mod context;
 pub mod cost;
 pub mod engine;
 pub mod error;
+pub mod files;
 pub mod formats;
 pub mod generate;
 pub mod geom;
 pub mod model;
 pub mod params;
 pub mod precedence;
-pub mod search;
 pub mod solvers;
 pub mod validate;
 
-pub use check::{Report, Violation, check};
+pub use checker::{Report, Violation, check};
 pub use error::{Error, Result};
 pub use model::{Cell, Instance, Machine, Mode, Objective, Sequence, StepKind, Tool, Visit};

@@ -2,11 +2,12 @@
 
 use super::rows::{Table, say_wrote, write_output};
 use anyhow::bail;
-use cellseq::formats::write::ensure_not_input;
-use cellseq::formats::{read_text, save_instance};
+use cellseq::files::ensure_not_input;
+use cellseq::files::read_text;
+use cellseq::formats::save_instance;
 use cellseq_programs::gcode::{self, Figures};
-use cellseq_programs::pipeline::Allowance;
-use cellseq_programs::pipeline::gcode::{self as gcode_pipeline, Kept, Options};
+use cellseq_programs::optimize::Allowance;
+use cellseq_programs::optimize::gcode::{self as gcode_pipeline, Kept, Options};
 use clap::Args;
 use std::path::{Path, PathBuf};
 
@@ -60,7 +61,7 @@ pub struct OptimizeArgs {
     #[arg(long, default_value_t = 0.5)]
     pub margin: f64,
     #[command(flatten)]
-    pub drawing: super::drawing::DrawingArgs,
+    pub drawing: super::strokes::DrawingArgs,
 }
 
 /// Arguments of `import`.
@@ -87,7 +88,7 @@ pub struct ImportArgs {
     #[arg(long)]
     pub no_reversible: bool,
     #[command(flatten)]
-    pub drawing: super::drawing::DrawingArgs,
+    pub drawing: super::strokes::DrawingArgs,
 }
 
 /// Arguments of `verify-gcode`.
@@ -138,7 +139,7 @@ pub fn optimize(a: OptimizeArgs) -> anyhow::Result<()> {
     }
     let fmt = format_of(&a.input, a.format.as_deref())?;
     if fmt != "gcode" {
-        return super::drawing::optimize(&a, fmt);
+        return super::strokes::optimize(&a, fmt);
     }
     optimize_gcode(&a)
 }
@@ -287,7 +288,7 @@ pub fn import(a: ImportArgs) -> anyhow::Result<()> {
     ensure_not_input(&a.input, &a.output, a.overwrite_input)?;
     let fmt = format_of(&a.input, a.format.as_deref())?;
     if fmt != "gcode" {
-        return super::drawing::import(&a, fmt);
+        return super::strokes::import(&a, fmt);
     }
     let file = a.input.display().to_string();
     let text = read_text(&a.input)?;

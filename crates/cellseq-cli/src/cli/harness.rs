@@ -1,10 +1,10 @@
 //! `check`, `run`, `merge`, `report`: the research harness (see `cellseq_lab`).
 
 use anyhow::{Context as _, Result, bail};
+use cellseq::solvers::auto::portfolio;
 use cellseq_lab::plan::{Limits, Plan};
 use cellseq_lab::run::{RunOptions, run_plan};
 use cellseq_lab::{report, results};
-use cellseq::solvers::auto::portfolio;
 use clap::Args;
 use std::path::{Path, PathBuf};
 
@@ -200,10 +200,7 @@ const MERGED_TABLES: [&str; 5] = [
 /// merged directories: its tables would be replaced by tables that do not hold its rows.
 /// One of the inputs (the default: the first) is fine: its rows are read first and kept.
 fn refuse_foreign_results(out: &Path, dirs: &[PathBuf]) -> Result<()> {
-    if dirs
-        .iter()
-        .any(|d| cellseq::formats::write::same_file(d, out))
-    {
+    if dirs.iter().any(|d| cellseq::files::same_file(d, out)) {
         return Ok(());
     }
     if let Some(t) = MERGED_TABLES

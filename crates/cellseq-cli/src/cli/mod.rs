@@ -14,12 +14,12 @@ macro_rules! say {
 
 mod bound;
 mod demo;
-mod drawing;
 mod gcode;
 mod harness;
 mod plot;
 mod rows;
 mod solve;
+mod strokes;
 
 use clap::{Parser, Subcommand};
 

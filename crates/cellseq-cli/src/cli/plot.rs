@@ -1,7 +1,7 @@
 //! `plot`: pictures of instances and solutions.
 
 use anyhow::{Context as _, Result};
-use cellseq::formats::{self, json};
+use cellseq::formats::json;
 use clap::Args;
 use std::path::PathBuf;
 
@@ -35,7 +35,7 @@ pub struct PlotArgs {
 pub fn plot(a: PlotArgs) -> Result<()> {
     cellseq_lab::plot::PictureFormat::of(&a.out)?;
     for input in std::iter::once(&a.file).chain(&a.solution).chain(&a.after) {
-        formats::write::ensure_not_input(input, &a.out, a.overwrite_input)?;
+        cellseq::files::ensure_not_input(input, &a.out, a.overwrite_input)?;
     }
     let ext = a
         .file
@@ -61,7 +61,7 @@ pub fn plot(a: PlotArgs) -> Result<()> {
         None => None,
         Some(path) => {
             let spath = path.display().to_string();
-            let text = formats::read_text(path)?;
+            let text = cellseq::files::read_text(path)?;
             let sol = json::parse_solution(&spath, &text)?;
             let seq = json::from_refs(&inst, &sol.sequence, &spath)?;
             let objective = super::solve::objective_of(&inst, Some(&sol.objective))
@@ -93,19 +93,19 @@ fn panels_of(
     title: &str,
     optimized: bool,
 ) -> Result<Vec<cellseq_lab::plot::Panel>> {
+    use cellseq_programs::optimize::strokes as pipe;
     use cellseq_programs::{dxf, gcode, svg};
-    use cellseq_programs::pipeline::drawing as pipe;
     let file = path.display().to_string();
     let mut out = Vec::new();
     match fmt {
         "gcode" => {
-            let text = formats::read_text(path)?;
+            let text = cellseq::files::read_text(path)?;
             let parsed = gcode::parse(&file, &text)?;
             out.push(cellseq_lab::plot::program_panel(title, &parsed.program));
             if optimized {
-                let o = cellseq_programs::pipeline::gcode::optimize(
+                let o = cellseq_programs::optimize::gcode::optimize(
                     &parsed,
-                    &cellseq_programs::pipeline::gcode::Options::default(),
+                    &cellseq_programs::optimize::gcode::Options::default(),
                 )?;
                 let prog = gcode::interp::interpret(&o.text)
                     .map_err(|(l, m)| anyhow::anyhow!("<optimized>:{l}: {m}"))?;
@@ -116,7 +116,7 @@ fn panels_of(
             let d = if fmt == "svg" {
                 svg::read(
                     &file,
-                    &formats::read_text(path)?,
+                    &cellseq::files::read_text(path)?,
                     svg::ReadOptions::default(),
                 )?
             } else {
@@ -130,7 +130,11 @@ fn panels_of(
                     ..pipe::Options::default()
                 };
                 let o = pipe::optimize(&d, &opts)?;
-                out.push(cellseq_lab::plot::drawing_panel("optimized", &d, &o.strokes));
+                out.push(cellseq_lab::plot::drawing_panel(
+                    "optimized",
+                    &d,
+                    &o.strokes,
+                ));
             }
         }
     }

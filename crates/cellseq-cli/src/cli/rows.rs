@@ -2,7 +2,7 @@
 //! table and the output file.
 
 use anyhow::Context as _;
-use cellseq::formats::write_atomic;
+use cellseq::files::write_atomic;
 use std::fmt::Display;
 use std::path::Path;
 
@@ -55,7 +55,7 @@ impl Table {
     }
 }
 
-/// Writes `text` to `output` (safely, see `formats::write_atomic`), if one was given.
+/// Writes `text` to `output` (safely, see `cellseq::files::write_atomic`), if one was given.
 pub(super) fn write_output(output: Option<&Path>, text: &str) -> anyhow::Result<()> {
     if let Some(o) = output {
         write_atomic(o, text.as_bytes()).with_context(|| format!("writing {}", o.display()))?;

@@ -163,7 +163,7 @@ pub fn validate(a: ValidateArgs) -> Result<()> {
 
 pub fn solve(a: SolveArgs) -> Result<()> {
     if let Some(out) = &a.out {
-        formats::write::ensure_not_input(&a.file, out, a.overwrite_input)?;
+        cellseq::files::ensure_not_input(&a.file, out, a.overwrite_input)?;
     }
     let mut params = parse_kv(&a.params)?;
     if let Some(p) = &a.portfolio {
@@ -223,7 +223,7 @@ pub fn solve(a: SolveArgs) -> Result<()> {
     let bk = best_known(&a.file).map(|b| b.0);
     if let Some(out) = &a.out {
         let sol = solution_file(&inst, &a.solver, a.seed, &r);
-        formats::write_atomic(out, json::solution_to_json(&sol).as_bytes())
+        cellseq::files::write_atomic(out, json::solution_to_json(&sol).as_bytes())
             .with_context(|| format!("writing {}", out.display()))?;
     }
     if a.json {
@@ -356,7 +356,7 @@ pub fn eval(a: EvalArgs) -> Result<()> {
     let inst = load(&a.file)?;
     let objective = objective_of(&inst, a.objective.as_deref())?;
     let spath = a.solution.display().to_string();
-    let text = formats::read_text(&a.solution)?;
+    let text = cellseq::files::read_text(&a.solution)?;
     let sol = json::parse_solution(&spath, &text)?;
     let seq = json::from_refs(&inst, &sol.sequence, &spath)?;
     let rep = cellseq::check(&inst, &seq, objective)
@@ -419,7 +419,7 @@ pub fn generate(a: GenerateArgs) -> Result<()> {
     let params = parse_kv(&a.params)?;
     // a parameter naming a file (tools=PATH) is an input: never written over silently
     for v in params.values().map(Path::new).filter(|p| p.is_file()) {
-        formats::write::ensure_not_input(v, &a.out, a.overwrite_input)?;
+        cellseq::files::ensure_not_input(v, &a.out, a.overwrite_input)?;
     }
     let inst = cellseq::generate::generate(&a.kind, &params, a.seed)?;
     let sop = a
@@ -428,7 +428,7 @@ pub fn generate(a: GenerateArgs) -> Result<()> {
         .is_some_and(|e| e.eq_ignore_ascii_case("sop"));
     if sop {
         let text = cellseq::generate::families::sop::to_sop_text(&inst)?;
-        formats::write_atomic(&a.out, text.as_bytes())?;
+        cellseq::files::write_atomic(&a.out, text.as_bytes())?;
     } else {
         formats::save_instance(&a.out, &inst)?;
     }

@@ -1,7 +1,7 @@
 //! Core tests: exact optima, checker violations, JSON round trip, greedy on the benchmarks.
 
 use crate::common::{instance_path, line_instance};
-use cellseq::check::{Violation, check};
+use cellseq::checker::{Violation, check};
 use cellseq::formats::{self, json};
 use cellseq::model::{Objective, Visit};
 use cellseq::solvers::{self, Budget, NoObserver};

@@ -3,8 +3,8 @@
 use ::dxf::entities::{Arc, Circle, Entity, EntityType, Insert, Line, LwPolyline};
 use ::dxf::{Block, LwPolylineVertex, Point};
 use cellseq_programs::dxf::{self, Post, ReadOptions};
+use cellseq_programs::optimize::strokes::{self as pipe, Options};
 use cellseq_programs::svg;
-use cellseq_programs::pipeline::drawing::{self as pipe, Options};
 use proptest::prelude::*;
 
 fn ent(layer: &str, t: EntityType) -> Entity {

@@ -7,7 +7,7 @@ use ::dxf::entities::{Arc, Circle, Entity, EntityType, Insert};
 use ::dxf::{Block, Point};
 use cellseq_programs::dxf::{self, Post, ReadOptions};
 use cellseq_programs::gcode::interp::{self, CutKind};
-use cellseq_programs::pipeline::drawing::{self as pipe, Options};
+use cellseq_programs::optimize::strokes::{self as pipe, Options};
 use std::f64::consts::PI;
 
 fn ent(t: EntityType) -> Entity {

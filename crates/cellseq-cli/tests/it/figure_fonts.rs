@@ -2,7 +2,7 @@
 //! every font it references must carry its font program (or be a Type 3 font, whose glyphs are
 //! drawn in the file).
 
-use cellseq_lab::plots;
+use cellseq_lab::plot::charts;
 use std::collections::BTreeMap;
 
 /// A PDF token: a name (`/Type`), a number or keyword, or a delimiter.
@@ -121,11 +121,11 @@ fn fonts(pdf: &[u8]) -> Vec<(u32, String, bool)> {
 #[test]
 fn figures_are_written_as_pdf_with_every_font_embedded() {
     let dir = tempfile::tempdir().unwrap();
-    let groups: Vec<plots::Group> = vec![
+    let groups: Vec<charts::Group> = vec![
         ("greedy".into(), 0, vec![1.0, 2.0, 3.5, 4.0]),
         ("ils τ ≤ 2".into(), 1, vec![2.0, 2.5, 3.0, 10.0]),
     ];
-    let files = plots::box_plot(
+    let files = charts::box_plot(
         dir.path(),
         "box",
         "Reduction per trial",

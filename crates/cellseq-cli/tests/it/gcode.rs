@@ -1,7 +1,7 @@
 //! G-code import, reordering, writing and verification on small self-written fixtures.
 
 use cellseq_programs::gcode;
-use cellseq_programs::pipeline::gcode::{Options, optimize};
+use cellseq_programs::optimize::gcode::{Options, optimize};
 use proptest::prelude::*;
 
 const FIXTURES: [&str; 3] = ["mill.ngc", "laser.gcode", "inch_plasma.ngc"];
@@ -65,7 +65,7 @@ fn mill_fixture_rules() {
     // order, which is then kept (never worse): the rules are checked on the solver's order
     let out = optimize(&p, &Options::default()).unwrap();
     assert!(out.after.not_worse_than(&out.before));
-    if out.kept == cellseq_programs::pipeline::gcode::Kept::Whole {
+    if out.kept == cellseq_programs::optimize::gcode::Kept::Whole {
         assert_eq!(out.text, text);
         return;
     }
@@ -364,7 +364,7 @@ fn never_worse_on_any_figure() {
             out.after,
             out.before
         );
-        if out.kept == cellseq_programs::pipeline::gcode::Kept::Whole {
+        if out.kept == cellseq_programs::optimize::gcode::Kept::Whole {
             assert_eq!(out.text, text, "{name}");
         }
     }

@@ -2,7 +2,7 @@
 //! full circle, inch) reversed and verified, milling off by default and refused per cell.
 
 use cellseq_programs::gcode::{self, interp::CutKind};
-use cellseq_programs::pipeline::gcode::{Options, optimize};
+use cellseq_programs::optimize::gcode::{Options, optimize};
 
 fn fixture(name: &str) -> String {
     crate::common::fixture_text(&format!("gcode/{name}"))

@@ -15,7 +15,8 @@
 //! `CELLSEQ_GOLDEN_RECORD=1 cargo test --release golden` (without the variable the test only
 //! compares; a missing file is an error).
 
-use cellseq::formats::{load_instance, write_atomic};
+use cellseq::files::write_atomic;
+use cellseq::formats::load_instance;
 use cellseq::generate::generate;
 use cellseq::model::{Instance, Sequence};
 use cellseq::solvers::{Budget, NoObserver, registry, run};

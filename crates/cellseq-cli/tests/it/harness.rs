@@ -412,8 +412,7 @@ source = "test"
     let out = dir.path().join("o");
     run_plan(&plan, &opts(&out, 2)).unwrap();
     let rows: Vec<Row> = read_strict(&out.join("results.csv")).unwrap();
-    let layers: Vec<cellseq_lab::results::LayerRow> =
-        read_strict(&out.join("layers.csv")).unwrap();
+    let layers: Vec<cellseq_lab::results::LayerRow> = read_strict(&out.join("layers.csv")).unwrap();
     let mut casing_trials = 0;
     for r in rows.iter().filter(|r| r.feasible) {
         let mine: Vec<_> = layers.iter().filter(|l| l.run_key == r.run_key).collect();

@@ -2,7 +2,7 @@
 //! independent checker must agree on which moves stay at depth and how long they are, also when
 //! a move touches or follows an area's boundary (integer coordinates make that common).
 
-use cellseq::check::{at_depth_length, check};
+use cellseq::checker::{at_depth_length, check};
 use cellseq::cost::CostModel;
 use cellseq::geom::Point3;
 use cellseq::model::{Cell, Instance, KeepOut, Machine, Mode, Objective, Tool, Visit};

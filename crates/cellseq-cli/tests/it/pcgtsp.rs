@@ -10,7 +10,8 @@ use std::collections::BTreeMap;
 use std::path::PathBuf;
 
 fn fixture(name: &str) -> PathBuf {
-    PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../..")).join(format!("tests/fixtures/pcgtsp/{name}"))
+    PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../.."))
+        .join(format!("tests/fixtures/pcgtsp/{name}"))
 }
 
 #[test]
@@ -32,8 +33,8 @@ fn real_files_load_by_extension_and_by_type() {
 #[test]
 fn agrees_with_the_integer_pcglns_file_of_the_same_instance() {
     let float = formats::load_instance(&fixture("ESC07.pcgtsp")).unwrap();
-    let int_path =
-        PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../..")).join("instances/pcgtsplib/ESC07.pcglns");
+    let int_path = PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../.."))
+        .join("instances/pcgtsplib/ESC07.pcglns");
     let int = formats::load_instance(&int_path).unwrap();
     let modes = |i: &cellseq::model::Instance| -> Vec<usize> {
         i.cells.iter().map(|c| c.modes.len()).collect()

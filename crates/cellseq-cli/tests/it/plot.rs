@@ -84,8 +84,8 @@ fn cli_generate_solve_plot() {
 
 #[test]
 fn programs_and_drawings_plot_directly_right_way_up() {
-    use cellseq_programs::svg;
     use cellseq_lab::plot::{drawing_panel, plot_panels, program_panel};
+    use cellseq_programs::svg;
     let dir = tempfile::tempdir().unwrap();
     // an SVG triangle pointing down (y grows down in SVG): its apex has the largest y, and
     // the y axis labels read as the file's y (not negated)

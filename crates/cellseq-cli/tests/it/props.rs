@@ -1,7 +1,7 @@
 //! Property tests on random small instances: greedy is feasible, exact <= greedy, and exact
 //! equals brute-force enumeration (scored by the independent checker) for n <= 7.
 
-use cellseq::check::check;
+use cellseq::checker::check;
 use cellseq::geom::Point3;
 use cellseq::model::{Cell, CostMatrix, Instance, Machine, Mode, Objective, Tool, Visit};
 use cellseq::solvers::{self, Budget, NoObserver};

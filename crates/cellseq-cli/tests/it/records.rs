@@ -1,7 +1,8 @@
 //! Kept solutions that improve on a published best known value stay feasible and keep their
 //! cost under the independent checker (`results/reference/sop/`).
 
-use cellseq::formats::{json, load_instance, read_text};
+use cellseq::files::read_text;
+use cellseq::formats::{json, load_instance};
 use cellseq::model::Objective;
 
 #[test]

@@ -27,7 +27,11 @@ fn read(p: &Path) -> Vec<u8> {
 fn generate_refuses_to_write_over_its_tools_file() {
     let d = tempfile::tempdir().unwrap();
     let tools = d.path().join("tools.toml");
-    std::fs::copy(root().join("crates/cellseq/src/generate/default-tools.toml"), &tools).unwrap();
+    std::fs::copy(
+        root().join("crates/cellseq/src/generate/default-tools.toml"),
+        &tools,
+    )
+    .unwrap();
     let before = read(&tools);
     let param = format!("tools={}", s(&tools));
     let args = ["generate", "panel", "--param", &param, "-o", s(&tools)];

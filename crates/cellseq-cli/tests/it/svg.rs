@@ -1,7 +1,7 @@
 //! SVG reader, sequencer, writer and verifier.
 
+use cellseq_programs::optimize::strokes::{self as pipe, Options};
 use cellseq_programs::svg::{self, ReadOptions};
-use cellseq_programs::pipeline::drawing::{self as pipe, Options};
 use proptest::prelude::*;
 
 fn fixture(name: &str) -> String {

@@ -4,8 +4,8 @@
 //! Inkscape layers keep the file's order; plain top-level groups are blocks put in the order
 //! of least pen-up travel (the file's with `--keep-group-order`).
 
+use cellseq_programs::optimize::strokes::{self as pipe, Options};
 use cellseq_programs::svg::{self, ReadOptions};
-use cellseq_programs::pipeline::drawing::{self as pipe, Options};
 
 fn real(name: &str) -> String {
     crate::common::fixture_text(&format!("svg/real/{name}"))

@@ -7,8 +7,8 @@
 //! recorded with their arc ([`crate::drawing::Drawing::arcs`]) so the post writes them as
 //! G2/G3.
 
-use cellseq::error::{Error, Result};
 use crate::drawing::{ArcOf, Drawing, Layer, Stroke, Style};
+use cellseq::error::{Error, Result};
 use dxf::entities::EntityType;
 use kurbo::Affine;
 use std::collections::HashMap;

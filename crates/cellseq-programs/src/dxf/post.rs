@@ -6,9 +6,9 @@
 //! arc is traced back along the chords it replaces, each of which must lie on an arc of the
 //! file with the same centre, radius and direction.
 
-use cellseq::error::{Error, Result};
 use crate::drawing::{self as svg, Drawing, Stroke};
 use crate::gcode::interp::{self, CutKind};
+use cellseq::error::{Error, Result};
 use std::collections::HashMap;
 use std::fmt::Write as _;
 

@@ -1,6 +1,6 @@
 //! G-code (RS-274: LinuxCNC, Fanuc-style, GRBL): read a program, split it into cells, build
 //! an [`Instance`], write the program back in a given order, and verify equivalence. This
-//! codec runs no solver: [`crate::pipeline::gcode`] does.
+//! codec runs no solver: [`crate::optimize::gcode`] does.
 //!
 //! [`lex`] tokenizes lines (whitespace made ASCII outside comments), [`interp`] executes them
 //! with full modal state (and which elements the program set at all) and lists every cutting
@@ -16,10 +16,10 @@ pub mod reverse;
 pub mod verify;
 pub mod write;
 
+use cells::{Layout, Split};
 use cellseq::error::{Error, Result};
 use cellseq::geom::Point3;
 use cellseq::model::{Cell, Instance, Machine, Metadata, Mode, StepKind, Tool, Visit};
-use cells::{Layout, Split};
 use interp::Program;
 pub use verify::Figures;
 
@@ -225,7 +225,7 @@ fn with_leads(l: &Layout, cells: &[usize], margin: f64) -> (Vec<(usize, usize)>,
 }
 
 /// The whole program as one instance (groups chained by precedence), for `cellseq import`;
-/// `reversible` as in `pipeline::gcode::Options::reversible`.
+/// `reversible` as in [`crate::optimize::gcode::Options::reversible`].
 pub fn import(p: &Parsed, merge: bool, margin: f64, reversible: Option<bool>) -> Result<Instance> {
     let gs = groups(p, merge);
     let all: Vec<usize> = gs.iter().flatten().copied().collect();

@@ -777,7 +777,8 @@ mod tests {
     /// text interpreted and held, in both direction rules, and a program matches itself.
     #[test]
     fn streamed_digest_equals_the_held_programs() {
-        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/fixtures/gcode");
+        let dir =
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/fixtures/gcode");
         let mut files: Vec<_> = ["", "real"]
             .iter()
             .flat_map(|d| std::fs::read_dir(dir.join(d)).unwrap())

@@ -1,6 +1,6 @@
 //! SVG drawings (pen plotters, lasers): read strokes, write the drawing back in a new order and
 //! verify that it draws exactly the same segments and keeps every element it does not sequence.
-//! Sequencing is in [`crate::pipeline::drawing`]; this codec imports no solver.
+//! Sequencing is in [`crate::optimize::strokes`]; this codec imports no solver.
 //!
 //! [`read()`] parses the file (every subpath of every shape is one [`Stroke`], curves flattened
 //! within a tolerance, transforms applied), [`write()`] emits one `<path>` per stroke grouped

@@ -9,8 +9,8 @@
 //! points is capped ([`ReadOptions::max_points`]).
 
 use super::{Drawing, Layer, Stroke, Style};
-use cellseq::error::{Error, Result};
 use crate::drawing::Kept;
+use cellseq::error::{Error, Result};
 use kurbo::{Affine, BezPath, PathEl, Point, Shape};
 use roxmltree::{Document, Node, ParsingOptions};
 use svgtypes::{SimplePathSegment, SimplifyingPathParser};

@@ -21,11 +21,11 @@ pub use three_opt::THREE_K;
 use three_opt::Three;
 
 use super::moves::or_as_swap;
-use super::search::improves;
 use super::twolevel::{TwoLevel, turn};
+use super::vnd::improves;
 use super::{Costs, Neighbours, Slot, Solution};
+use crate::context::Context;
 use crate::model::Objective;
-use crate::search::Context;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::collections::VecDeque;

@@ -14,8 +14,8 @@
 
 use super::order::OrderList;
 use super::{Costs, Neighbours, Solution};
+use crate::context::Context;
 use crate::cost::CostModel;
-use crate::search::Context;
 use std::collections::VecDeque;
 
 /// The path as a cyclic linked list with order labels, and the cells' modes.
@@ -117,7 +117,7 @@ pub fn or_opt(c: &Costs, nb: &Neighbours, s: &mut Solution, ctx: &mut Context) -
         mode_change(c, &l, x, &mut best, &mut evals);
         segment_moves(c, nb, &l, x, prec, &mut best, &mut evals);
         ctx.count(evals);
-        if !super::search::improves(best.delta, s.cost) {
+        if !super::vnd::improves(best.delta, s.cost) {
             continue;
         }
         improved = true;

@@ -17,11 +17,11 @@
 //! a step is evaluated in O(1); otherwise the segment's inner links are summed, O(length).
 
 use super::moves::{flipped_at, reverse_delta_direct, reverse_delta_ends, reversible_segment};
-use super::search::{Search, improves};
 use super::solution::flip_mode;
+use super::vnd::{Search, improves};
 use super::{Costs, Neighbours, Slot, Solution};
+use crate::context::Context;
 use crate::model::CostMatrix;
-use crate::search::Context;
 use std::collections::VecDeque;
 
 /// Instances with at most this many nodes are tested for symmetric costs (O(nodes²)).
@@ -524,11 +524,11 @@ impl Lk {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::context::{Budget, NoObserver};
     use crate::cost::CostModel;
-    use crate::engine::search::Search;
+    use crate::engine::vnd::Search;
     use crate::model::{Instance, Objective, Sequence, Visit};
     use crate::params::Params;
-    use crate::search::{Budget, NoObserver};
     use rand::{RngExt, SeedableRng};
     use rand_chacha::ChaCha8Rng;
 

@@ -6,7 +6,7 @@
 //! evaluate their delta in O(1) and check precedence in O(1) per candidate (insertion windows
 //! from last-predecessor / first-successor positions, reach arrays for reversals, labelling
 //! for SOP-3-exchange). [`neighbours`] builds K-nearest candidate lists, [`modes`] the
-//! layered shortest-path mode DP, [`search`] the variable neighbourhood descent.
+//! layered shortest-path mode DP, [`vnd`] the variable neighbourhood descent.
 
 pub mod atsp;
 pub mod crossover;
@@ -18,11 +18,11 @@ pub mod moves;
 pub mod neighbours;
 pub mod order;
 pub mod ruin;
-pub mod search;
 pub mod shift;
 pub mod solution;
 pub mod sop3x;
 pub mod twolevel;
+pub mod vnd;
 pub mod window;
 
 pub use neighbours::Neighbours;

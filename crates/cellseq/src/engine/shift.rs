@@ -22,9 +22,9 @@
 //! in a hash map per stage; a stage that would hold more than `max_states` ends the pass
 //! without a change.
 
-use super::search::improves;
+use super::vnd::improves;
 use super::{Costs, Slot, Solution};
-use crate::search::Context;
+use crate::context::Context;
 use rustc_hash::FxHashMap;
 
 /// No last cell yet: the run's left neighbour (or the path start) comes before.

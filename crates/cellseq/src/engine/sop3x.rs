@@ -1,7 +1,7 @@
 //! SOP-3-exchange in both directions (Gambardella and Dorigo 2000), seeded by a don't-push
 //! stack of cells.
 //!
-//! [`super::search::Search::sop3_seeded`] searches forward only: the swapped blocks
+//! [`super::vnd::Search::sop3_seeded`] searches forward only: the swapped blocks
 //! L = `[h+1..=i]` and R = `[i+1..=j]` start at or just after the looked-at cell. This module
 //! adds the backward search, where the blocks end at or just before the looked-at cell: R grows
 //! leftwards from j, and for every R the block L grows leftwards from i. Feasibility by
@@ -33,10 +33,10 @@
 //! [`CostModel::closure`]: crate::cost::CostModel::closure
 
 use super::moves::sop3_sum;
-use super::search::{Search, improves};
+use super::vnd::{Search, improves};
 use super::{Costs, Slot, Solution};
+use crate::context::Context;
 use crate::precedence::Closure;
-use crate::search::Context;
 
 /// Labelling scratch space of SOP-3-exchange: a stamp per cell and the current label.
 #[derive(Debug, Default, Clone)]
@@ -384,10 +384,10 @@ pub fn sop3_two_way(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::context::{Budget, NoObserver};
     use crate::cost::CostModel;
     use crate::model::{Instance, Objective};
     use crate::params::Params;
-    use crate::search::{Budget, NoObserver};
     use rand::{RngExt, SeedableRng};
     use rand_chacha::ChaCha8Rng;
 

@@ -13,9 +13,9 @@
 
 use super::modes::ModeLayers;
 use super::moves::window;
-use super::search::improves;
+use super::vnd::improves;
 use super::{Costs, Slot, Solution};
-use crate::search::Context;
+use crate::context::Context;
 
 /// Scratch space for window moves.
 #[derive(Debug, Default)]

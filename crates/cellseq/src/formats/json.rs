@@ -1,6 +1,6 @@
 //! Native JSON formats: `cellseq-instance/1` and `cellseq-solution/1` (see `docs/format.md`).
 
-use crate::check::Report;
+use crate::checker::Report;
 use crate::error::{Error, Result};
 use crate::model::{Cell, CostMatrix, Instance, Machine, Metadata, Sequence, Tool, Visit};
 use serde::{Deserialize, Serialize};

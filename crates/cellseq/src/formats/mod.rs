@@ -2,15 +2,15 @@
 //!
 //! [`load_instance`] picks the reader from the extension (`.json`, `.sop`, `.pcglns`, `.pcgtsp`) or, failing
 //! that, from the `TYPE:` header, and validates the result. Every file cellseq writes goes
-//! through [`write`](mod@write) ([`write_atomic`]).
+//! through [`crate::files`] ([`crate::files::write_atomic`]).
 
 pub mod json;
 pub mod pcgtsp;
 mod sections;
 pub mod tsplib;
-pub mod write;
 
 use crate::error::{Error, Result};
+use crate::files::{read_text, write_atomic};
 use crate::model::Instance;
 use std::path::Path;
 
@@ -59,18 +59,6 @@ pub fn detect(path: &Path, text: &str) -> Option<Format> {
     None
 }
 
-/// Reads a whole file as UTF-8 text.
-pub fn read_text(path: &Path) -> Result<String> {
-    let file = path.display().to_string();
-    let bytes = std::fs::read(path).map_err(|e| Error::io(&file, e))?;
-    String::from_utf8(bytes).map_err(|e| {
-        Error::invalid(
-            &file,
-            format!("not UTF-8 text (byte {})", e.utf8_error().valid_up_to()),
-        )
-    })
-}
-
 /// Parses instance text in a known format (no validation).
 pub fn parse_instance(file: &str, text: &str, format: Format) -> Result<Instance> {
     if text.trim().is_empty() {
@@ -102,14 +90,6 @@ pub fn load_instance(path: &Path) -> Result<Instance> {
 /// Saves an instance as `cellseq-instance/1` JSON (atomically).
 pub fn save_instance(path: &Path, inst: &Instance) -> Result<()> {
     write_atomic(path, json::instance_to_json(inst).as_bytes())
-}
-
-/// Writes a whole file safely: through an exclusively created temporary sibling with a random
-/// name, `fsync` and a rename, so readers never see half a file and no planted link is followed;
-/// FIFOs and character devices are written directly, directories and other special files are
-/// refused (see [`write`](mod@write) for every rule).
-pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
-    write::write_file(path, bytes)
 }
 
 /// The name an instance file is known by in `bks.csv`: the file name without its extension.

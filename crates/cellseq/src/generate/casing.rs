@@ -469,7 +469,7 @@ pub fn paper_example() -> Instance {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::check::check;
+    use crate::checker::check;
     use crate::cost::CostModel;
     use crate::model::{Objective, Sequence};
     use std::collections::BTreeMap;

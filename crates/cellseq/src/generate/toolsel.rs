@@ -129,15 +129,18 @@ impl ToolLibrary {
     }
     /// The library shipped with the project.
     pub fn default_library() -> ToolLibrary {
-        ToolLibrary::parse("crates/cellseq/src/generate/default-tools.toml", DEFAULT_LIBRARY)
-            .expect("the shipped tool library parses")
+        ToolLibrary::parse(
+            "crates/cellseq/src/generate/default-tools.toml",
+            DEFAULT_LIBRARY,
+        )
+        .expect("the shipped tool library parses")
     }
     /// `default` gives the shipped library; anything else is read as a TOML file.
     pub fn load(spec: &str) -> Result<ToolLibrary> {
         if spec == "default" {
             return Ok(ToolLibrary::default_library());
         }
-        let text = crate::formats::read_text(Path::new(spec))?;
+        let text = crate::files::read_text(Path::new(spec))?;
         ToolLibrary::parse(spec, &text)
     }
     /// End mills, largest first.

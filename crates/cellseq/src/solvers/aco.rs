@@ -8,7 +8,7 @@
 use super::start::{greedy_solution, outcome};
 use super::{Caps, Context, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo};
 use crate::engine::modes::mode_dp;
-use crate::engine::search::Search;
+use crate::engine::vnd::Search;
 use crate::engine::{Costs, Solution, cheaper};
 use crate::error::Result;
 use crate::model::{Sequence, Visit};

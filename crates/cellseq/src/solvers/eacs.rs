@@ -27,8 +27,8 @@ use super::{Caps, Context, Outcome, ParamKind, ParamSpec, Params, Solver, Solver
 use crate::engine::crossover::Crossover;
 use crate::engine::lk::Lk;
 use crate::engine::modes::mode_dp;
-use crate::engine::search::Search;
 use crate::engine::sop3x::{TwoWay, sop3_two_way};
+use crate::engine::vnd::Search;
 use crate::engine::{Costs, Solution, cheaper};
 use crate::error::Result;
 use crate::model::{Sequence, Visit};

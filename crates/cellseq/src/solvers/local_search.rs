@@ -15,7 +15,7 @@ use super::start::{best_start, outcome};
 use super::{Caps, Context, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo};
 use crate::engine::large::{self, Large};
 use crate::engine::moves::{apply_segment, segment_delta, window};
-use crate::engine::search::Search;
+use crate::engine::vnd::Search;
 use crate::engine::{Costs, cheaper, linked};
 use crate::error::Result;
 use rand::{RngExt, SeedableRng};

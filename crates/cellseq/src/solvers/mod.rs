@@ -26,16 +26,16 @@ pub mod start;
 pub mod tabu;
 pub mod two_opt;
 
-use crate::check::{Report, check};
+use crate::checker::{Report, check};
 use crate::cost::CostModel;
 use crate::error::{Error, Result};
 use crate::model::{Instance, Objective, Sequence};
 use std::collections::BTreeMap;
 
-pub use crate::params::{ParamKind, ParamSpec, Params, parse_kv};
-pub use crate::search::{
+pub use crate::context::{
     Budget, Context, NoObserver, Observer, Outcome, Progress, Trace, outcome_of,
 };
+pub use crate::params::{ParamKind, ParamSpec, Params, parse_kv};
 
 /// A sequencing algorithm.
 pub trait Solver: Send + Sync {

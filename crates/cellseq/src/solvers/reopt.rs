@@ -31,7 +31,7 @@ use super::{
     Budget, Caps, Context, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo, Sub,
 };
 use crate::cost::CostModel;
-use crate::engine::search::Search;
+use crate::engine::vnd::Search;
 use crate::engine::{Costs, Slot, Solution};
 use crate::error::Result;
 use crate::model::{Cell, CostMatrix, Instance, Mode, Objective, Sequence, Visit};

@@ -13,7 +13,7 @@ use super::{Caps, Context, Outcome, ParamKind, ParamSpec, Params, Solver, Solver
 use crate::engine::moves::{
     apply_segment, reverse_delta_direct, reversible_segment, segment_delta, window,
 };
-use crate::engine::search::Search;
+use crate::engine::vnd::Search;
 use crate::engine::{Costs, Solution, cheaper};
 use crate::error::Result;
 use rand::{RngExt, SeedableRng};

@@ -9,7 +9,7 @@
 use super::start::{greedy_start, outcome, random_start};
 use super::{Caps, Context, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo};
 use crate::engine::moves::{apply_segment, mode_delta, window};
-use crate::engine::search::Search;
+use crate::engine::vnd::Search;
 use crate::engine::{Costs, Solution, cheaper};
 use crate::error::Result;
 use rand::SeedableRng;

@@ -3,7 +3,7 @@
 use super::start::{greedy_solution, outcome};
 use super::{Caps, Context, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo};
 use crate::engine::Costs;
-use crate::engine::search::Search;
+use crate::engine::vnd::Search;
 use crate::error::Result;
 
 /// Registry entry.

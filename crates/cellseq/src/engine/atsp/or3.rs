@@ -23,7 +23,7 @@
 //! an open path, which keeps every block's orientation.
 
 use crate::engine::moves::sop3_delta;
-use crate::engine::search::improves;
+use crate::engine::vnd::improves;
 use crate::engine::{Costs, Neighbours, Solution};
 use crate::solvers::Context;
 use rand::RngExt;

@@ -213,11 +213,11 @@ fn first_and_last_cells_are_the_dummies() {
         let seq = inst.as_given.as_ref().unwrap();
         assert_eq!(seq.first().unwrap().cell, 0);
         assert_eq!(seq.last().unwrap().cell, last);
-        crate::check::check(&inst, seq, Objective::Matrix)
+        crate::checker::check(&inst, seq, Objective::Matrix)
             .unwrap_or_else(|v| panic!("{kind}: as-given infeasible: {v}"));
     }
     let geo = gen_("geometric-sparse", &[("n", "500")], 2);
-    crate::check::check(&geo, geo.as_given.as_ref().unwrap(), Objective::Time).unwrap();
+    crate::checker::check(&geo, geo.as_given.as_ref().unwrap(), Objective::Time).unwrap();
     let d = closure_density(&Dag::new(geo.n(), &geo.precedence));
     assert!(d > 0.0 && d < 0.01, "sparse: {d}");
 }
@@ -242,7 +242,7 @@ fn every_family_is_solved_by_the_registry() {
             )
             .unwrap_or_else(|e| panic!("{kind} / {solver}: {e}"));
             let seq = &r.outcome.sequence;
-            crate::check::check(&inst, seq, obj)
+            crate::checker::check(&inst, seq, obj)
                 .unwrap_or_else(|v| panic!("{kind} / {solver}: infeasible: {v}"));
         }
     }

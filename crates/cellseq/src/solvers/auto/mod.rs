@@ -25,11 +25,11 @@
 //! `seconds` of wall-clock time.
 
 pub mod features;
-pub mod plan;
+pub mod phases;
 pub mod portfolio;
 
 pub use features::Features;
-pub use plan::{Phase, Start, parse_plan, phase_seed, plan_text};
+pub use phases::{Phase, Start, parse_plan, phase_seed, plan_text};
 pub use portfolio::{Beam, Portfolio, Rule};
 
 use super::{

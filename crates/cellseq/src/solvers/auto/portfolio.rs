@@ -9,7 +9,7 @@
 //! The format is described for users in `docs/portfolio.md`.
 
 use super::features::Features;
-use super::plan::{Phase, Start, check_phase};
+use super::phases::{Phase, Start, check_phase};
 use crate::error::{Error, Result};
 use serde::Deserialize;
 use std::collections::BTreeMap;

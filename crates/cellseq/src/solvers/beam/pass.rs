@@ -7,9 +7,9 @@ use super::prefix::{Prefix, first_prefixes, keep_best, rank};
 use super::refine::refined;
 use super::tables::Tables;
 use crate::bound::qpath::QPath;
+use crate::context::Context;
 use crate::cost::CostModel;
 use crate::model::{Sequence, Visit};
-use crate::search::Context;
 use rustc_hash::FxHashMap;
 
 /// Evaluations charged per generated child (and per refined candidate): a child copies a

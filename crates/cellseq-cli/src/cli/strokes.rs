@@ -3,9 +3,10 @@
 use super::gcode::{ImportArgs, OptimizeArgs};
 use super::rows::{Table, say_wrote, write_output};
 use anyhow::{Context as _, bail};
-use cellseq::formats::{read_text, save_instance};
+use cellseq::files::read_text;
+use cellseq::formats::save_instance;
+use cellseq_programs::optimize::strokes as pipe;
 use cellseq_programs::svg;
-use cellseq_programs::pipeline::drawing as pipe;
 use clap::Args;
 use std::path::Path;
 

@@ -1,6 +1,6 @@
-//! Safe writes: every file cellseq writes goes through this module.
+//! Files: reading text and safe writes — every file cellseq writes goes through this module.
 //!
-//! [`write_file`] (and [`super::write_atomic`], which calls it) writes a whole file so that a
+//! [`write_file`] (and [`write_atomic`], which calls it) writes a whole file so that a
 //! reader never sees half of it and nothing but the target is ever touched:
 //!
 //! - **Regular file or new name**: the bytes go to a temporary file in the target's directory,
@@ -36,6 +36,26 @@ use std::fs::{File, OpenOptions};
 use std::io::{self, Write};
 use std::path::{Path, PathBuf};
 use std::sync::{Mutex, Once};
+
+/// Reads a whole file as UTF-8 text.
+pub fn read_text(path: &Path) -> Result<String> {
+    let file = path.display().to_string();
+    let bytes = std::fs::read(path).map_err(|e| Error::io(&file, e))?;
+    String::from_utf8(bytes).map_err(|e| {
+        Error::invalid(
+            &file,
+            format!("not UTF-8 text (byte {})", e.utf8_error().valid_up_to()),
+        )
+    })
+}
+
+/// Writes a whole file safely: through an exclusively created temporary sibling with a random
+/// name, `fsync` and a rename, so readers never see half a file and no planted link is followed;
+/// FIFOs and character devices are written directly, directories and other special files are
+/// refused (see the module documentation for every rule).
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
+    write_file(path, bytes)
+}
 
 /// Temporary files that exist right now (removed by the signal handler).
 static LIVE: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());

@@ -3,8 +3,8 @@
 //! plot instead of over it, log axes carry clean decade ticks (`10⁻⁴`, `0.01`, `1`, `10⁵`), and
 //! quartile bands are drawn only where each sits in a panel of its own (facets).
 //!
-//! Text uses the embedded DejaVu Sans (`assets/fonts/DejaVuSans.ttf`, registered through
-//! plotters' `ab_glyph` feature), so no system font is needed; in the SVG files text stays text
+//! Text uses the embedded DejaVu Sans ([`super::FONT`], registered by [`super::register_font`]),
+//! so no system font is needed; in the SVG files text stays text
 //! (`font-family="DejaVu Sans, sans-serif"`), so it can be searched, edited and re-typeset; the
 //! PDF of each figure ([`svg_to_pdf`]) is the SVG with its text set in that same font, the used
 //! glyphs embedded as a subset, so the PDF looks the same on every machine and in any paper.
@@ -12,34 +12,16 @@
 //! Every axis is drawn in transformed coordinates: a log axis plots `log10(v)` on a linear scale
 //! and labels the ticks with the values, which is what makes exact decade ticks possible.
 
-use super::stats::{loglog_slope, median, quantile};
+use super::{FAMILY, FONT, register_font};
+use crate::stats::{loglog_slope, median, quantile};
 use plotters::coord::Shift;
 use plotters::coord::ranged1d::{DefaultFormatting, KeyPointHint};
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
-use plotters::style::{FontStyle, register_font};
 use std::path::{Path, PathBuf};
-use std::sync::Once;
 
-static FONT: &[u8] = include_bytes!("../assets/fonts/DejaVuSans.ttf");
-static REGISTER: Once = Once::new();
-const FONT_NAME: &str = "sans-serif";
-/// The family the figures name: DejaVu Sans, with a generic fallback for SVG viewers.
-const FAMILY: &str = "DejaVu Sans, sans-serif";
 /// Width of the legend column beside a plot, pixels.
 const LEGEND_W: u32 = 215;
-
-/// Registers the embedded DejaVu Sans as plotters' `sans-serif` and as the figures' family
-/// (idempotent). Anything else that draws with plotters in this crate's build (e.g. criterion's
-/// HTML report in benches) needs this, because the `ab_glyph` feature has no system-font
-/// fallback.
-pub fn register() {
-    REGISTER.call_once(|| {
-        // The bytes are a valid TTF shipped with the crate; failure would leave text unrendered.
-        let _ = register_font(FONT_NAME, FontStyle::Normal, FONT);
-        let _ = register_font(FAMILY, FontStyle::Normal, FONT);
-    });
-}
 
 type PlotResult = std::result::Result<(), String>;
 type Files = std::result::Result<Vec<PathBuf>, String>;
@@ -733,8 +715,8 @@ pub fn svg_to_pdf(svg: &str) -> std::result::Result<Vec<u8>, String> {
 /// Draws a figure with `$f` into `$dir/$name.png`, `.svg` and `.pdf`.
 macro_rules! both {
     ($dir:expr, $name:expr, $size:expr, $f:expr) => {{
-        register();
-        // drawn in memory, written through the safe write of `formats::write_atomic`
+        register_font();
+        // drawn in memory, written through the safe write of `cellseq::files::write_atomic`
         let png: PathBuf = $dir.join(format!("{}.png", $name));
         {
             let mut rgb = vec![0u8; $size.0 as usize * $size.1 as usize * 3];
@@ -743,7 +725,7 @@ macro_rules! both {
                 $f(root)?;
             }
             let bytes = crate::plot::encode_png(&rgb, $size.0, $size.1).map_err(err)?;
-            cellseq::formats::write_atomic(&png, &bytes).map_err(err)?;
+            cellseq::files::write_atomic(&png, &bytes).map_err(err)?;
         }
         let svg: PathBuf = $dir.join(format!("{}.svg", $name));
         let pdf: PathBuf = $dir.join(format!("{}.pdf", $name));
@@ -753,8 +735,8 @@ macro_rules! both {
                 let root = SVGBackend::with_string(&mut text, $size).into_drawing_area();
                 $f(root)?;
             }
-            cellseq::formats::write_atomic(&svg, text.as_bytes()).map_err(err)?;
-            cellseq::formats::write_atomic(&pdf, &svg_to_pdf(&text)?).map_err(err)?;
+            cellseq::files::write_atomic(&svg, text.as_bytes()).map_err(err)?;
+            cellseq::files::write_atomic(&pdf, &svg_to_pdf(&text)?).map_err(err)?;
         }
         Ok(vec![png, svg, pdf])
     }};

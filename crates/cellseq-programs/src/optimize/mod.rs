@@ -9,10 +9,9 @@
 //! ([`solve_group`]), and where the time went ([`Timings`]). [`gcode`] is the G-code pipeline,
 //! [`drawing`] the pipeline of SVG and DXF drawings.
 
-pub mod drawing;
 pub mod gcode;
+pub mod strokes;
 
-use cellseq::check;
 use cellseq::error::{Error, Result};
 use cellseq::model::{Instance, Objective, Sequence, Visit};
 use cellseq::solvers::{self, Budget, NoObserver};
@@ -144,12 +143,12 @@ pub fn solve_group(
     let original = original_order(inst);
     // the original order is what the program does, even where it breaks a derived rule
     // (inner contours first): its cost is measured without precedence then
-    let original_cost = match check::check(inst, &original, objective) {
+    let original_cost = match cellseq::check(inst, &original, objective) {
         Ok(r) => r.cost,
         Err(_) => {
             let mut free = inst.clone();
             free.precedence.clear();
-            check::check(&free, &original, objective)
+            cellseq::check(&free, &original, objective)
                 .map_err(|v| {
                     Error::invalid(&inst.name, format!("the original order is invalid: {v}"))
                 })?

@@ -7,7 +7,7 @@ use super::moves::{
 use super::sop3x::{Labels, forward};
 use super::window::ModeWindow;
 use super::{Costs, Neighbours, Solution};
-use crate::search::Context;
+use crate::context::Context;
 use std::collections::VecDeque;
 
 /// Improvement threshold (relative) below which a delta does not count as an improvement.
@@ -364,11 +364,11 @@ impl<'a> Search<'a> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::context::{Budget, NoObserver};
     use crate::cost::CostModel;
     use crate::engine::moves::{SegmentMove, window};
     use crate::model::Objective;
     use crate::params::Params;
-    use crate::search::{Budget, NoObserver};
 
     /// With candidate lists holding every cell, Or-opt ends where no single cell can move
     /// to any place its precedence allows, in any of its modes, for less: cells of several

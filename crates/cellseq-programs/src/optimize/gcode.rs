@@ -4,8 +4,8 @@
 //! new motion) → never worse than the input on air, lifts and time, else the original order.
 
 use super::{Allowance, Timings, solve_group};
-use cellseq::error::Result;
 use crate::gcode::{self, Figures, Parsed, Verification, Verifier, reverse, write};
+use cellseq::error::Result;
 use cellseq::model::Objective;
 use cellseq::solvers;
 use std::time::Instant;

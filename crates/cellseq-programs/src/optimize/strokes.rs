@@ -7,12 +7,12 @@
 //! inner-before-outer precedence.
 
 use super::{Allowance, solve_group};
-use cellseq::error::{Error, Result};
-use cellseq::geom::Point3;
-use cellseq::geom::polygon::PolygonIndex;
 use crate::drawing::{Drawing, PenUp, Stroke, pen_up};
 use crate::dxf::{self, Post};
 use crate::svg;
+use cellseq::error::{Error, Result};
+use cellseq::geom::Point3;
+use cellseq::geom::polygon::PolygonIndex;
 use cellseq::model::{Cell, Instance, Machine, Metadata, Mode, Objective, StepKind, Tool, Visit};
 use rstar::RTree;
 use rstar::primitives::{GeomWithData, Rectangle};

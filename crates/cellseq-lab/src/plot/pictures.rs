@@ -4,28 +4,15 @@
 //! (filled dot) to its exit (hollow square); a closed cell as a hollow circle at its start
 //! point; other candidate modes as small dots. With a sequence, the air moves between
 //! consecutive cells (from the home position on) are drawn in grey, in order, with the mode
-//! the sequence chose. Text uses the DejaVu Sans font embedded in the binary
-//! (`assets/fonts/DejaVuSans.ttf`, free licence in `assets/fonts/DejaVu-LICENSE.txt`), so no
-//! system font package is needed.
+//! the sequence chose. Text uses the font of [`super`] ([`super::FONT`]), so no system font
+//! package is needed.
 
+use super::register_font;
 use cellseq::error::{Error, Result};
 use cellseq::model::{Instance, Sequence};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::path::Path;
-use std::sync::Once;
-
-/// The embedded font (DejaVu Sans, Bitstream Vera derived free licence).
-pub const FONT: &[u8] = include_bytes!("../assets/fonts/DejaVuSans.ttf");
-
-static REGISTER: Once = Once::new();
-
-fn register_font() {
-    REGISTER.call_once(|| {
-        // The embedded font is a valid TTF; a failure would only lose the text.
-        let _ = plotters::style::register_font("sans-serif", FontStyle::Normal, FONT);
-    });
-}
 
 /// Output picture format, from the file extension.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -67,7 +54,7 @@ pub fn plot(inst: &Instance, seq: Option<&Sequence>, caption: &str, out: &Path) 
     let file = out.display().to_string();
     let (w, h) = picture_size(inst);
     let err = |e: String| Error::invalid(&file, format!("drawing failed: {e}"));
-    // Drawn in memory and written once, through the safe write of `formats::write_atomic`.
+    // Drawn in memory and written once, through the safe write of `cellseq::files::write_atomic`.
     let bytes = match fmt {
         PictureFormat::Svg => {
             let mut text = String::new();
@@ -88,7 +75,7 @@ pub fn plot(inst: &Instance, seq: Option<&Sequence>, caption: &str, out: &Path) 
             encode_png(&rgb, w, h).map_err(err)?
         }
     };
-    cellseq::formats::write_atomic(out, &bytes)
+    cellseq::files::write_atomic(out, &bytes)
 }
 
 /// Encodes an RGB8 buffer of `w` × `h` pixels as PNG.
@@ -411,7 +398,7 @@ pub fn plot_panels(panels: &[Panel], y_down: bool, overlay: bool, out: &Path) ->
     let pw = if cols > 1 { 800u32 } else { 1200 };
     let size = (pw * cols, ((pw as f64 * aspect) as u32 + 120).min(3000));
     let err = |e: String| Error::invalid(&file, format!("drawing failed: {e}"));
-    // Drawn in memory and written once, through the safe write of `formats::write_atomic`.
+    // Drawn in memory and written once, through the safe write of `cellseq::files::write_atomic`.
     let bytes = match fmt {
         PictureFormat::Svg => {
             let mut text = String::new();
@@ -432,7 +419,7 @@ pub fn plot_panels(panels: &[Panel], y_down: bool, overlay: bool, out: &Path) ->
             encode_png(&rgb, size.0, size.1).map_err(err)?
         }
     };
-    cellseq::formats::write_atomic(out, &bytes)
+    cellseq::files::write_atomic(out, &bytes)
 }
 
 fn draw_panels<DB: DrawingBackend>(
