@@ -14,6 +14,8 @@ Three rules, each failing the run with the file and line of the offending import
    same rank may not import each other either, unless listed in SAME_RANK_OK).
 3. Codecs run no solver: the G-code, SVG, DXF and drawing modules of cellseq-programs import
    nothing of the core's solving API (CODEC_FORBIDDEN).
+4. Examples are what a newcomer copies: they use the public API only, none of the modules the
+   `internals` feature opens (CORE_INTERNAL).
 
 An import is a `crate::x` or `<crate>::x` path outside comments and outside test code (a
 `#[cfg(test)]` module, or a file declared only as a test module). Exit status 1 on any breach.
@@ -43,13 +45,13 @@ CORE_FORBIDDEN = [
 LAYERS = {
     "cellseq": [
         ["error"],
-        ["geom", "params"],
+        ["files", "geom", "params"],
         ["precedence"],
         ["model"],
         ["validate", "checker", "formats"],
         ["cost", "generate"],
         ["bound"],
-        ["search"],
+        ["context"],
         ["engine"],
         ["construct"],
         ["solvers"],
@@ -59,7 +61,7 @@ LAYERS = {
     "cellseq-programs": [
         ["drawing", "units"],
         ["gcode", "svg", "dxf"],
-        ["pipeline"],
+        ["optimize"],
         ["api"],
         ["lib"],
     ],
@@ -88,6 +90,9 @@ SAME_RANK_OK = {
     ("cellseq-lab", "latex", "report"),
     ("cellseq-lab", "figures", "paper"),
 }
+
+# The core's modules that are public only with the `internals` feature.
+CORE_INTERNAL = {"bound", "construct", "context", "cost", "engine", "solvers"}
 
 # What the codecs of cellseq-programs must not import from the core.
 CODEC_MODULES = {"gcode", "svg", "dxf", "drawing", "units"}
@@ -202,6 +207,25 @@ def check_modules(crate, graph):
     return bad
 
 
+def check_examples():
+    bad = []
+    for crate in CRATES:
+        ex = os.path.join(ROOT, "crates", crate, "examples")
+        if not os.path.isdir(ex):
+            continue
+        for f in sorted(os.listdir(ex)):
+            if not f.endswith(".rs"):
+                continue
+            p = os.path.join(ex, f)
+            text = strip(open(p, encoding="utf-8").read())
+            for n, line in enumerate(text.split("\n"), 1):
+                for m in re.finditer(r"\bcellseq::([a-z_]+)", line):
+                    if m.group(1) in CORE_INTERNAL:
+                        bad.append(f"{os.path.relpath(p, ROOT)}:{n}: the example uses the "
+                                   f"internal module cellseq::{m.group(1)}")
+    return bad
+
+
 def check_manifests():
     bad = []
     for crate, allowed in CRATES.items():
@@ -218,7 +242,7 @@ def check_manifests():
 def check_core_tree():
     try:
         out = subprocess.run(
-            ["cargo", "tree", "-p", "cellseq", "-e", "normal", "--prefix", "none", "--offline"],
+            ["cargo", "tree", "-p", "cellseq", "-e", "normal", "--prefix", "none"],
             cwd=ROOT, capture_output=True, text=True, check=True).stdout
     except (OSError, subprocess.CalledProcessError) as e:
         print(f"note: cargo tree not run ({e}); crate-tree rule skipped", file=sys.stderr)
@@ -233,6 +257,7 @@ def main(argv):
     bad = check_manifests()
     for crate in CRATES:
         bad += check_modules(crate, graph)
+    bad += check_examples()
     bad += check_core_tree()
     if "--graph" in argv:
         for c, a, b in sorted(graph):

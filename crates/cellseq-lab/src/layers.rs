@@ -146,18 +146,11 @@ mod tests {
     }
 
     fn solve(inst: &Instance, name: &str) -> Sequence {
-        cellseq::solvers::run(
-            name,
-            inst,
-            Objective::Time,
-            &BTreeMap::new(),
-            1,
-            cellseq::solvers::Budget::default(),
-            &mut cellseq::solvers::NoObserver,
-        )
-        .unwrap()
-        .outcome
-        .sequence
+        cellseq::Solve::new(name.parse().unwrap())
+            .objective(Objective::Time)
+            .run(inst)
+            .unwrap()
+            .sequence
     }
 
     #[test]

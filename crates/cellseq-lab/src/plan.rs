@@ -14,11 +14,12 @@
 pub mod files;
 
 use super::hash::{hex, stable_hash, trial_seed};
+use cellseq::SolverKind;
 use cellseq::error::{Error, Result};
 use cellseq::generate::KINDS;
 use cellseq::model::Objective;
 use cellseq::params::Params;
-use cellseq::solvers;
+use cellseq::registry as solvers;
 use serde::Deserialize;
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
@@ -508,7 +509,7 @@ fn plan_solvers(
             if !spec.params.is_empty() {
                 return Err(bad(format!("{what}: '*' takes no parameters")));
             }
-            for info in solvers::registry() {
+            for info in solvers::all() {
                 solvers_out.push(SolverRef {
                     id: info.name.to_string(),
                     name: info.name.to_string(),
@@ -526,16 +527,16 @@ fn plan_solvers(
             } else {
                 format!("{}[{}]", info.name, params_suffix(&params))
             };
-            if info.name == solvers::auto::INFO.name
+            if info.name == SolverKind::Auto.name()
                 && let Some(p) = params.get_mut("portfolio")
-                && p != solvers::auto::portfolio::BUILT_IN_NAME
+                && p != solvers::BUILT_IN_PORTFOLIO
                 && Path::new(p.as_str()).is_relative()
             {
                 *p = base.join(p.as_str()).to_string_lossy().into_owned();
             }
             // building the solver validates what its parameters mean (an `auto` plan or
             // portfolio file)
-            info.build(&params)
+            info.check_params(&params)
                 .map_err(|e| bad(format!("{what}: {e}")))?;
             solvers_out.push(SolverRef {
                 id,
@@ -842,6 +843,6 @@ name = "as-given"
     #[test]
     fn star_means_all_registered() {
         let p = parse(&OK.replace("name = \"greedy\"", "name = \"*\"")).unwrap();
-        assert_eq!(p.solvers.len(), solvers::registry().len());
+        assert_eq!(p.solvers.len(), solvers::all().len());
     }
 }

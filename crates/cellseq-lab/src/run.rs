@@ -9,7 +9,7 @@ use super::results::{
 use cellseq::error::{Error, Result};
 use cellseq::formats::{best_known, load_instance};
 use cellseq::model::{Instance, Objective};
-use cellseq::solvers::{self, Budget, NoObserver, Trace};
+use cellseq::{Budget, Solve, SolverKind, Trace};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rayon::prelude::*;
 use std::collections::{BTreeMap, BTreeSet, HashMap};
@@ -81,20 +81,14 @@ pub fn prepare(plan: &Plan, idx: usize) -> Result<Prepared> {
         Some(Objective::Matrix) | None => instance.default_objective(),
         Some(o) => o,
     };
-    let none = BTreeMap::new();
-    let as_given = solvers::run(
-        "as-given",
-        &instance,
-        objective,
-        &none,
-        0,
-        Budget::default(),
-        &mut NoObserver,
-    )
-    .ok();
+    let as_given = Solve::new(SolverKind::AsGiven)
+        .seed(0)
+        .objective(objective)
+        .run(&instance)
+        .ok();
     let as_given_layers = as_given
         .as_ref()
-        .and_then(|r| breakdown(&instance, &r.outcome.sequence));
+        .and_then(|r| breakdown(&instance, &r.sequence));
     let as_given = as_given.map(|r| {
         (
             r.report.cost,
@@ -183,22 +177,21 @@ pub fn run_trial(plan: &Plan, prep: &Prepared, t: &Trial, calib_s: f64) -> Trial
     let mut trace = Trace::default();
     let start = Instant::now();
     let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-        solvers::run(
-            &sref.name,
-            inst,
-            prep.objective,
-            &sref.params,
-            t.seed,
-            budget,
-            &mut trace,
-        )
+        sref.name.parse::<SolverKind>().and_then(|kind| {
+            Solve::new(kind)
+                .params_text(&sref.params)
+                .seed(t.seed)
+                .budget(budget)
+                .objective(prep.objective)
+                .observe(&mut trace)
+                .run(inst)
+        })
     }));
     let wall = start.elapsed().as_secs_f64();
-    let full_params = solvers::find(&sref.name)
-        .ok()
-        .and_then(|info| cellseq::params::Params::new(&sref.name, info.params, &sref.params).ok())
+    let full_params = cellseq::registry::find(&sref.name)
+        .and_then(|info| info.check_params(&sref.params))
         .map(|p| kv(p.values()))
-        .unwrap_or_else(|| kv(&sref.params));
+        .unwrap_or_else(|_| kv(&sref.params));
     let mut row = Row {
         run_key: t.key.clone(),
         trial: t.index,
@@ -223,7 +216,7 @@ pub fn run_trial(plan: &Plan, prep: &Prepared, t: &Trial, calib_s: f64) -> Trial
     let mut layer_rows = Vec::new();
     match result {
         Ok(Ok(r)) => {
-            if let Some(b) = breakdown(inst, &r.outcome.sequence) {
+            if let Some(b) = breakdown(inst, &r.sequence) {
                 for l in &b.layers {
                     let base = prep
                         .as_given_layers
@@ -268,15 +261,15 @@ pub fn run_trial(plan: &Plan, prep: &Prepared, t: &Trial, calib_s: f64) -> Trial
             }
             row.gap_bks_pct = gap(row.cost, row.best_known);
             let proven_bks = prep.bks.filter(|b| b.1).map(|b| b.0);
-            row.lower_bound = match (r.outcome.lower_bound, proven_bks) {
+            row.lower_bound = match (r.lower_bound, proven_bks) {
                 (Some(a), Some(b)) => Some(a.max(b)),
                 (a, b) => a.or(b),
             };
-            if r.outcome.proven_optimal {
+            if r.proven_optimal {
                 row.lower_bound = Some(rep.cost);
             }
             row.gap_lb_pct = gap(row.cost, row.lower_bound);
-            row.proven_optimal = r.outcome.proven_optimal;
+            row.proven_optimal = r.proven_optimal;
             row.evaluations = r.evaluations;
         }
         Ok(Err(e)) => row.error = e.to_string(),
@@ -317,15 +310,9 @@ pub fn calibrate() -> Result<f64> {
     let mut times = Vec::new();
     for _ in 0..5 {
         let t = Instant::now();
-        solvers::run(
-            "greedy",
-            &inst,
-            Objective::Time,
-            &BTreeMap::new(),
-            1,
-            Budget::default(),
-            &mut NoObserver,
-        )?;
+        Solve::new(SolverKind::Greedy)
+            .objective(Objective::Time)
+            .run(&inst)?;
         times.push(t.elapsed().as_secs_f64());
     }
     times.sort_by(f64::total_cmp);

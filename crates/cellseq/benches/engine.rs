@@ -15,7 +15,7 @@ use cellseq::model::Instance;
 use cellseq::solvers::aco::{Aco, Pheromone};
 use cellseq::solvers::sa::Anneal;
 use cellseq::solvers::tabu::{TabuList, tabu_step};
-use cellseq::solvers::{Budget, Context, NoObserver, Params, greedy};
+use cellseq::solvers::{Budget, Context, NoObserver, greedy};
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -52,7 +52,6 @@ fn benches(cr: &mut Criterion) {
     let c = Costs::open(&m);
     let seq = greedy::geometric(&m, &mut |_| {});
     let s0 = Solution::new(&c, &seq);
-    let params = Params::default();
 
     let mut g = cr.benchmark_group("engine");
     let mut rng = ChaCha8Rng::seed_from_u64(1);
@@ -86,7 +85,7 @@ fn benches(cr: &mut Criterion) {
         b.iter(|| {
             let mut s = bs.clone();
             let mut obs = NoObserver;
-            let mut ctx = Context::new(&big, &bm, &params, 1, Budget::default(), &mut obs);
+            let mut ctx = Context::new(&big, &bm, 1, Budget::default(), &mut obs);
             bsearch.or_opt(&mut s, &mut ctx);
             black_box(s.cost)
         })
@@ -95,7 +94,7 @@ fn benches(cr: &mut Criterion) {
         b.iter(|| {
             let mut s = bs.clone();
             let mut obs = NoObserver;
-            let mut ctx = Context::new(&big, &bm, &params, 1, Budget::default(), &mut obs);
+            let mut ctx = Context::new(&big, &bm, 1, Budget::default(), &mut obs);
             bsearch.two_opt(&mut s, &mut ctx);
             black_box(s.cost)
         })
@@ -115,7 +114,7 @@ fn benches(cr: &mut Criterion) {
         g.bench_function(name, |b| {
             b.iter(|| {
                 let mut obs = NoObserver;
-                let mut ctx = Context::new(&pts, &pm, &params, 1, Budget::default(), &mut obs);
+                let mut ctx = Context::new(&pts, &pm, 1, Budget::default(), &mut obs);
                 let mut l = Large::new(pc, &pnb, &ps);
                 l.three = three;
                 l.optimize(&mut ctx);
@@ -137,7 +136,7 @@ fn benches(cr: &mut Criterion) {
         |b| {
             b.iter(|| {
                 let mut obs = NoObserver;
-                let mut ctx = Context::new(&sym, &sm, &params, 1, Budget::default(), &mut obs);
+                let mut ctx = Context::new(&sym, &sm, 1, Budget::default(), &mut obs);
                 let mut s = ss.clone();
                 let mut lk = Lk::new(&sc, 12, 3);
                 lk.penalty = 2.0 * s.cost / 201.0;
@@ -157,7 +156,7 @@ fn benches(cr: &mut Criterion) {
     let mut os = Solution::new(&oc, &greedy::matrix(&om, &mut |_| {}));
     {
         let mut obs = NoObserver;
-        let mut ctx = Context::new(&sop, &om, &params, 1, Budget::default(), &mut obs);
+        let mut ctx = Context::new(&sop, &om, 1, Budget::default(), &mut obs);
         osearch.or_opt(&mut os, &mut ctx);
     }
     let every: Vec<u32> = (0..os.n() as u32).collect();
@@ -167,7 +166,7 @@ fn benches(cr: &mut Criterion) {
         |b| {
             b.iter(|| {
                 let mut obs = NoObserver;
-                let mut ctx = Context::new(&sop, &om, &params, 1, Budget::default(), &mut obs);
+                let mut ctx = Context::new(&sop, &om, 1, Budget::default(), &mut obs);
                 let mut s = os.clone();
                 while sop3_two_way(&osearch, &mut two_way, &mut s, &mut ctx, &every) {}
                 black_box(s.cost)
@@ -188,7 +187,7 @@ fn benches(cr: &mut Criterion) {
         b.iter(|| {
             let mut s = s0.clone();
             let mut obs = NoObserver;
-            let mut ctx = Context::new(&inst, &m, &params, 1, Budget::default(), &mut obs);
+            let mut ctx = Context::new(&inst, &m, 1, Budget::default(), &mut obs);
             let mut rng = ChaCha8Rng::seed_from_u64(3);
             anneal.run(&mut ctx, &c, &mut s, None, &mut rng);
             black_box(s.cost)
@@ -205,7 +204,7 @@ fn benches(cr: &mut Criterion) {
         };
         b.iter(|| {
             let mut obs = NoObserver;
-            let mut ctx = Context::new(&inst, &m, &params, 1, Budget::default(), &mut obs);
+            let mut ctx = Context::new(&inst, &m, 1, Budget::default(), &mut obs);
             tabu.iter += 1;
             tabu_step(&c, &search, &mut s, &mut tabu, f64::NEG_INFINITY, &mut ctx);
             black_box(s.cost)
@@ -228,7 +227,7 @@ fn benches(cr: &mut Criterion) {
         let mut rng = ChaCha8Rng::seed_from_u64(5);
         b.iter(|| {
             let mut obs = NoObserver;
-            let mut ctx = Context::new(&inst, &m, &params, 1, Budget::default(), &mut obs);
+            let mut ctx = Context::new(&inst, &m, 1, Budget::default(), &mut obs);
             black_box(aco.construct(&mut ctx, &mut tau, 1e-6, &mut rng).len())
         })
     });

@@ -10,8 +10,7 @@
 //! with a header if the file is new; `greedy_air` is the greedy air length measured in the same
 //! process after the solver, so the peak memory is the solver's).
 
-use cellseq::model::Objective;
-use cellseq::solvers::{self, Budget, NoObserver};
+use cellseq::{Budget, Objective, Solve, SolverKind};
 use std::collections::BTreeMap;
 use std::time::Instant;
 
@@ -49,7 +48,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             } else if k == "evals" {
                 budget.max_evals = Some(v.parse()?);
             } else if k == "seconds" {
-                budget.time_limit = Some(std::time::Duration::from_secs_f64(v.parse()?));
+                budget.time_limit = Budget::seconds(v.parse()?)?.time_limit;
             } else if let Some(g) = k.strip_prefix("gen.") {
                 gp.insert(g.into(), v.into());
             } else {
@@ -65,15 +64,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         t.elapsed().as_secs_f64()
     );
     let t = Instant::now();
-    let r = solvers::run(
-        &solver,
-        &inst,
-        Objective::Air,
-        &sp,
-        1,
-        budget,
-        &mut NoObserver,
-    )?;
+    let r = Solve::new(solver.parse()?)
+        .params_text(&sp)
+        .budget(budget)
+        .objective(Objective::Air)
+        .run(&inst)?;
     let elapsed = t.elapsed().as_secs_f64();
     let peak = peak_rss_mib();
     println!(
@@ -84,17 +79,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let greedy_air = if solver == "greedy" {
             r.report.air_length
         } else {
-            solvers::run(
-                "greedy",
-                &inst,
-                Objective::Air,
-                &BTreeMap::new(),
-                1,
-                Budget::default(),
-                &mut NoObserver,
-            )?
-            .report
-            .air_length
+            Solve::new(SolverKind::Greedy)
+                .objective(Objective::Air)
+                .run(&inst)?
+                .report
+                .air_length
         };
         let params: Vec<String> = sp.iter().map(|(k, v)| format!("{k}={v}")).collect();
         let new = !std::path::Path::new(&path).exists();

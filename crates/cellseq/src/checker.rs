@@ -85,6 +85,18 @@ pub enum Violation {
 }
 
 /// Checks `seq` against `inst` and recomputes its report for `objective`.
+///
+/// ```
+/// use cellseq::prelude::*;
+///
+/// // three cells, cell 0 before cell 2
+/// let inst = Instance::from_matrix("three", 3, vec![0.0, 1.0, 5.0, 1.0, 0.0, 2.0, 5.0, 2.0, 0.0], &[(0, 2)])?;
+/// let good = vec![Visit::new(0, 0), Visit::new(1, 0), Visit::new(2, 0)];
+/// assert_eq!(cellseq::check(&inst, &good, Objective::Matrix).unwrap().cost, 3.0);
+/// let bad = vec![Visit::new(2, 0), Visit::new(1, 0), Visit::new(0, 0)];
+/// assert!(cellseq::check(&inst, &bad, Objective::Matrix).is_err());
+/// # Ok::<(), cellseq::Error>(())
+/// ```
 pub fn check(inst: &Instance, seq: &Sequence, objective: Objective) -> Result<Report, Violation> {
     let n = inst.cells.len();
     let mut position = vec![usize::MAX; n];

@@ -6,7 +6,6 @@
 
 use crate::cost::CostModel;
 use crate::model::{Instance, Sequence};
-use crate::params::Params;
 use std::time::{Duration, Instant};
 
 /// How much work a solver may do. Evaluation budgets make runs deterministic.
@@ -55,14 +54,13 @@ impl Observer for NoObserver {
     fn improved(&mut self, _p: Progress) {}
 }
 
-/// What a solver sees while it runs: the instance, its cost model, parameters, seed, budget.
+/// What a solver sees while it runs: the instance, its cost model, seed and budget (its
+/// parameters were read when it was built).
 pub struct Context<'a> {
     /// The instance.
     pub instance: &'a Instance,
     /// Arc costs and precedence.
     pub model: &'a CostModel,
-    /// Validated parameters.
-    pub params: &'a Params,
     /// Random seed.
     pub seed: u64,
     /// Budget.
@@ -78,7 +76,6 @@ impl<'a> Context<'a> {
     pub fn new(
         instance: &'a Instance,
         model: &'a CostModel,
-        params: &'a Params,
         seed: u64,
         budget: Budget,
         observer: &'a mut dyn Observer,
@@ -86,7 +83,6 @@ impl<'a> Context<'a> {
         Context {
             instance,
             model,
-            params,
             seed,
             budget,
             observer,
@@ -135,6 +131,7 @@ impl<'a> Context<'a> {
         }
     }
     /// Best cost reported so far.
+    #[cfg(any(test, feature = "internals"))]
     pub fn best(&self) -> f64 {
         self.best
     }

@@ -31,6 +31,95 @@ pub struct ParamSpec {
     pub help: &'static str,
 }
 
+/// A parameter value as a program gives it: typed, checked against the declared
+/// [`ParamKind`] when a solver or generator is built (an integer for an `Int`, a number for a
+/// `Float`, `true`/`false` for a `Bool`, text for a `Choice` or `Text`; text that parses as
+/// the declared type is accepted too, as on the command line).
+#[derive(Debug, Clone, PartialEq)]
+pub enum ParamValue {
+    /// A non-negative integer.
+    Int(u64),
+    /// A number.
+    Float(f64),
+    /// A truth value.
+    Bool(bool),
+    /// Text: a choice, a path, a list, or any value in its command-line spelling.
+    Text(String),
+}
+
+impl ParamValue {
+    /// The value in its command-line spelling (`--param KEY=VALUE`).
+    pub fn to_text(&self) -> String {
+        match self {
+            ParamValue::Int(v) => v.to_string(),
+            ParamValue::Float(v) => v.to_string(),
+            ParamValue::Bool(v) => v.to_string(),
+            ParamValue::Text(v) => v.clone(),
+        }
+    }
+
+    /// Checks the value's type against `spec`: an error names the owner, the parameter, the
+    /// type it needs and the value given.
+    pub fn check(&self, owner: &str, spec: &ParamSpec) -> Result<()> {
+        let fits = matches!(
+            (self, spec.kind),
+            (ParamValue::Text(_), _)
+                | (ParamValue::Int(_), ParamKind::Int | ParamKind::Float)
+                | (ParamValue::Float(_), ParamKind::Float)
+                | (ParamValue::Bool(_), ParamKind::Bool)
+        );
+        if !fits {
+            return Err(Error::Param(format!(
+                "'{owner}': parameter '{}' must be {}, got {self:?}",
+                spec.name,
+                wanted(spec.kind)
+            )));
+        }
+        check_value(owner, spec, &self.to_text())
+    }
+}
+
+macro_rules! int_value {
+    ($($t:ty),*) => {$(
+        impl From<$t> for ParamValue {
+            fn from(v: $t) -> Self {
+                ParamValue::Int(v as u64)
+            }
+        }
+    )*};
+}
+int_value!(u8, u16, u32, u64, usize);
+
+impl From<f64> for ParamValue {
+    fn from(v: f64) -> Self {
+        ParamValue::Float(v)
+    }
+}
+
+impl From<f32> for ParamValue {
+    fn from(v: f32) -> Self {
+        ParamValue::Float(v as f64)
+    }
+}
+
+impl From<bool> for ParamValue {
+    fn from(v: bool) -> Self {
+        ParamValue::Bool(v)
+    }
+}
+
+impl From<&str> for ParamValue {
+    fn from(v: &str) -> Self {
+        ParamValue::Text(v.to_string())
+    }
+}
+
+impl From<String> for ParamValue {
+    fn from(v: String) -> Self {
+        ParamValue::Text(v)
+    }
+}
+
 /// Validated parameter values (defaults filled in).
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Params {
@@ -66,6 +155,22 @@ impl Params {
                 .or_insert_with(|| s.default.to_string());
         }
         Ok(Params { values })
+    }
+    /// Validates typed values against `specs` ([`ParamValue::check`]): unknown names list the
+    /// known ones; the result is the same as [`Params::new`] with the values' text.
+    pub fn typed(
+        owner: &str,
+        specs: &[ParamSpec],
+        given: &[(String, ParamValue)],
+    ) -> Result<Params> {
+        let mut text = BTreeMap::new();
+        for (k, v) in given {
+            if let Some(spec) = specs.iter().find(|s| s.name == k) {
+                v.check(owner, spec)?;
+            }
+            text.insert(k.clone(), v.to_text());
+        }
+        Params::new(owner, specs, &text)
     }
     /// All values, defaults included.
     pub fn values(&self) -> &BTreeMap<String, String> {
@@ -115,17 +220,22 @@ fn check_value(owner: &str, spec: &ParamSpec, v: &str) -> Result<()> {
     if ok {
         Ok(())
     } else {
-        let want = match spec.kind {
-            ParamKind::Int => "a non-negative integer".to_string(),
-            ParamKind::Float => "a finite number".to_string(),
-            ParamKind::Bool => "true or false".to_string(),
-            ParamKind::Choice(c) => format!("one of {}", c.join(", ")),
-            ParamKind::Text => "non-empty text".to_string(),
-        };
         Err(Error::Param(format!(
-            "'{owner}': parameter '{}' must be {want}, got '{v}'",
-            spec.name
+            "'{owner}': parameter '{}' must be {}, got '{v}'",
+            spec.name,
+            wanted(spec.kind)
         )))
+    }
+}
+
+/// What a parameter of `kind` must be, in words.
+fn wanted(kind: ParamKind) -> String {
+    match kind {
+        ParamKind::Int => "a non-negative integer".to_string(),
+        ParamKind::Float => "a finite number".to_string(),
+        ParamKind::Bool => "true or false".to_string(),
+        ParamKind::Choice(c) => format!("one of {}", c.join(", ")),
+        ParamKind::Text => "non-empty text".to_string(),
     }
 }
 

@@ -2,13 +2,10 @@
 
 use super::solve::{load, objective_of};
 use anyhow::Result;
-use cellseq::bound::{self, BoundOptions};
-use cellseq::cost::CostModel;
 use cellseq::formats::best_known;
-use cellseq::solvers::{self, Budget, NoObserver};
+use cellseq::{BoundOptions, Solve, SolverKind, certified_gap_percent, lower_bounds};
 use clap::Args;
 use serde_json::json;
-use std::collections::BTreeMap;
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -35,27 +32,19 @@ pub fn bound(a: BoundArgs) -> Result<()> {
     let defaults = BoundOptions::default();
     let upper = (inst.n() <= defaults.lagrangian_max_cells && a.iterations > 0)
         .then(|| {
-            let given = BTreeMap::new();
-            solvers::run(
-                "greedy",
-                &inst,
-                objective,
-                &given,
-                1,
-                Budget::default(),
-                &mut NoObserver,
-            )
-            .ok()
-            .map(|r| r.report.cost)
+            Solve::new(SolverKind::Greedy)
+                .objective(objective)
+                .run(&inst)
+                .ok()
+                .map(|r| r.cost())
         })
         .flatten();
-    let model = CostModel::new(&inst, objective);
     let opts = BoundOptions {
         lagrangian_iterations: a.iterations,
         upper,
         ..defaults
     };
-    let b = bound::compute(&model, &opts);
+    let b = lower_bounds(&inst, objective, &opts)?;
     let total = t.elapsed().as_secs_f64();
     let bk = best_known(&a.file).map(|x| x.0);
     if a.json {
@@ -69,19 +58,19 @@ pub fn bound(a: BoundArgs) -> Result<()> {
             json!({
                 "instance": inst.name,
                 "cells": inst.n(),
-                "objective": model.objective().name(),
+                "objective": objective.name(),
                 "bounds": parts,
                 "lower_bound": b.best,
                 "best_bound": b.best_name,
                 "upper_bound": upper,
                 "best_known": bk,
-                "certified_gap_percent": upper.and_then(|u| bound::certified_gap_percent(u, b.best)),
+                "certified_gap_percent": upper.and_then(|u| certified_gap_percent(u, b.best)),
                 "elapsed_s": total,
             })
         );
     } else {
         say!("instance        {} ({} cells)", inst.name, inst.n());
-        say!("objective       {}", model.objective().name());
+        say!("objective       {}", objective.name());
         for p in &b.parts {
             say!("{:<15} {}  ({:.3} s)", p.name, fmt(p.value), p.seconds);
         }
@@ -90,7 +79,7 @@ pub fn bound(a: BoundArgs) -> Result<()> {
             say!("greedy          {}", fmt(u));
         }
         if let Some(k) = bk {
-            let g = bound::certified_gap_percent(k, b.best).unwrap_or(0.0);
+            let g = certified_gap_percent(k, b.best).unwrap_or(0.0);
             say!(
                 "best known      {}  (bound is {:.3} % below)",
                 fmt(k),

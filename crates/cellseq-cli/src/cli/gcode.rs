@@ -179,12 +179,12 @@ fn optimize_gcode(a: &OptimizeArgs) -> anyhow::Result<()> {
     let text = read_text(&a.input)?;
     let parsed = gcode::parse(&file, &text)?;
     let parse_s = t0.elapsed().as_secs_f64();
-    let solver = a
-        .solver
-        .clone()
-        .unwrap_or_else(|| cellseq::solvers::DEFAULT_SOLVER.to_string());
+    let solver: cellseq::SolverKind = match &a.solver {
+        Some(s) => s.parse()?,
+        None => cellseq::SolverKind::default(),
+    };
     let opts = Options {
-        solver: solver.clone(),
+        solver,
         time_limit: a.time_limit,
         max_evals: a.max_evals,
         seed: a.seed,
@@ -210,7 +210,7 @@ fn optimize_gcode(a: &OptimizeArgs) -> anyhow::Result<()> {
         let v = serde_json::json!({
             "input": file,
             "output": a.output.as_ref().map(|p| p.display().to_string()),
-            "solver": solver,
+            "solver": solver.name(),
             "cells": parsed.layout.cells.len(),
             "tool_blocks": parsed.layout.blocks.len(),
             "groups": out.groups,

@@ -1,7 +1,6 @@
 //! `check`, `run`, `merge`, `report`: the research harness (see `cellseq_lab`).
 
 use anyhow::{Context as _, Result, bail};
-use cellseq::solvers::auto::portfolio;
 use cellseq_lab::plan::{Limits, Plan};
 use cellseq_lab::run::{RunOptions, run_plan};
 use cellseq_lab::{report, results};
@@ -100,7 +99,7 @@ pub fn check(a: CheckArgs) -> Result<()> {
     if a.shards == 0 || a.threads == Some(0) {
         bail!("--shards and --threads must be at least 1");
     }
-    if portfolio::is_portfolio_file(&a.plan) {
+    if cellseq::registry::is_portfolio_file(&a.plan) {
         return check_portfolio(&a.plan);
     }
     let plan = Plan::load_with(&a.plan, a.limits.limits())?;
@@ -125,8 +124,7 @@ fn check_portfolio(path: &Path) -> Result<()> {
     let text = path
         .to_str()
         .with_context(|| format!("{}: the path is not UTF-8", path.display()))?;
-    let p = portfolio::Portfolio::load(text)?;
-    let names: Vec<&str> = p.rules.iter().map(|r| r.name.as_str()).collect();
+    let names = cellseq::registry::validate_portfolio(text)?;
     say!(
         "ok: portfolio with {} rules ({})",
         names.len(),

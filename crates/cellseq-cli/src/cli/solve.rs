@@ -1,14 +1,15 @@
 //! `info`, `validate`, `solve`, `eval`, `solvers`, `generate`.
 
 use anyhow::{Context as _, Result, bail};
-use cellseq::formats::json::{self, SOLUTION_FORMAT, SolutionFile};
+use cellseq::formats::json;
 use cellseq::formats::{self, best_known};
 use cellseq::model::{Instance, Objective};
-use cellseq::solvers::{self, Budget, NoObserver, RunResult, parse_kv};
+use cellseq::params::parse_kv;
+use cellseq::registry::{self, DEFAULT_SOLVER};
+use cellseq::{Solve, Solved, SolverKind};
 use clap::Args;
 use serde_json::json;
 use std::path::{Path, PathBuf};
-use std::time::Duration;
 
 #[derive(Args, Debug)]
 pub struct InfoArgs {
@@ -27,7 +28,7 @@ pub struct SolveArgs {
     /// Instance file.
     pub file: PathBuf,
     /// Solver name (see `cellseq solvers`).
-    #[arg(long, default_value = solvers::DEFAULT_SOLVER)]
+    #[arg(long, default_value = DEFAULT_SOLVER)]
     pub solver: String,
     /// Solver parameter KEY=VALUE (repeatable).
     #[arg(long = "param", value_name = "KEY=VALUE")]
@@ -165,9 +166,10 @@ pub fn solve(a: SolveArgs) -> Result<()> {
     if let Some(out) = &a.out {
         cellseq::files::ensure_not_input(&a.file, out, a.overwrite_input)?;
     }
+    let kind: SolverKind = a.solver.parse()?;
     let mut params = parse_kv(&a.params)?;
     if let Some(p) = &a.portfolio {
-        if a.solver != solvers::auto::INFO.name {
+        if kind != SolverKind::Auto {
             bail!("--portfolio applies to the auto solver, not '{}'", a.solver);
         }
         if params.contains_key("portfolio") {
@@ -178,19 +180,36 @@ pub fn solve(a: SolveArgs) -> Result<()> {
             .with_context(|| format!("--portfolio {}: the path is not UTF-8", p.display()))?;
         params.insert("portfolio".to_string(), p.to_string());
     }
-    if a.explain && a.solver != solvers::auto::INFO.name {
+    if a.explain && kind != SolverKind::Auto {
         bail!(
             "--explain describes the auto solver's choice; '{}' has none",
             a.solver
         );
     }
+    let mut solve = Solve::new(kind)
+        .params_text(&params)
+        .seed(a.seed)
+        .lower_bound(!a.no_bound);
+    if let Some(t) = a.time_limit {
+        solve = solve.time_limit(cellseq::solve::checked_seconds("--time-limit", t).map_err(
+            |_| {
+                anyhow::anyhow!(
+                    "--time-limit must be a positive number of seconds (at most {:e}), got {t}",
+                    cellseq::solve::MAX_SECONDS
+                )
+            },
+        )?);
+    }
+    if let Some(n) = a.max_evals {
+        solve = solve.max_evals(n);
+    }
     // the solver and its parameters (an auto portfolio file) are checked before the instance
     // is read
-    solvers::find(&a.solver)?.build(&params)?;
+    solve.validated_params()?;
     let inst = load(&a.file)?;
     let objective = objective_of(&inst, a.objective.as_deref())?;
     let explained = if a.explain {
-        Some(solvers::auto::explain(&inst, objective, &params)?)
+        Some(registry::explain(&inst, objective, &params)?)
     } else {
         None
     };
@@ -199,120 +218,32 @@ pub fn solve(a: SolveArgs) -> Result<()> {
             say!("{l}");
         }
     }
-    if let Some(t) = a.time_limit
-        && !(t.is_finite() && t > 0.0)
-    {
-        bail!("--time-limit must be a positive number of seconds, got {t}");
-    }
-    let budget = Budget {
-        time_limit: a.time_limit.map(Duration::from_secs_f64),
-        max_evals: a.max_evals,
-    };
-    let mut r = solvers::run(
-        &a.solver,
-        &inst,
-        objective,
-        &params,
-        a.seed,
-        budget,
-        &mut NoObserver,
-    )?;
-    if !a.no_bound {
-        attach_bound(&inst, &mut r);
-    }
+    let r = solve.objective(objective).run(&inst)?;
     let bk = best_known(&a.file).map(|b| b.0);
     if let Some(out) = &a.out {
-        let sol = solution_file(&inst, &a.solver, a.seed, &r);
-        cellseq::files::write_atomic(out, json::solution_to_json(&sol).as_bytes())
+        r.save(&inst, out)
             .with_context(|| format!("writing {}", out.display()))?;
     }
     if a.json {
-        let mut v = result_json(&inst, &a.solver, a.seed, &r, bk);
+        let mut v = r.to_json(&inst, bk);
         if let (Some(e), Some(o)) = (&explained, v.as_object_mut()) {
             o.insert("explain".to_string(), serde_json::to_value(e)?);
         }
         say!("{}", serde_json::to_string(&v)?);
     } else {
-        print_report(&inst, &a.solver, &r, bk);
+        print_report(&inst, &r, bk);
     }
     Ok(())
-}
-
-/// Largest instance for which `solve` computes a lower bound after solving.
-pub const SOLVE_BOUND_MAX_CELLS: usize = 200_000;
-
-/// Raises the run's lower bound with [`cellseq::bound::compute`] (cheap settings).
-pub fn attach_bound(inst: &Instance, r: &mut RunResult) {
-    if inst.n() > SOLVE_BOUND_MAX_CELLS || r.outcome.proven_optimal {
-        return;
-    }
-    let model = cellseq::cost::CostModel::new(inst, r.objective);
-    let opts = cellseq::bound::BoundOptions {
-        lagrangian_iterations: 100,
-        lagrangian_max_cells: 200,
-        assignment_max_cells: 1000,
-        upper: Some(r.report.cost),
-        ..Default::default()
-    };
-    let b = cellseq::bound::compute(&model, &opts).best;
-    r.outcome.lower_bound = Some(r.outcome.lower_bound.map_or(b, |x| x.max(b)));
-}
-
-/// The solution file of a run.
-pub fn solution_file(inst: &Instance, solver: &str, seed: u64, r: &RunResult) -> SolutionFile {
-    SolutionFile {
-        format: SOLUTION_FORMAT.into(),
-        instance: inst.name.clone(),
-        solver: solver.into(),
-        seed,
-        objective: r.objective.name().into(),
-        sequence: json::to_refs(inst, &r.outcome.sequence),
-        report: Some(r.report),
-    }
 }
 
 fn gap(cost: f64, bk: Option<f64>) -> Option<f64> {
     bk.filter(|&b| b > 0.0).map(|b| 100.0 * (cost - b) / b)
 }
 
-/// The `--json` object of a run.
-pub fn result_json(
-    inst: &Instance,
-    solver: &str,
-    seed: u64,
-    r: &RunResult,
-    bk: Option<f64>,
-) -> serde_json::Value {
-    let rep = &r.report;
-    json!({
-        "instance": inst.name,
-        "solver": solver,
-        "seed": seed,
-        "objective": r.objective.name(),
-        "feasible": true,
-        "cost": rep.cost,
-        "air_length": rep.air_length,
-        "cut_length": rep.cut_length,
-        "path_length": rep.path_length,
-        "lifts": rep.lifts,
-        "tool_changes": rep.tool_changes,
-        "machining_time": rep.machining_time,
-        "best_known": bk,
-        "gap_percent": gap(rep.cost, bk),
-        "proven_optimal": r.outcome.proven_optimal,
-        "lower_bound": r.outcome.lower_bound,
-        "certified_gap_percent": r.outcome.lower_bound
-            .and_then(|lb| cellseq::bound::certified_gap_percent(rep.cost, lb)),
-        "evaluations": r.evaluations,
-        "elapsed_s": r.elapsed_s,
-        "sequence": json::to_refs(inst, &r.outcome.sequence),
-    })
-}
-
-fn print_report(inst: &Instance, solver: &str, r: &RunResult, bk: Option<f64>) {
+fn print_report(inst: &Instance, r: &Solved, bk: Option<f64>) {
     let rep = &r.report;
     say!("instance        {} ({} cells)", inst.name, inst.n());
-    say!("solver          {solver}");
+    say!("solver          {}", r.solver);
     say!("objective       {}", r.objective.name());
     say!("cost            {}", fmt_num(rep.cost));
     if !inst.is_matrix() {
@@ -330,12 +261,12 @@ fn print_report(inst: &Instance, solver: &str, r: &RunResult, bk: Option<f64>) {
             gap(rep.cost, Some(b)).unwrap_or(0.0)
         );
     }
-    if r.outcome.proven_optimal {
+    if r.proven_optimal {
         say!("proven optimal  yes");
     }
-    if let Some(lb) = r.outcome.lower_bound {
+    if let Some(lb) = r.lower_bound {
         say!("lower bound     {}", fmt_num(lb));
-        if let Some(g) = cellseq::bound::certified_gap_percent(rep.cost, lb) {
+        if let Some(g) = r.certified_gap_percent() {
             say!("certified gap   {g:.3} %");
         }
     }
@@ -397,18 +328,18 @@ pub struct SolversArgs {
 
 pub fn solvers(a: SolversArgs) -> Result<()> {
     if a.markdown {
-        say!("{}", solvers::docs::markdown().trim_end());
+        say!("{}", registry::markdown().trim_end());
         return Ok(());
     }
-    for s in solvers::registry() {
-        let default = if s.name == solvers::DEFAULT_SOLVER {
+    for s in registry::all() {
+        let default = if s.name == DEFAULT_SOLVER {
             "  (default)"
         } else {
             ""
         };
         say!("{}{default}\n    {}", s.name, s.summary);
         for p in s.params {
-            let kind = solvers::docs::kind_label(&p.kind);
+            let kind = registry::kind_label(&p.kind);
             say!("    --param {}={}  [{kind}]  {}", p.name, p.default, p.help);
         }
     }

@@ -3,6 +3,7 @@
 use super::gcode::{ImportArgs, OptimizeArgs};
 use super::rows::{Table, say_wrote, write_output};
 use anyhow::{Context as _, bail};
+use cellseq::SolverKind;
 use cellseq::files::read_text;
 use cellseq::formats::save_instance;
 use cellseq_programs::optimize::strokes as pipe;
@@ -94,7 +95,14 @@ pub fn import(a: &ImportArgs, fmt: &str) -> anyhow::Result<()> {
     } else {
         read_dxf(&a.input, &a.drawing)?
     };
-    let mut opts = svg_options(&d, &a.drawing, !a.no_reversible, "greedy", None, 1);
+    let mut opts = svg_options(
+        &d,
+        &a.drawing,
+        !a.no_reversible,
+        SolverKind::Greedy,
+        None,
+        1,
+    );
     if fmt == "dxf" {
         opts.cut = !a.drawing.no_inner_first;
     }
@@ -140,12 +148,12 @@ fn svg_options(
     d: &svg::Drawing,
     a: &DrawingArgs,
     reversible: bool,
-    solver: &str,
+    solver: SolverKind,
     time_limit: Option<f64>,
     seed: u64,
 ) -> pipe::Options {
     pipe::Options {
-        solver: solver.to_string(),
+        solver,
         time_limit,
         max_evals: None,
         params: Default::default(),
@@ -161,15 +169,18 @@ fn svg_options(
 
 /// The solver (default `drawing`), whether strokes may be reversed (by default yes) and the
 /// pipeline options of `optimize` on drawing `d`.
-fn optimize_options(a: &OptimizeArgs, d: &svg::Drawing) -> (String, bool, pipe::Options) {
+fn optimize_options(
+    a: &OptimizeArgs,
+    d: &svg::Drawing,
+) -> anyhow::Result<(SolverKind, bool, pipe::Options)> {
     let reversible = !a.no_reversible;
-    let solver = a
-        .solver
-        .clone()
-        .unwrap_or_else(|| pipe::DRAWING_SOLVER.to_string());
-    let mut opts = svg_options(d, &a.drawing, reversible, &solver, a.time_limit, a.seed);
+    let solver = match &a.solver {
+        Some(s) => s.parse()?,
+        None => pipe::DRAWING_SOLVER,
+    };
+    let mut opts = svg_options(d, &a.drawing, reversible, solver, a.time_limit, a.seed);
     opts.max_evals = a.max_evals;
-    (solver, reversible, opts)
+    Ok((solver, reversible, opts))
 }
 
 /// The elements the reader skipped, and the note when the original order was kept.
@@ -187,7 +198,7 @@ fn optimize_svg(a: &OptimizeArgs) -> anyhow::Result<()> {
     let t0 = std::time::Instant::now();
     let d = read_svg(&a.input, &a.drawing)?;
     let read_s = t0.elapsed().as_secs_f64();
-    let (solver, reversible, opts) = optimize_options(a, &d);
+    let (solver, reversible, opts) = optimize_options(a, &d)?;
     let mut out = pipe::optimize(&d, &opts)?;
     let (text, segments) = pipe::render(&d, &mut out, pipe::Output::Svg)?;
     write_output(a.output.as_deref(), &text)?;
@@ -196,7 +207,7 @@ fn optimize_svg(a: &OptimizeArgs) -> anyhow::Result<()> {
         let v = serde_json::json!({
             "input": file,
             "output": a.output.as_ref().map(|p| p.display().to_string()),
-            "solver": solver,
+            "solver": solver.name(),
             "strokes": d.strokes.len(),
             "scopes": out.scopes,
             "precedence_edges": out.edges,
@@ -273,7 +284,7 @@ fn optimize_dxf(a: &OptimizeArgs) -> anyhow::Result<()> {
     for w in &d.warnings {
         eprintln!("warning: {file}: {w}");
     }
-    let (solver, reversible, mut opts) = optimize_options(a, &d);
+    let (solver, reversible, mut opts) = optimize_options(a, &d)?;
     opts.cut = !a.drawing.no_inner_first;
     let mut out = pipe::optimize(&d, &opts)?;
     let post = dxf::Post {
@@ -303,7 +314,7 @@ fn optimize_dxf(a: &OptimizeArgs) -> anyhow::Result<()> {
             "input": file,
             "output": a.output.as_ref().map(|p| p.display().to_string()),
             "output_kind": if preview { "svg" } else { "gcode" },
-            "solver": solver,
+            "solver": solver.name(),
             "contours": d.strokes.len(),
             "closed_contours": closed,
             "layers": d.layers.len() - 1,

@@ -254,7 +254,7 @@ fn check_node_bounds_along_optimum(inst: &Instance, obj: Objective) {
                 p + 1
             );
         }
-        let cl = bound::closure::Closure::new(&m.dag).expect("acyclic");
+        let cl = cellseq::precedence::Closure::new(&m.dag).expect("acyclic");
         let g = bound::cells::CellGraph::new(&m, &cl);
         if let Some(s) =
             bound::sec::sec_bound(&g, Some(&cl), upper.map(|u| u - m.constant()), 200, 64)
@@ -503,7 +503,7 @@ fn near_twins_are_ordered_by_constraint() {
     let text = near_twin_sop_text(6, &costs, &[false], &[6], &[(6, 3)]);
     let inst = formats::parse_instance("near.sop", &text, Format::Sop).unwrap();
     let m = CostModel::new(&inst, Objective::Matrix);
-    let cl = bound::closure::Closure::new(&m.dag).unwrap();
+    let cl = cellseq::precedence::Closure::new(&m.dag).unwrap();
     assert!(
         cl.ancestors(6) > cl.ancestors(1),
         "the copy is more constrained"

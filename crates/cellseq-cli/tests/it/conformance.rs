@@ -27,7 +27,7 @@ fn caps(name: &str) -> Caps {
         improves_start: info.caps.improves,
         // an exact solver with its own warm start (beam) answers from any budget; one without
         // (exact) has no answer before its proof
-        exact: info.caps.exact && !info.caps.warm_start,
+        exact: info.caps.exact && !info.warm_start(),
     }
 }
 

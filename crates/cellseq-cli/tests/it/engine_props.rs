@@ -56,16 +56,14 @@ fn close(a: f64, b: f64) -> bool {
 }
 
 /// `s` is a permutation of the model's cells, `pos` inverts `order`, and every mode exists.
-/// What a search context borrows, for tests: empty parameters and no observer.
+/// What a search context borrows, for tests: no observer.
 struct Ctx {
-    params: cellseq::params::Params,
     obs: cellseq::solvers::NoObserver,
 }
 
 impl Ctx {
     fn new() -> Self {
         Ctx {
-            params: cellseq::params::Params::new("t", &[], &BTreeMap::new()).unwrap(),
             obs: cellseq::solvers::NoObserver,
         }
     }
@@ -80,7 +78,7 @@ impl Ctx {
             max_evals: Some(max_evals),
             ..Default::default()
         };
-        cellseq::solvers::Context::new(inst, m, &self.params, 1, budget, &mut self.obs)
+        cellseq::solvers::Context::new(inst, m, 1, budget, &mut self.obs)
     }
 }
 

@@ -265,7 +265,7 @@ fn as_given_writes_the_program_as_it_is() {
         let out = optimize(
             &p,
             &Options {
-                solver: "as-given".into(),
+                solver: cellseq::SolverKind::AsGiven,
                 ..Options::default()
             },
         )

@@ -1,5 +1,6 @@
 //! SVG reader, sequencer, writer and verifier.
 
+use cellseq::SolverKind;
 use cellseq_programs::optimize::strokes::{self as pipe, Options};
 use cellseq_programs::svg::{self, ReadOptions};
 use proptest::prelude::*;
@@ -68,9 +69,9 @@ fn optimize_writes_the_same_drawing_with_less_pen_up() {
 #[test]
 fn registry_solver_and_no_reversal_also_verify() {
     let d = svg::read("s.svg", &fixture("shapes.svg"), ReadOptions::default()).unwrap();
-    for (solver, rev) in [("as-given", true), ("drawing", false)] {
+    for (solver, rev) in [(SolverKind::AsGiven, true), (SolverKind::Drawing, false)] {
         let o = Options {
-            solver: solver.into(),
+            solver,
             reversible: rev,
             ..Options::default()
         };

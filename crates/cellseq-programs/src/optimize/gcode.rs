@@ -5,16 +5,16 @@
 
 use super::{Allowance, Timings, solve_group};
 use crate::gcode::{self, Figures, Parsed, Verification, Verifier, reverse, write};
+use cellseq::SolverKind;
 use cellseq::error::Result;
 use cellseq::model::Objective;
-use cellseq::solvers;
 use std::time::Instant;
 
 /// Options of [`optimize`].
 #[derive(Debug, Clone)]
 pub struct Options {
-    /// Solver from the registry.
-    pub solver: String,
+    /// The solver.
+    pub solver: SolverKind,
     /// Time limit (s) of the whole command (parse, solve, verify, write).
     pub time_limit: Option<f64>,
     /// Evaluation budget shared among groups by size (deterministic).
@@ -34,7 +34,7 @@ pub struct Options {
 impl Default for Options {
     fn default() -> Self {
         Options {
-            solver: solvers::DEFAULT_SOLVER.to_string(),
+            solver: SolverKind::default(),
             time_limit: None,
             max_evals: None,
             seed: 1,
@@ -238,7 +238,7 @@ fn solve_groups(
             Some(solve_group(
                 &inst,
                 Objective::Air,
-                &opts.solver,
+                opts.solver,
                 &Default::default(),
                 opts.seed,
                 budget,

@@ -14,7 +14,7 @@ pub mod strokes;
 
 use cellseq::error::{Error, Result};
 use cellseq::model::{Instance, Objective, Sequence, Visit};
-use cellseq::solvers::{self, Budget, NoObserver};
+use cellseq::{Budget, Solve, SolverKind};
 use serde::Serialize;
 use std::collections::BTreeMap;
 use std::time::{Duration, Instant};
@@ -134,7 +134,7 @@ pub fn original_order(inst: &Instance) -> Sequence {
 pub fn solve_group(
     inst: &Instance,
     objective: Objective,
-    solver: &str,
+    solver: SolverKind,
     params: &BTreeMap<String, String>,
     seed: u64,
     budget: Budget,
@@ -155,7 +155,7 @@ pub fn solve_group(
                 .cost
         }
     };
-    if solver == "as-given" {
+    if solver == SolverKind::AsGiven {
         return Ok(GroupSolve {
             sequence: original,
             kept_original: true,
@@ -164,19 +164,16 @@ pub fn solve_group(
             elapsed_s: 0.0,
         });
     }
-    let r = solvers::run(
-        solver,
-        inst,
-        objective,
-        params,
-        seed,
-        budget,
-        &mut NoObserver,
-    )?;
+    let r = Solve::new(solver)
+        .params_text(params)
+        .seed(seed)
+        .budget(budget)
+        .objective(objective)
+        .run(inst)?;
     let better = r.report.cost < original_cost - 1e-9 * original_cost.abs().max(1.0);
     Ok(GroupSolve {
         kept_original: !better,
-        sequence: if better { r.outcome.sequence } else { original },
+        sequence: if better { r.sequence } else { original },
         original_cost,
         solver_cost: r.report.cost,
         elapsed_s: r.elapsed_s,

@@ -10,6 +10,7 @@ use super::{Allowance, solve_group};
 use crate::drawing::{Drawing, PenUp, Stroke, pen_up};
 use crate::dxf::{self, Post};
 use crate::svg;
+use cellseq::SolverKind;
 use cellseq::error::{Error, Result};
 use cellseq::geom::Point3;
 use cellseq::geom::polygon::PolygonIndex;
@@ -19,8 +20,9 @@ use rstar::primitives::{GeomWithData, Rectangle};
 
 pub mod blocks;
 
-/// The registry solver drawings get by default ([`cellseq::solvers::drawing`]).
-pub const DRAWING_SOLVER: &str = "drawing";
+/// The registry solver drawings get by default (`drawing`: 2-opt and Or-opt with reversal,
+/// then iterated local search).
+pub const DRAWING_SOLVER: SolverKind = SolverKind::Drawing;
 
 /// Evaluations per stroke of the default budget (deterministic, linear in the drawing's size);
 /// see `notes/svg.md` for the measurements behind it.
@@ -32,8 +34,8 @@ pub const MIN_EVALS: u64 = 1_000_000;
 /// Options of [`optimize`].
 #[derive(Debug, Clone)]
 pub struct Options {
-    /// Solver name.
-    pub solver: String,
+    /// The solver.
+    pub solver: SolverKind,
     /// Total time limit (s), shared among scopes by size.
     pub time_limit: Option<f64>,
     /// Total evaluation budget, shared among scopes by size. Without this and without a time
@@ -64,7 +66,7 @@ pub struct Options {
 impl Default for Options {
     fn default() -> Self {
         Options {
-            solver: DRAWING_SOLVER.to_string(),
+            solver: DRAWING_SOLVER,
             time_limit: None,
             max_evals: None,
             params: Default::default(),
@@ -447,13 +449,13 @@ fn solve_pass(
         let r = solve_group(
             &inst,
             Objective::Air,
-            &opts.solver,
+            opts.solver,
             &opts.params,
             opts.seed,
             budget,
         )?;
         p.solve_s += r.elapsed_s;
-        p.kept += usize::from(r.kept_original && opts.solver != "as-given");
+        p.kept += usize::from(r.kept_original && opts.solver != SolverKind::AsGiven);
         let first = p.strokes.len();
         for v in &r.sequence {
             let (rev, k) = orient[v.cell][v.mode];

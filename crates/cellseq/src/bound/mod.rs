@@ -24,9 +24,6 @@ pub mod sec;
 
 use crate::cost::CostModel;
 use crate::precedence::Closure;
-/// The precedence closure, which lives with the DAG ([`crate::precedence::closure`]);
-/// re-exported here for callers that named it `bound::closure`.
-pub use crate::precedence::closure;
 use cells::CellGraph;
 use std::time::Instant;
 

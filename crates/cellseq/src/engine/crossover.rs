@@ -27,6 +27,7 @@ pub struct Crossover {
 impl Crossover {
     /// The number of segments of the last crossover (1 when the parents share no cut but
     /// the end).
+    #[cfg(any(test, feature = "internals"))]
     pub fn segments(&self) -> usize {
         self.cuts.len()
     }

@@ -528,7 +528,6 @@ mod tests {
     use crate::cost::CostModel;
     use crate::engine::vnd::Search;
     use crate::model::{Instance, Objective, Sequence, Visit};
-    use crate::params::Params;
     use rand::{RngExt, SeedableRng};
     use rand_chacha::ChaCha8Rng;
 
@@ -574,9 +573,8 @@ mod tests {
     fn descend_with(inst: &Instance, depth: usize, penalty: f64) -> (f64, f64, Vec<u32>, bool) {
         let m = CostModel::new(inst, Objective::Matrix);
         let c = Costs::open(&m);
-        let params = Params::new("t", &[], &Default::default()).expect("params");
         let mut obs = NoObserver;
-        let mut ctx = Context::new(inst, &m, &params, 1, Budget::default(), &mut obs);
+        let mut ctx = Context::new(inst, &m, 1, Budget::default(), &mut obs);
         let seq: Sequence = (0..inst.n()).map(|c| Visit::new(c, 0)).collect();
         let mut s = Solution::new(&c, &seq);
         let start = s.cost;
@@ -642,9 +640,8 @@ mod tests {
         // at an LK optimum a further pass changes nothing
         let m = CostModel::new(&inst, Objective::Matrix);
         let c = Costs::open(&m);
-        let params = Params::new("t", &[], &Default::default()).expect("params");
         let mut obs = NoObserver;
-        let mut ctx = Context::new(&inst, &m, &params, 1, Budget::default(), &mut obs);
+        let mut ctx = Context::new(&inst, &m, 1, Budget::default(), &mut obs);
         let seq: Sequence = a.2.iter().map(|&c| Visit::new(c as usize, 0)).collect();
         let mut s = Solution::new(&c, &seq);
         let before = s.clone();

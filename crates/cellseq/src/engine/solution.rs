@@ -82,6 +82,7 @@ impl Solution {
     }
     /// Position of the earliest successor of `cell` (n if none).
     #[inline]
+    #[cfg(any(test, feature = "internals"))]
     pub fn first_succ(&self, m: &CostModel, cell: usize) -> isize {
         m.dag.succs[cell]
             .iter()
@@ -90,6 +91,7 @@ impl Solution {
             .unwrap_or(self.n() as isize)
     }
     /// True when every precedence pair is respected (O(n + edges), for assertions and tests).
+    #[cfg(any(test, feature = "internals"))]
     pub fn feasible(&self, m: &CostModel) -> bool {
         (0..self.n()).all(|c| {
             m.dag.succs[c]

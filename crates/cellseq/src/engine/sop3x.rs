@@ -387,7 +387,6 @@ mod tests {
     use crate::context::{Budget, NoObserver};
     use crate::cost::CostModel;
     use crate::model::{Instance, Objective};
-    use crate::params::Params;
     use rand::{RngExt, SeedableRng};
     use rand_chacha::ChaCha8Rng;
 
@@ -446,9 +445,8 @@ mod tests {
             let inst = instance(40, seed);
             let m = CostModel::new(&inst, Objective::Matrix);
             let c = Costs::open(&m);
-            let params = Params::new("t", &[], &Default::default()).expect("params");
             let mut obs = NoObserver;
-            let mut ctx = Context::new(&inst, &m, &params, 1, Budget::default(), &mut obs);
+            let mut ctx = Context::new(&inst, &m, 1, Budget::default(), &mut obs);
             let seq: crate::model::Sequence =
                 (0..40).map(|c| crate::model::Visit::new(c, 0)).collect();
             let mut s = Solution::new(&c, &seq);
@@ -485,9 +483,8 @@ mod tests {
             let m = CostModel::new(&inst, Objective::Matrix);
             let c = Costs::open(&m);
             let cl = m.closure();
-            let params = Params::new("t", &[], &Default::default()).expect("params");
             let mut obs = NoObserver;
-            let mut ctx = Context::new(&inst, &m, &params, 1, Budget::default(), &mut obs);
+            let mut ctx = Context::new(&inst, &m, 1, Budget::default(), &mut obs);
             let mut rng = ChaCha8Rng::seed_from_u64(seed);
             let mut plain = unbounded();
             let mut bounded = Labels::default();

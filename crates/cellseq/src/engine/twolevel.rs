@@ -90,6 +90,7 @@ impl TwoLevel {
     }
 
     /// Number of segments (for tests and statistics).
+    #[cfg(any(test, feature = "internals"))]
     pub fn segments(&self) -> usize {
         self.order.len()
     }

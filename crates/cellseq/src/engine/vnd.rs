@@ -368,7 +368,6 @@ mod tests {
     use crate::cost::CostModel;
     use crate::engine::moves::{SegmentMove, window};
     use crate::model::Objective;
-    use crate::params::Params;
 
     /// With candidate lists holding every cell, Or-opt ends where no single cell can move
     /// to any place its precedence allows, in any of its modes, for less: cells of several
@@ -385,9 +384,8 @@ mod tests {
             let inst = crate::generate::generate("generalized", &kv, seed).expect("generated");
             let m = CostModel::new(&inst, Objective::Matrix);
             let c = Costs::open(&m);
-            let params = Params::new("t", &[], &Default::default()).expect("params");
             let mut obs = NoObserver;
-            let mut ctx = Context::new(&inst, &m, &params, 1, Budget::default(), &mut obs);
+            let mut ctx = Context::new(&inst, &m, 1, Budget::default(), &mut obs);
             let mut s = Solution::new(&c, inst.as_given.as_ref().expect("as given"));
             let mut search = Search::new(c, m.n());
             let before = s.clone();

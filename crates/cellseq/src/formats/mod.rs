@@ -11,7 +11,7 @@ pub mod tsplib;
 
 use crate::error::{Error, Result};
 use crate::files::{read_text, write_atomic};
-use crate::model::Instance;
+use crate::model::{Cell, CostMatrix, Instance, Metadata, Mode};
 use std::path::Path;
 
 /// The instance formats cellseq reads.
@@ -123,4 +123,63 @@ pub fn best_known(path: &Path) -> Option<(f64, bool)> {
         }
     }
     None
+}
+
+impl Instance {
+    /// An instance given by an `n × n` cost matrix (row-major: `costs[a * n + b]` is the cost
+    /// of cutting cell `b` right after cell `a`) and precedence pairs `(before, after)` of
+    /// 0-based cell indices: one mode per cell, an open path with no fixed first or last cell
+    /// (TSPLIB's SOP fixes both: give them as precedence). Cells are named `1`…`n`. Validated
+    /// like a file: costs finite, in 0..=10¹², precedence acyclic and in range.
+    pub fn from_matrix(
+        name: &str,
+        n: usize,
+        costs: Vec<f64>,
+        precedence: &[(usize, usize)],
+    ) -> Result<Instance> {
+        Instance::from_mode_matrix(name, &vec![1; n], costs, precedence)
+    }
+
+    /// The generalized form of [`Instance::from_matrix`]: cell `i` has `modes[i]` modes (the
+    /// ways to cut it: a direction, a start point), the matrix's nodes are the modes of every
+    /// cell, cell by cell (`modes.iter().sum()` nodes in all), and a sequence visits each cell
+    /// once in one of its modes.
+    pub fn from_mode_matrix(
+        name: &str,
+        modes: &[usize],
+        costs: Vec<f64>,
+        precedence: &[(usize, usize)],
+    ) -> Result<Instance> {
+        let size: usize = modes.iter().sum();
+        if modes.is_empty() || modes.contains(&0) {
+            return Err(Error::invalid(name, "every cell needs at least one mode"));
+        }
+        if size.checked_mul(size) != Some(costs.len()) {
+            return Err(Error::invalid(
+                name,
+                format!(
+                    "the cost matrix has {} entries; {size} modes need {size} x {size}",
+                    costs.len()
+                ),
+            ));
+        }
+        let cells = modes
+            .iter()
+            .enumerate()
+            .map(|(i, &k)| Cell::new((i + 1).to_string(), "", vec![Mode::default(); k]))
+            .collect();
+        let inst = Instance {
+            name: name.to_string(),
+            meta: Metadata {
+                generator: Some("matrix".into()),
+                ..Default::default()
+            },
+            cells,
+            precedence: precedence.to_vec(),
+            matrix: Some(CostMatrix { size, costs }),
+            ..Instance::default()
+        };
+        crate::validate::validate(&inst, name)?;
+        Ok(inst)
+    }
 }

@@ -106,7 +106,20 @@ pub static KINDS: &[GeneratorInfo] = &[
     },
 ];
 
-/// Generates an instance of `kind` from `KEY=VALUE` parameters and a seed.
+/// Generates an instance of `kind` from `KEY=VALUE` parameters and a seed: the same seed and
+/// parameters give the same instance on any machine. [`KINDS`] lists every kind with its
+/// parameters; an unknown kind or parameter is an error listing the known ones.
+///
+/// ```
+/// use std::collections::BTreeMap;
+///
+/// let params = BTreeMap::from([("rows".to_string(), "2".to_string())]);
+/// let a = cellseq::generate::generate("panel", &params, 7)?;
+/// let b = cellseq::generate::generate("panel", &params, 7)?;
+/// assert_eq!(a, b);
+/// assert!(cellseq::generate::generate("nosuch", &params, 7).is_err());
+/// # Ok::<(), cellseq::Error>(())
+/// ```
 pub fn generate(kind: &str, given: &BTreeMap<String, String>, seed: u64) -> Result<Instance> {
     let info = KINDS.iter().find(|k| k.name == kind).ok_or_else(|| {
         Error::Param(format!(

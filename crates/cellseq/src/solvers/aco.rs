@@ -5,6 +5,7 @@
 //! rule, local and global pheromone updates, the engine's local search (SOP-3-exchange VND) on
 //! the ants, and the mode DP (the greedy pass over contact points) on every tour.
 
+use super::Build;
 use super::start::{greedy_solution, outcome};
 use super::{Caps, Context, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo};
 use crate::engine::modes::mode_dp;
@@ -54,6 +55,10 @@ pub(crate) const COLONY: [ParamSpec; 5] = [
 pub static INFO: SolverInfo = SolverInfo {
     name: "aco",
     summary: "ant colony system (patent 003 / HAS-SOP): fringe construction, tool-change-aware heuristic, local search, mode DP",
+    description: "Ant colony system after patent 003 and HAS-SOP: ants build sequences over the \
+precedence fringe with a heuristic that charges tool changes, local and global pheromone \
+updates on cell → cell arcs, local search on every ant, the iteration best or none (`ls`), \
+and the mode DP.",
     params: &[
         COLONY[0],
         COLONY[1],
@@ -89,7 +94,7 @@ pub static INFO: SolverInfo = SolverInfo {
         improves: true,
         ..Caps::NONE
     },
-    make: |p: &Params| {
+    build: Build::Fresh(|p: &Params| {
         Ok(Box::new(Aco {
             ants: p.int("ants").max(1) as usize,
             beta: p.float("beta"),
@@ -101,7 +106,7 @@ pub static INFO: SolverInfo = SolverInfo {
             ls: p.word("ls").to_string(),
             k: p.int("k").max(1) as usize,
         }))
-    },
+    }),
 };
 
 /// The ant colony solver.

@@ -1,6 +1,7 @@
 //! `as-given`: the instance's own programmed order (the papers' "unoptimized" baseline),
 //! else file order, repaired to respect precedence.
 
+use super::Build;
 use super::{Caps, Context, Outcome, Params, Solver, SolverInfo, outcome_of};
 use crate::error::Result;
 use crate::model::Visit;
@@ -10,9 +11,12 @@ use crate::precedence::ranked_topological_order;
 pub static INFO: SolverInfo = SolverInfo {
     name: "as-given",
     summary: "the instance's as-programmed order (else file order), repaired to respect precedence",
+    description: "The order the instance was programmed in (its `as_given` order; else file \
+order), repaired to respect precedence: the \"unoptimized\" baseline the papers compare \
+against.",
     params: &[],
     caps: Caps { ..Caps::NONE },
-    make: |_p: &Params| Ok(Box::new(AsGiven)),
+    build: Build::Fresh(|_p: &Params| Ok(Box::new(AsGiven))),
 };
 
 /// The as-given solver.

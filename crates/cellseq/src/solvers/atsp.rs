@@ -2,6 +2,7 @@
 //! patched into a path, candidate lists from its reduced costs, then an iterated Or-3opt
 //! search with block-swap kicks ([`crate::engine::atsp`]).
 
+use super::Build;
 use super::start::{greedy_solution, outcome};
 use super::{Caps, Context, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo};
 use crate::engine::atsp::cands::{Rank, candidates};
@@ -18,6 +19,21 @@ use rand_chacha::ChaCha8Rng;
 pub static INFO: SolverInfo = SolverInfo {
     name: "atsp",
     summary: "asymmetric costs with little or no precedence: assignment cycles patched into a path, reduced-cost candidates, iterated Or-3opt with block-swap kicks",
+    description: "For asymmetric costs with little or no precedence (an asymmetric TSP as an open path).
+
+- **Start**: the better of `greedy` and the assignment problem's solution (a dummy node \
+closes the path) whose cycles are patched into one path (`patch=greedy`: the cheapest join of \
+any two cycles first; `karp`: into the largest cycle); arcs no feasible order can use are left \
+out, and a patched path that breaks the precedence is repaired by a topological sort that \
+follows it. Above `ap-max-cells` no assignment is solved.
+- **Search**: iterated Or-3opt (two adjacent blocks swap places, no reversal) on candidate \
+lists ranked by the assignment's reduced costs (`cand=reduced`, ties by raw cost; `k` per \
+cell), precedence checked on every move; kicks swap two blocks across a third (`kick=far`) \
+or two adjacent blocks (`near`), of up to `kick-len` cells; equal-or-better results are \
+accepted.
+- `auto` runs it (the built-in portfolio's `free` rule) on asymmetric matrix instances whose \
+`free_density` (the closure density apart from cells ordered against every other: a fixed \
+start and end) is at most 0.001; notes/atsp.md has the measurements.",
     params: &[
         ParamSpec {
             name: "k",
@@ -57,7 +73,7 @@ pub static INFO: SolverInfo = SolverInfo {
         },
     ],
     caps: Caps { ..Caps::NONE },
-    make: |p: &Params| {
+    build: Build::Fresh(|p: &Params| {
         Ok(Box::new(Atsp {
             k: p.int("k").max(1) as usize,
             rank: if p.word("cand") == "raw" {
@@ -70,7 +86,7 @@ pub static INFO: SolverInfo = SolverInfo {
             far: p.word("kick") == "far",
             greedy_patch: p.word("patch") == "greedy",
         }))
-    },
+    }),
 };
 
 /// The solver.

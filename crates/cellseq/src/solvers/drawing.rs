@@ -14,6 +14,7 @@
 //! Every move costs O(1) to evaluate; a 2-opt costs the length of the reversed block to
 //! apply. Other instances (precedence, several tools, lifts, matrix costs) get `local-search`.
 
+use super::Build;
 use super::{Caps, Context, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo, outcome_of};
 use crate::cost::CostModel;
 use crate::engine::neighbours::Neighbours;
@@ -26,6 +27,11 @@ pub static INFO: SolverInfo = SolverInfo {
     name: "drawing",
     summary: "drawings: greedy, then 2-opt/Or-opt with reversal and iterated local search \
               (flat single-tool instances without precedence; else local-search)",
+    description: "The default of `cellseq optimize` on SVG and DXF drawings: strokes are cells that may be \
+drawn either way (and closed paths from any vertex). Greedy on k-d trees, then 2-opt with \
+stroke reversal, Or-opt and start-vertex moves on candidate lists, then iterated local \
+search until the budget. Other instances get `local-search`. Details: \
+[drawings.md](drawings.md).",
     params: &[
         ParamSpec {
             name: "k",
@@ -41,12 +47,12 @@ pub static INFO: SolverInfo = SolverInfo {
         },
     ],
     caps: Caps { ..Caps::NONE },
-    make: |p: &Params| {
+    build: Build::Fresh(|p: &Params| {
         Ok(Box::new(Drawing {
             k: p.int("k").max(1) as usize,
             kick_len: p.int("kick-len").max(2) as usize,
         }))
-    },
+    }),
 };
 
 /// The drawing sequencer.

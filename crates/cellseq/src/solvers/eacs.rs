@@ -21,6 +21,8 @@
 //! The start is the greedy sequence after a full VND. Every construction step and every move
 //! evaluation is counted, so a run under an evaluation budget is deterministic.
 
+use super::Build;
+use super::StartsFrom;
 use super::aco::{COLONY, Pheromone};
 use super::start::{greedy_solution, outcome};
 use super::{Caps, Context, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo};
@@ -39,6 +41,12 @@ use rand_chacha::ChaCha8Rng;
 pub static INFO: SolverInfo = SolverInfo {
     name: "eacs",
     summary: "enhanced ant colony system (EACS): best-guided construction, focused SOP-3-exchange/Or-opt on near-best ants, mode DP",
+    description: "The enhanced ant colony system of Gambardella, Montemanni and Weyland: ants copy the \
+best solution's successor with probability q0 = 1 − `s`/n; the local search (Or-opt, \
+SOP-3-exchange searched forward and backward, 2-opt, the mode DP) runs only on ants within \
+`ls-band` of the best and starts only from the cells whose neighbours differ from the best \
+solution. Each ant's local optimum is recombined with the best by partition crossover \
+(`cross`).",
     params: &[
         COLONY[0],
         COLONY[1],
@@ -96,10 +104,9 @@ pub static INFO: SolverInfo = SolverInfo {
     ],
     caps: Caps {
         improves: true,
-        starts_from: true,
         ..Caps::NONE
     },
-    make: |p: &Params| Ok(Box::new(from_params(p))),
+    build: Build::StartsFrom(|p: &Params| Ok(Box::new(from_params(p)))),
 };
 
 /// Builds the solver from validated parameters.
@@ -341,9 +348,12 @@ impl Solver for Eacs {
     fn solve(&self, ctx: &mut Context) -> Result<Outcome> {
         self.run(ctx, None)
     }
-    fn solve_from(&self, ctx: &mut Context, start: Option<&Sequence>) -> Result<Outcome> {
-        let start = start.map(|seq| Solution::new(&Costs::open(ctx.model), seq));
-        self.run(ctx, start)
+}
+
+impl StartsFrom for Eacs {
+    fn start_from(&self, ctx: &mut Context, start: &Sequence) -> Result<Outcome> {
+        let start = Solution::new(&Costs::open(ctx.model), start);
+        self.run(ctx, Some(start))
     }
 }
 

@@ -1,6 +1,7 @@
 //! `greedy-edge`: greedy matching, the registry entry of [`crate::construct::edge`] (on
 //! instances where it does not apply, the nearest-neighbour `greedy` sequence).
 
+use super::Build;
 use super::{Caps, Context, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo};
 use crate::construct::greedy;
 use crate::error::Result;
@@ -11,6 +12,10 @@ pub use crate::construct::edge::{applicable, sequence};
 pub static INFO: SolverInfo = SolverInfo {
     name: "greedy-edge",
     summary: "greedy matching of cheapest links into chains, joined by nearest neighbour (no precedence, one tool; else greedy)",
+    description: "Greedy matching: the cheapest links first (candidates from k-d trees), each accepted \
+when it joins two chain ends without closing a cycle; the chains are then joined by nearest \
+neighbour. Applies to geometric instances without precedence and with one tool; anything \
+else gets `greedy`. On uniform strokes it reaches 0.91–0.93 × greedy's air length.",
     params: &[ParamSpec {
         name: "k",
         default: "8",
@@ -18,11 +23,11 @@ pub static INFO: SolverInfo = SolverInfo {
         help: "candidate successors per cell",
     }],
     caps: Caps { ..Caps::NONE },
-    make: |p: &Params| {
+    build: Build::Fresh(|p: &Params| {
         Ok(Box::new(GreedyEdge {
             k: p.int("k").max(1) as usize,
         }))
-    },
+    }),
 };
 
 /// The greedy matching solver.

@@ -9,6 +9,7 @@
 //! found again by recomputing costs within a tolerance, which failed ("broken DP
 //! back-pointer") once costs overflowed to infinity (∞ − ∞ is NaN).
 
+use super::Build;
 use super::{Caps, Context, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo};
 use crate::error::{Error, Result};
 use crate::model::Visit;
@@ -18,6 +19,10 @@ use rustc_hash::FxHashMap;
 pub static INFO: SolverInfo = SolverInfo {
     name: "exact",
     summary: "Held-Karp DP over precedence-closed subsets with modes; proves optimality",
+    description: "Held–Karp dynamic programming over precedence-closed subsets of cells, with modes: the \
+optimum, proven. The number of precedence-closed subsets decides its memory; an instance \
+whose tables would pass `memory_mb`, or with more than `max_cells` cells, is refused with an \
+error rather than started.",
     params: &[
         ParamSpec {
             name: "memory_mb",
@@ -36,12 +41,12 @@ pub static INFO: SolverInfo = SolverInfo {
         exact: true,
         ..Caps::NONE
     },
-    make: |p: &Params| {
+    build: Build::Fresh(|p: &Params| {
         Ok(Box::new(Exact {
             memory_mb: p.int("memory_mb"),
             max_cells: p.int("max_cells").min(128) as usize,
         }))
-    },
+    }),
 };
 
 /// The exact DP solver.

@@ -1,6 +1,7 @@
 //! `greedy`: precedence-aware nearest neighbour, the registry entry of
 //! [`crate::construct::greedy`].
 
+use super::Build;
 use super::{Caps, Context, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo, outcome_of};
 use crate::error::Result;
 
@@ -10,6 +11,10 @@ pub use crate::construct::greedy::{geometric, matrix};
 pub static INFO: SolverInfo = SolverInfo {
     name: "greedy",
     summary: "precedence-aware nearest neighbour (k-d tree per tool on geometric instances)",
+    description: "Precedence-aware nearest neighbour: from the current cell, the cheapest next cell whose \
+predecessors are all done. On geometric instances the candidates come from a k-d tree per \
+tool, so 10^5 cells take well under a second. `randomize` makes it a randomized start for \
+multi-start solvers.",
     params: &[ParamSpec {
         name: "randomize",
         default: "0",
@@ -17,11 +22,11 @@ pub static INFO: SolverInfo = SolverInfo {
         help: "probability of taking the second-best candidate at a step (0 = pure greedy)",
     }],
     caps: Caps { ..Caps::NONE },
-    make: |p: &Params| {
+    build: Build::Fresh(|p: &Params| {
         Ok(Box::new(Greedy {
             randomize: p.float("randomize"),
         }))
-    },
+    }),
 };
 
 /// The greedy solver.

@@ -15,6 +15,8 @@
 //! own record, and every repaired kick is crossed with the best of all walks (not in the
 //! built-in portfolio: notes/lab/ils-walks.md).
 
+use super::Build;
+use super::StartsFrom;
 use super::start::{greedy_solution, outcome};
 use super::{Caps, Context, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo};
 use crate::engine::crossover::Crossover;
@@ -34,6 +36,26 @@ use rand_chacha::ChaCha8Rng;
 pub static INFO: SolverInfo = SolverInfo {
     name: "ils",
     summary: "iterated local search: segment-swap kicks, focused SOP-3-exchange/Or-opt repair, mode DP, record-to-record acceptance",
+    description: "Iterated local search.
+
+- **Kick**: a random feasible reorder of a window (`perturb=shuffle`), random segment swaps \
+(`swap`), or ruin and recreate (`ruin`: strings of cells around a random cell removed and \
+reinserted at their cheapest feasible places; `ruin-size`, `ruin-string`).
+- **Repair**: Or-opt and SOP-3-exchange (both directions with `two-way`) from the cells the \
+kick touched; on costs that read the same backwards also Lin–Kernighan chains of reversals \
+(`lk`, `lk-depth`, `lk-breadth`) that may pass through up to `lk-max-viol` broken \
+precedence pairs, each charged `lk-penalty` in the gain criterion, keeping only feasible \
+prefixes. `shift-repair=K` ends every repair with the bounded-shift DP of Balas and \
+Simonetti over the kicked span (the best reorder, with modes, in which no cell passes one \
+that lay K or more places after it).
+- **Crossover** (`cross`): each repaired kick is recombined with the best by partition \
+crossover: the two sequences are cut wherever their prefixes hold the same cells and the \
+cheapest feasible mix of segments is kept, in O(n).
+- **Acceptance**: record-to-record, within `accept` above the best; a restart from the best \
+after `restart` kicks without a gain.
+- On instances whose cells have several modes (PCGTSPLIB), the polish of a new best adds \
+window moves with modes (a cell moved inside a 5-position window while the modes around it \
+are re-chosen); `window-repair=true` runs them in every repair as well.",
     params: &[
         ParamSpec {
             name: "k",
@@ -164,10 +186,9 @@ pub static INFO: SolverInfo = SolverInfo {
     ],
     caps: Caps {
         improves: true,
-        starts_from: true,
         ..Caps::NONE
     },
-    make: |p: &Params| Ok(Box::new(from_params(p))),
+    build: Build::StartsFrom(|p: &Params| Ok(Box::new(from_params(p)))),
 };
 
 /// Most walks kept at once (each holds two solutions, so memory stays bounded).
@@ -409,9 +430,12 @@ impl Solver for Ils {
     fn solve(&self, ctx: &mut Context) -> Result<Outcome> {
         self.run(ctx, None)
     }
-    fn solve_from(&self, ctx: &mut Context, start: Option<&Sequence>) -> Result<Outcome> {
-        let start = start.map(|seq| Solution::new(&Costs::open(ctx.model), seq));
-        self.run(ctx, start)
+}
+
+impl StartsFrom for Ils {
+    fn start_from(&self, ctx: &mut Context, start: &Sequence) -> Result<Outcome> {
+        let start = Solution::new(&Costs::open(ctx.model), start);
+        self.run(ctx, Some(start))
     }
 }
 

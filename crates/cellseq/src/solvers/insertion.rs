@@ -1,6 +1,7 @@
 //! `insertion`: cheapest precedence-feasible insertion, the registry entry of
 //! [`crate::construct::insertion`].
 
+use super::Build;
 use super::{Caps, Context, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo, outcome_of};
 use crate::error::Result;
 
@@ -10,6 +11,13 @@ pub use crate::construct::insertion::sequence;
 pub static INFO: SolverInfo = SolverInfo {
     name: "insertion",
     summary: "cheapest precedence-feasible insertion, cells with more descendants first (grids of exits and entries on geometric instances)",
+    description: "Cheapest precedence-feasible insertion: cells in a topological order that takes those \
+with more descendants first (ties at random, by `--seed`), each put into the cheapest place \
+after its last predecessor. Order labels on a linked path answer \"after the predecessor?\" \
+in O(1). On geometric instances the places tried are the `k` feasible ones next to nearby \
+cells (grids of exits and entries); on matrix instances every place. On sparse random \
+precedence (`uniform preds=1`) it reaches 0.61–0.67 × greedy's air at 2000–5000 cells, and \
+it is what `local-search` starts from on geometric instances with precedence.",
     params: &[ParamSpec {
         name: "k",
         default: "8",
@@ -17,11 +25,11 @@ pub static INFO: SolverInfo = SolverInfo {
         help: "feasible places next to nearby inserted cells to try per cell (geometric instances)",
     }],
     caps: Caps { ..Caps::NONE },
-    make: |p: &Params| {
+    build: Build::Fresh(|p: &Params| {
         Ok(Box::new(Insertion {
             k: p.int("k").max(1) as usize,
         }))
-    },
+    }),
 };
 
 /// The insertion solver.

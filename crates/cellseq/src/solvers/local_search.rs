@@ -11,6 +11,7 @@
 //! local double-bridge kicks with undo until the budget, or `kicks` × 1000 failures in a row
 //! without one), and one VND on the array form finishes.
 
+use super::Build;
 use super::start::{best_start, outcome};
 use super::{Caps, Context, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo};
 use crate::engine::large::{self, Large};
@@ -25,6 +26,22 @@ use rand_chacha::ChaCha8Rng;
 pub static INFO: SolverInfo = SolverInfo {
     name: "local-search",
     summary: "greedy, then (iterated) VND over Or-opt, 2-opt with mode flip, mode change, SOP-3-exchange, the mode DP and (several modes per cell) window moves with modes",
+    description: "The workhorse improvement solver.
+
+- **Start**: the better of `greedy` and `greedy-edge` (only `greedy-edge` above 50 000 \
+cells where it applies) and, on geometric instances with precedence up to 200 000 cells, \
+`insertion`.
+- **From 200 000 cells**: first an Or-opt pass on a linked list (O(1) per move, precedence \
+checked with order labels); `vnd=false` stops after it.
+- **VND** over Or-opt, 2-opt, SOP-3-exchange (blocks up to `max-block`), mode change, the \
+mode DP and, where cells have several modes (up to 5000 cells), window moves with modes; \
+then iterated VND with `kicks` random Or-opt kicks of `strength` moves.
+- **Large instances without precedence** (from 20 000 cells, on costs that read the same \
+backwards: air length, or time without linking at cutting feed): the search runs on a \
+two-level list instead (2-opt, Or-opt and mode moves at O(√n) each, then local double-bridge \
+kicks with undo; `two-level`, `kick-block`), and one VND finishes. At 10^5 uniform cells it \
+reaches 0.78 × greedy's air in 10 s; with sparse precedence, from the insertion start, \
+0.715.",
     params: &[
         ParamSpec {
             name: "k",
@@ -85,7 +102,7 @@ pub static INFO: SolverInfo = SolverInfo {
         improves: true,
         ..Caps::NONE
     },
-    make: |p: &Params| {
+    build: Build::Fresh(|p: &Params| {
         let kicks = p.int("kicks");
         let strength = p.int("strength").max(1) as usize;
         Ok(Box::new(LocalSearch {
@@ -99,7 +116,7 @@ pub static INFO: SolverInfo = SolverInfo {
             walk_kicks: p.float("walk-kicks").clamp(0.0, 1.0),
             three_opt: p.bool("three-opt"),
         }))
-    },
+    }),
 };
 
 /// From this many cells on, instances get a first Or-opt pass on a linked list

@@ -1,30 +1,75 @@
-//! Solvers: one [`Solver`] trait, parameters, budgets, progress observers and a registry.
+//! Solvers: one [`SolverKind`] per registry entry, what each declares ([`SolverInfo`]: name,
+//! summary, description, parameters, capabilities), and how they are run.
 //!
-//! To add a solver: write a module here with a type implementing [`Solver`], give it a
-//! [`SolverInfo`] (name, summary, parameters with defaults, constructor) and list it in
-//! [`registry`]. The conformance tests in `tests/it/conformance.rs` then cover it automatically.
+//! To add a solver: write `src/solvers/<name>.rs` with a type implementing [`Solver`] (and
+//! [`StartsFrom`] or [`WarmStart`] when it can take a start sequence) and a
+//! `pub static INFO: SolverInfo` that declares everything about it, then add one line to the
+//! `registry!` list below. The [`SolverKind`] variant, [`registry`], `docs/solvers.md`
+//! ([`markdown`]) and the conformance tests (which iterate [`SolverKind::ALL`]) follow from it.
 
-pub mod aco;
-pub mod as_given;
-pub mod atsp;
-pub mod auto;
-pub mod beam;
+/// Declares the solver modules and derives [`SolverKind`] from them: one line per solver,
+/// `Variant => module`, in display order. The module's `INFO` says everything else.
+macro_rules! registry {
+    ($($variant:ident => $module:ident),* $(,)?) => {
+        $(pub mod $module;)*
+
+        /// A solver of the registry, chosen by type: `SolverKind::Ils`, or by its registry name
+        /// with [`str::parse`] (`"ils".parse::<SolverKind>()`, an unknown name is an
+        /// [`Error::UnknownSolver`] listing the known ones). [`SolverKind::info`] tells its
+        /// name, summary, description, parameters and capabilities.
+        #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+        #[non_exhaustive]
+        pub enum SolverKind {
+            $(
+                #[doc = concat!("The solver declared in `src/solvers/", stringify!($module),
+                                "` (see [`SolverKind::info`]).")]
+                $variant,
+            )*
+        }
+
+        impl SolverKind {
+            /// Every registry solver, in display order.
+            pub const ALL: &'static [SolverKind] = &[$(SolverKind::$variant),*];
+
+            /// What the solver declares: name, summary, description, parameters, capabilities.
+            pub fn info(self) -> &'static SolverInfo {
+                match self {
+                    $(SolverKind::$variant => &$module::INFO,)*
+                }
+            }
+        }
+    };
+}
+
+registry! {
+    Auto => auto,
+    AsGiven => as_given,
+    Greedy => greedy,
+    GreedyEdge => edge,
+    Insertion => insertion,
+    Ils => ils,
+    Atsp => atsp,
+    Exact => exact,
+    Beam => beam,
+    Reopt => reopt,
+    TwoOpt => two_opt,
+    LocalSearch => local_search,
+    Sa => sa,
+    Tabu => tabu,
+    Aco => aco,
+    Eacs => eacs,
+    Process => process,
+    Rules => rules,
+    Drawing => drawing,
+}
+
 pub mod docs;
-pub mod drawing;
-pub mod eacs;
-pub mod edge;
-pub mod exact;
-pub mod greedy;
-pub mod ils;
-pub mod insertion;
-pub mod local_search;
-pub mod process;
-pub mod reopt;
-pub mod rules;
-pub mod sa;
 pub mod start;
-pub mod tabu;
-pub mod two_opt;
+
+pub use auto::{
+    BUILT_IN_PORTFOLIO, Explanation, Features, explain, is_portfolio_file, validate_portfolio,
+};
+pub use docs::{kind_label, markdown};
 
 use crate::checker::{Report, check};
 use crate::cost::CostModel;
@@ -33,21 +78,71 @@ use crate::model::{Instance, Objective, Sequence};
 use std::collections::BTreeMap;
 
 pub use crate::context::{
-    Budget, Context, NoObserver, Observer, Outcome, Progress, Trace, outcome_of,
+    Budget, Context, NoObserver, Observer, Outcome, outcome_of,
 };
-pub use crate::params::{ParamKind, ParamSpec, Params, parse_kv};
+pub use crate::params::{ParamKind, ParamSpec, Params};
+#[cfg(feature = "internals")]
+pub use crate::{context::{Progress, Trace}, params::parse_kv};
 
-/// A sequencing algorithm.
+/// A sequencing algorithm (crate-internal: users choose a [`SolverKind`] and run it through
+/// [`crate::Solve`]).
 pub trait Solver: Send + Sync {
     /// Runs the algorithm.
     fn solve(&self, ctx: &mut Context) -> Result<Outcome>;
-    /// Runs the algorithm from `start` when one is given: solvers whose [`Caps`] declare
-    /// `starts_from` search from it, those that declare `warm_start` take it as their first
-    /// incumbent; the others run [`Solver::solve`] and are never handed a start by
-    /// [`sub_run`]. Without a start this is [`Solver::solve`].
-    fn solve_from(&self, ctx: &mut Context, start: Option<&Sequence>) -> Result<Outcome> {
-        let _ = start;
-        self.solve(ctx)
+}
+
+/// A solver that searches from a given sequence and returns one no worse (a plan phase may
+/// start it from an earlier phase's sequence: `*`, `+`).
+pub trait StartsFrom: Solver {
+    /// Runs the algorithm from `start`, a feasible sequence of the context's instance.
+    fn start_from(&self, ctx: &mut Context, start: &Sequence) -> Result<Outcome>;
+}
+
+/// A solver that takes a given sequence as its first incumbent (an upper bound to prune with)
+/// instead of its own warm start; the result is never worse.
+pub trait WarmStart: Solver {
+    /// Runs the algorithm with `incumbent`, a feasible sequence, as its first upper bound.
+    fn warm_start(&self, ctx: &mut Context, incumbent: &Sequence) -> Result<Outcome>;
+}
+
+/// How a registry entry builds its solver from validated parameters; which start the solver
+/// can take is part of the type, so the compiler holds the declaration and the code together.
+/// A constructor fails when the parameters do not make a solver (a malformed `auto` plan).
+#[derive(Clone, Copy)]
+pub enum Build {
+    /// A solver that runs from scratch only.
+    Fresh(fn(&Params) -> Result<Box<dyn Solver>>),
+    /// A solver that can search from a given sequence ([`StartsFrom`]).
+    StartsFrom(fn(&Params) -> Result<Box<dyn StartsFrom>>),
+    /// A solver that can take a given sequence as its first incumbent ([`WarmStart`]).
+    WarmStart(fn(&Params) -> Result<Box<dyn WarmStart>>),
+}
+
+/// A solver built from a registry entry, with the start it can take.
+pub enum Built {
+    /// Runs from scratch only.
+    Fresh(Box<dyn Solver>),
+    /// Can search from a given sequence.
+    StartsFrom(Box<dyn StartsFrom>),
+    /// Can take a given sequence as its first incumbent.
+    WarmStart(Box<dyn WarmStart>),
+}
+
+impl Built {
+    /// Runs the solver, from `start` when one is given; a solver that cannot take a start is
+    /// refused one (an error naming `name`).
+    pub fn run(&self, ctx: &mut Context, start: Option<&Sequence>, name: &str) -> Result<Outcome> {
+        match (self, start) {
+            (Built::Fresh(s), None) => s.solve(ctx),
+            (Built::StartsFrom(s), None) => s.solve(ctx),
+            (Built::WarmStart(s), None) => s.solve(ctx),
+            (Built::StartsFrom(s), Some(q)) => s.start_from(ctx, q),
+            (Built::WarmStart(s), Some(q)) => s.warm_start(ctx, q),
+            (Built::Fresh(_), Some(_)) => Err(Error::Solver {
+                solver: name.to_string(),
+                msg: "cannot start from a given sequence".to_string(),
+            }),
+        }
     }
 }
 
@@ -62,18 +157,13 @@ pub enum Needs {
     Matrix,
 }
 
-/// What a solver can do, declared in its registry entry; sub-runs, plans and tests read it.
+/// What a solver promises about its results, declared in its registry entry; sub-runs, plans
+/// and tests read it. (Which start it can take is not a flag: it is the [`Build`] variant.)
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Caps {
     /// Never ends worse than `greedy` and keeps to an evaluation budget up to one pass or
     /// construction (the local-search family).
     pub improves: bool,
-    /// Searches from a given sequence and returns one no worse ([`Solver::solve_from`]); a
-    /// plan phase may start it from an earlier sequence (`*`, `+`).
-    pub starts_from: bool,
-    /// Takes a given sequence as its first incumbent (an upper bound to prune with) instead of
-    /// its own warm start; the result is never worse.
-    pub warm_start: bool,
     /// Proves its result optimal when it finishes within the budget and its limits.
     pub exact: bool,
     /// The instances it runs on.
@@ -85,38 +175,63 @@ impl Caps {
     /// (`Caps { exact: true, ..Caps::NONE }`).
     pub const NONE: Caps = Caps {
         improves: false,
-        starts_from: false,
-        warm_start: false,
         exact: false,
         needs: Needs::Any,
     };
-    /// True when a start sequence can be handed to the solver.
-    pub fn takes_start(&self) -> bool {
-        self.starts_from || self.warm_start
-    }
 }
 
-/// A registry entry.
+/// A registry entry: everything a solver declares about itself, in its own file.
 pub struct SolverInfo {
-    /// Registry name.
+    /// Registry name (`--solver NAME`).
     pub name: &'static str,
     /// One-line description.
     pub summary: &'static str,
+    /// The longer description (Markdown) of `docs/solvers.md`.
+    pub description: &'static str,
     /// Parameters with defaults.
     pub params: &'static [ParamSpec],
-    /// What it can do.
+    /// What it promises.
     pub caps: Caps,
-    /// Builds the solver from validated parameters; fails when they do not make a solver
-    /// (for instance a malformed `auto` plan).
-    pub make: fn(&Params) -> Result<Box<dyn Solver>>,
+    /// How it is built, and which start it can take.
+    pub(crate) build: Build,
+}
+
+impl std::fmt::Debug for SolverInfo {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("SolverInfo")
+            .field("name", &self.name)
+            .field("caps", &self.caps)
+            .finish_non_exhaustive()
+    }
 }
 
 impl SolverInfo {
     /// Validates `given` against the declared parameters and builds the solver.
-    pub fn build(&self, given: &BTreeMap<String, String>) -> Result<(Params, Box<dyn Solver>)> {
+    pub(crate) fn build(&self, given: &BTreeMap<String, String>) -> Result<(Params, Built)> {
         let params = Params::new(self.name, self.params, given)?;
-        let solver = (self.make)(&params)?;
-        Ok((params, solver))
+        let built = match self.build {
+            Build::Fresh(f) => Built::Fresh(f(&params)?),
+            Build::StartsFrom(f) => Built::StartsFrom(f(&params)?),
+            Build::WarmStart(f) => Built::WarmStart(f(&params)?),
+        };
+        Ok((params, built))
+    }
+    /// Validates `given` against the declared parameters and tries the constructor (a
+    /// malformed `auto` plan or portfolio fails here): the parameters with defaults filled in.
+    pub fn check_params(&self, given: &BTreeMap<String, String>) -> Result<Params> {
+        self.build(given).map(|(p, _)| p)
+    }
+    /// True when the solver searches from a given sequence ([`StartsFrom`]).
+    pub fn starts_from(&self) -> bool {
+        matches!(self.build, Build::StartsFrom(_))
+    }
+    /// True when the solver takes a given sequence as its first incumbent ([`WarmStart`]).
+    pub fn warm_start(&self) -> bool {
+        matches!(self.build, Build::WarmStart(_))
+    }
+    /// True when a start sequence can be handed to the solver.
+    pub fn takes_start(&self) -> bool {
+        !matches!(self.build, Build::Fresh(_))
     }
 }
 
@@ -128,27 +243,7 @@ pub fn trace_enabled() -> bool {
 
 /// Every registered solver, in display order.
 pub fn registry() -> Vec<&'static SolverInfo> {
-    vec![
-        &auto::INFO,
-        &as_given::INFO,
-        &greedy::INFO,
-        &edge::INFO,
-        &insertion::INFO,
-        &ils::INFO,
-        &atsp::INFO,
-        &exact::INFO,
-        &beam::INFO,
-        &reopt::INFO,
-        &two_opt::INFO,
-        &local_search::INFO,
-        &sa::INFO,
-        &tabu::INFO,
-        &aco::INFO,
-        &eacs::INFO,
-        &process::INFO,
-        &rules::INFO,
-        &drawing::INFO,
-    ]
+    SolverKind::ALL.iter().map(|k| k.info()).collect()
 }
 
 /// Name of the solver `cellseq solve` uses when none is named.
@@ -156,17 +251,47 @@ pub const DEFAULT_SOLVER: &str = "auto";
 
 /// Looks a solver up by name.
 pub fn find(name: &str) -> Result<&'static SolverInfo> {
-    registry()
-        .into_iter()
-        .find(|s| s.name == name)
-        .ok_or_else(|| Error::UnknownSolver {
-            name: name.to_string(),
-            known: registry()
-                .iter()
-                .map(|s| s.name)
-                .collect::<Vec<_>>()
-                .join(", "),
-        })
+    name.parse::<SolverKind>().map(SolverKind::info)
+}
+
+impl std::str::FromStr for SolverKind {
+    type Err = Error;
+    /// The solver of registry name `name`; an unknown name is an [`Error::UnknownSolver`]
+    /// listing the known ones.
+    fn from_str(name: &str) -> Result<SolverKind> {
+        SolverKind::ALL
+            .iter()
+            .copied()
+            .find(|k| k.info().name == name)
+            .ok_or_else(|| Error::UnknownSolver {
+                name: name.to_string(),
+                known: SolverKind::ALL
+                    .iter()
+                    .map(|k| k.info().name)
+                    .collect::<Vec<_>>()
+                    .join(", "),
+            })
+    }
+}
+
+impl SolverKind {
+    /// Its registry name (`ils`, `greedy-edge`, ...).
+    pub fn name(self) -> &'static str {
+        self.info().name
+    }
+}
+
+impl Default for SolverKind {
+    /// `auto`, the solver `cellseq solve` uses when none is named.
+    fn default() -> Self {
+        SolverKind::Auto
+    }
+}
+
+impl std::fmt::Display for SolverKind {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
 }
 
 /// A solver run inside another (a portfolio phase, a warm start, a window, a fallback): which
@@ -181,7 +306,7 @@ pub struct Sub<'s> {
     pub budget: Budget,
     /// Its seed.
     pub seed: u64,
-    /// The sequence it starts from (solvers whose [`Caps::takes_start`]).
+    /// The sequence it starts from (solvers that [`SolverInfo::takes_start`]).
     pub start: Option<&'s Sequence>,
     /// Another instance and its cost model (a backwards twin, a window); `None`: the caller's.
     pub on: Option<(&'s Instance, &'s CostModel)>,
@@ -207,17 +332,11 @@ impl<'s> Sub<'s> {
 /// `ctx` when it succeeds. The caller decides whether to [`Context::report`] its cost.
 pub fn sub_run(ctx: &mut Context, sub: Sub) -> Result<Outcome> {
     let info = find(sub.name)?;
-    let (params, solver) = info.build(sub.params)?;
-    if sub.start.is_some() && !info.caps.takes_start() {
-        return Err(Error::Solver {
-            solver: info.name.to_string(),
-            msg: "cannot start from a given sequence".to_string(),
-        });
-    }
+    let (_, solver) = info.build(sub.params)?;
     let (instance, model) = sub.on.unwrap_or((ctx.instance, ctx.model));
     let mut quiet = NoObserver;
-    let mut inner = Context::new(instance, model, &params, sub.seed, sub.budget, &mut quiet);
-    let out = solver.solve_from(&mut inner, sub.start)?;
+    let mut inner = Context::new(instance, model, sub.seed, sub.budget, &mut quiet);
+    let out = solver.run(&mut inner, sub.start, info.name)?;
     ctx.count(inner.evaluations());
     Ok(out)
 }
@@ -251,7 +370,7 @@ pub fn run(
     observer: &mut dyn Observer,
 ) -> Result<RunResult> {
     let info = find(name)?;
-    let (params, solver) = info.build(given)?;
+    let (_, solver) = info.build(given)?;
     let model = CostModel::new(inst, objective);
     if !model.acyclic() {
         return Err(Error::invalid(
@@ -260,8 +379,8 @@ pub fn run(
         ));
     }
     let objective = model.objective();
-    let mut ctx = Context::new(inst, &model, &params, seed, budget, observer);
-    let outcome = solver.solve(&mut ctx)?;
+    let mut ctx = Context::new(inst, &model, seed, budget, observer);
+    let outcome = solver.run(&mut ctx, None, name)?;
     let elapsed_s = ctx.elapsed();
     let evaluations = ctx.evaluations();
     let report = check(inst, &outcome.sequence, objective).map_err(|v| Error::Solver {
@@ -326,13 +445,12 @@ mod tests {
     fn sub_runs_start_only_solvers_that_take_a_start() {
         let inst = tiny();
         let model = CostModel::new(&inst, inst.default_objective());
-        let params = Params::new("as-given", &[], &BTreeMap::new()).unwrap();
         let mut obs = NoObserver;
         let budget = Budget {
             time_limit: None,
             max_evals: Some(5_000),
         };
-        let mut ctx = Context::new(&inst, &model, &params, 3, budget, &mut obs);
+        let mut ctx = Context::new(&inst, &model, 3, budget, &mut obs);
         let start = sub_run(&mut ctx, Sub::new("as-given", budget, 3)).unwrap();
         let used = ctx.evaluations();
         for info in registry() {
@@ -341,7 +459,7 @@ mod tests {
                 ..Sub::new(info.name, budget, 3)
             };
             let out = sub_run(&mut ctx, sub);
-            if info.caps.takes_start() {
+            if info.takes_start() {
                 let out = out.unwrap_or_else(|e| panic!("{}: {e}", info.name));
                 assert!(out.cost <= start.cost, "{} worse than its start", info.name);
                 assert!(ctx.evaluations() >= used, "{}", info.name);

@@ -10,6 +10,7 @@
 //! Markov chains, Metropolis, stagnation stop) then reorders cells only inside each level-4
 //! group (contiguous run of the same group).
 
+use super::Build;
 use super::sa::{Anneal, SPECS};
 use super::start::outcome;
 use super::{Caps, Context, Outcome, Params, Solver, SolverInfo};
@@ -23,13 +24,18 @@ use rand_chacha::ChaCha8Rng;
 pub static INFO: SolverInfo = SolverInfo {
     name: "process",
     summary: "process-based sequencing (paper 000): 4-level grouping, process-scheme group order, SA inside level-4 groups",
+    description: "Process-based sequencing as in paper 000: cells are grouped on four levels (cutter; the \
+cutter's main working-step type against the supplementary ones; working-step type; layer), \
+groups are ordered by the process scheme (cutter order, supplementary steps before the \
+target group, layers top-down), and simulated annealing (the parameters of `sa`) reorders \
+the cells inside each level-4 group.",
     params: SPECS,
     caps: Caps { ..Caps::NONE },
-    make: |p: &Params| {
+    build: Build::Fresh(|p: &Params| {
         Ok(Box::new(Process {
             anneal: Anneal::from_params(p),
         }))
-    },
+    }),
 };
 
 /// The process-based solver.

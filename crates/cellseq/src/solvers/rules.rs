@@ -9,6 +9,7 @@
 //! - Rule 5: cells with no other priority ordered symmetrically about the part's centre
 //!   (mirror pairs left/right of the centre cut one after the other) to limit deformation.
 
+use super::Build;
 use super::start::outcome;
 use super::{Caps, Context, Outcome, ParamSpec, Params, Solver, SolverInfo};
 use crate::engine::modes::mode_dp;
@@ -23,9 +24,11 @@ use std::collections::BinaryHeap;
 pub static INFO: SolverInfo = SolverInfo {
     name: "rules",
     summary: "knowledge rules 1-5 of paper 002 (tool size, outer before inner, upper before lower, step order, symmetry)",
+    description: "The knowledge rules 1–5 of paper 002 (tool size, outer before inner, upper before lower, \
+step order, symmetry) applied in turn, with no search: the papers' rule-based baseline.",
     params: &[] as &[ParamSpec],
     caps: Caps { ..Caps::NONE },
-    make: |_p: &Params| Ok(Box::new(Rules)),
+    build: Build::Fresh(|_p: &Params| Ok(Box::new(Rules))),
 };
 
 /// The rule-based solver.

@@ -8,6 +8,7 @@
 //! precedence-free segment, single-cell mode change. [`Anneal`] can confine moves to fixed
 //! blocks of positions (the `process` solver anneals inside its level-4 groups).
 
+use super::Build;
 use super::start::{greedy_start, outcome, true_cost};
 use super::{Caps, Context, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo};
 use crate::engine::moves::{
@@ -23,17 +24,22 @@ use rand_chacha::ChaCha8Rng;
 pub static INFO: SolverInfo = SolverInfo {
     name: "sa",
     summary: "simulated annealing (paper 000): Metropolis, chains of length L, geometric cooling, stagnation stop",
+    description: "Simulated annealing as in paper 000: Metropolis acceptance over Markov chains of length \
+`chain` × n per temperature, geometric cooling by `alpha` from a temperature at which an \
+average worsening move is accepted with probability `accept0`, a stop after `stall` chains \
+without a new best, re-annealing from the best (`reheats`), open- or closed-loop evaluation \
+(`eval`), and a VND polish of the best (`polish`).",
     params: SPECS,
     caps: Caps {
         improves: true,
         ..Caps::NONE
     },
-    make: |p: &Params| {
+    build: Build::Fresh(|p: &Params| {
         Ok(Box::new(Sa {
             anneal: Anneal::from_params(p),
             polish: p.bool("polish"),
         }))
-    },
+    }),
 };
 
 /// The parameters shared by `sa` and `process`.

@@ -6,6 +6,7 @@
 //! Insertion positions come from the K-nearest candidate lists inside the cell's precedence
 //! window, so an iteration costs O(n·K·k).
 
+use super::Build;
 use super::start::{greedy_start, outcome, random_start};
 use super::{Caps, Context, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo};
 use crate::engine::moves::{apply_segment, mode_delta, window};
@@ -19,6 +20,12 @@ use rand_chacha::ChaCha8Rng;
 pub static INFO: SolverInfo = SolverInfo {
     name: "tabu",
     summary: "multi-start tabu search (paper 004): relocate a cell with its entry/exit pair, tenure, aspiration",
+    description: "Multi-start tabu search as in paper 004: each iteration takes one cell out with its \
+entry/exit pair and re-inserts it at the best non-tabu place, possibly with the pair swapped \
+(any mode of the cell), among places next to its `k` candidate neighbours inside its \
+precedence window; a move that beats the best is allowed even when tabu (aspiration), and a \
+moved cell stays tabu for `tenure` iterations. Starts: every ready start cell and mode first, then randomized greedy, up to \
+`starts`.",
     params: &[
         ParamSpec {
             name: "tenure",
@@ -55,7 +62,7 @@ pub static INFO: SolverInfo = SolverInfo {
         improves: true,
         ..Caps::NONE
     },
-    make: |p: &Params| {
+    build: Build::Fresh(|p: &Params| {
         Ok(Box::new(Tabu {
             tenure: p.int("tenure") as usize,
             iters: p.int("iters"),
@@ -63,7 +70,7 @@ pub static INFO: SolverInfo = SolverInfo {
             starts: p.int("starts").max(1) as usize,
             k: p.int("k").max(1) as usize,
         }))
-    },
+    }),
 };
 
 /// The tabu solver.

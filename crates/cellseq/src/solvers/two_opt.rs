@@ -1,5 +1,6 @@
 //! `two-opt`: greedy start, then 2-opt with mode flip to a local optimum.
 
+use super::Build;
 use super::start::{greedy_solution, outcome};
 use super::{Caps, Context, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo};
 use crate::engine::Costs;
@@ -10,6 +11,9 @@ use crate::error::Result;
 pub static INFO: SolverInfo = SolverInfo {
     name: "two-opt",
     summary: "greedy, then 2-opt with mode flip (reversal of precedence-free reversible segments) to a local optimum",
+    description: "`greedy`, then 2-opt with mode flip to a local optimum: a segment is reversed only when \
+no precedence pair lies inside it and every cell in it may be cut backwards (reversed cells \
+change mode).",
     params: &[ParamSpec {
         name: "k",
         default: "10",
@@ -20,11 +24,11 @@ pub static INFO: SolverInfo = SolverInfo {
         improves: true,
         ..Caps::NONE
     },
-    make: |p: &Params| {
+    build: Build::Fresh(|p: &Params| {
         Ok(Box::new(TwoOpt {
             k: p.int("k").max(1) as usize,
         }))
-    },
+    }),
 };
 
 /// The 2-opt solver.

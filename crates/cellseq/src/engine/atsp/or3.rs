@@ -25,7 +25,7 @@
 use crate::engine::moves::sop3_delta;
 use crate::engine::vnd::improves;
 use crate::engine::{Costs, Neighbours, Solution};
-use crate::solvers::Context;
+use crate::context::Context;
 use rand::RngExt;
 use rand_chacha::ChaCha8Rng;
 use std::collections::VecDeque;
@@ -281,7 +281,7 @@ mod tests {
     use super::*;
     use crate::cost::CostModel;
     use crate::model::{Objective, Visit};
-    use crate::solvers::{Budget, NoObserver, Params};
+    use crate::solvers::{Budget, NoObserver};
     use rand::SeedableRng;
 
     /// Every swap the search finds and every kick changes the cost by its delta, exactly as a
@@ -307,9 +307,8 @@ mod tests {
             let mut s = Solution::new(&c, &seq);
             let mut or3 = Or3::new(c, &nb);
             let mut rng = ChaCha8Rng::seed_from_u64(seed);
-            let params = Params::new("x", &[], &Default::default()).unwrap();
             let mut obs = NoObserver;
-            let mut ctx = Context::new(&inst, &m, &params, seed, Budget::default(), &mut obs);
+            let mut ctx = Context::new(&inst, &m, seed, Budget::default(), &mut obs);
             for round in 0..30 {
                 if round % 3 == 0 {
                     or3.kick(&mut s, &mut rng, 3, 10, round % 2 == 0);
@@ -341,9 +340,8 @@ mod tests {
             let seq: Vec<Visit> = (0..n).map(|x| Visit::new(x, 0)).collect();
             let mut s = Solution::new(&c, &seq);
             let mut or3 = Or3::new(c, &nb);
-            let params = Params::new("x", &[], &Default::default()).unwrap();
             let mut obs = NoObserver;
-            let mut ctx = Context::new(&inst, &m, &params, seed, Budget::default(), &mut obs);
+            let mut ctx = Context::new(&inst, &m, seed, Budget::default(), &mut obs);
             or3.push_all(&s);
             or3.descend(&mut s, &mut ctx);
             for h in -1..n as isize {

@@ -30,8 +30,9 @@ pub mod portfolio;
 
 pub use features::Features;
 pub use phases::{Phase, Start, parse_plan, phase_seed, plan_text};
-pub use portfolio::{Beam, Portfolio, Rule};
+pub use portfolio::{Beam, Portfolio};
 
+use super::Build;
 use super::{
     Budget, Caps, Context, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo, Sub, sub_run,
 };
@@ -51,6 +52,45 @@ pub const PLAN_RULE: &str = "plan parameter";
 pub static INFO: SolverInfo = SolverInfo {
     name: "auto",
     summary: "portfolio (default): instance features pick a rule of a portfolio file; a beam proof attempt on small instances, then the rule's phases (local-search, eacs, ils, atsp...) chained; best wins",
+    description: "A portfolio: phases of other solvers, each given a share of what is left of the budget \
+(evaluations as well as time, so a run under `--max-evals` stays deterministic), each later \
+phase able to start from the best sequence so far; the best sequence wins. What runs is data: \
+`auto` computes the instance's features once (cells, modes per cell, geometric or matrix, \
+symmetric costs, precedence closure density, free density, widest precedence level, share of \
+zero-cost arcs, cost spread) and takes the first rule of a portfolio file whose conditions \
+hold; the built-in file is `crates/cellseq/src/solvers/auto/portfolio.toml`, `--portfolio FILE` (or \
+`--param portfolio=FILE`) names another. The format, the features and what is refused: \
+[portfolio.md](portfolio.md).
+
+1. A `beam` proof attempt gets the rule's beam share of the budget, on instances of at most \
+its `max_cells` cells and, under a wall-clock budget, only when that budget is at least its \
+`min_seconds`; when it proves the optimum, `auto` stops there.
+2. Then the rule's phases (or its `after_beam` phases after a beam phase that ran). The \
+built-in rules: **symmetric** cost matrices with one mode per cell (a short `local-search`, \
+then `ils` with Lin–Kernighan chains in a 1 % acceptance band, from the beam's sequence when \
+the beam ran) and **symmetric-modes**, several modes per cell (a colony before `ils`); \
+**free** asymmetric matrices with no precedence apart from a fixed start and end (`atsp`); \
+**sparse** precedence (a short `local-search`, a colony run backwards, `ils` in a 1 % then a 3 \
+% acceptance band with the bounded-shift DP ending every repair, window re-optimization of the \
+best), and with several modes per cell on up to 300 cells **sparse-modes** (three rounds of a \
+fresh colony, each polished by `ils` in the 1 % band, then `ils` in the 3 % band from the best \
+of the three and window re-optimization); **dense** precedence (a short `local-search`, then \
+`ils` with kicks that reorder up to 45 cells; on up to 300 cells, when the beam runs, half the \
+budget for the beam, then the default phases); **geometric free** instances (geometric, no or \
+very sparse precedence, links that cost the same both ways: `local-search` on the two-level \
+list with local and random-walk double-bridge kicks for the whole budget); and the catch-all \
+**default**, the other geometric instances among them (`local-search`, an `eacs` colony of its \
+own, `ils` from the best so far).
+
+`cellseq solve F --explain` prints the features, the rule and its plan before solving; \
+`CELLSEQ_TRACE=1` prints them and one line per phase on stderr. `--param plan=...` skips the \
+rules: its phases run with the beam settings of the portfolio's last rule. Plan syntax: \
+`solver[key=value;...]:share,...`, where the share is a fraction of what is left. After the \
+name, `*` starts the phase from the best sequence so far and `+` from the previous phase's \
+sequence; `~` before the name runs the phase on the instance travelled backwards (matrix \
+instances; elsewhere the phase runs forwards). A solver named twice gets a new seed each time. \
+Example: `cellseq solve F --param plan=local-search:0.3,eacs:0.5,ils*:1`. How the built-in \
+rules were chosen: [notes/portfolio.md](../notes/portfolio.md).",
     params: &[
         ParamSpec {
             name: "seconds",
@@ -78,7 +118,7 @@ pub static INFO: SolverInfo = SolverInfo {
         },
     ],
     caps: Caps { ..Caps::NONE },
-    make: |p: &Params| Ok(Box::new(Auto::from_params(p)?)),
+    build: Build::Fresh(|p: &Params| Ok(Box::new(Auto::from_params(p)?))),
 };
 
 /// The portfolio solver.
@@ -424,3 +464,20 @@ pub fn explain(
         lines,
     })
 }
+
+/// Validates an `auto` portfolio file as `solve` and `run` would read it: the names of its
+/// rules, in order (`cellseq check FILE`).
+pub fn validate_portfolio(path: &str) -> Result<Vec<String>> {
+    let p = Portfolio::load(path)?;
+    Ok(p.rules.iter().map(|r| r.name.clone()).collect())
+}
+
+/// True when `path` looks like a portfolio file (TOML with `[[rule]]` tables) rather than an
+/// experiment plan.
+pub fn is_portfolio_file(path: &std::path::Path) -> bool {
+    portfolio::is_portfolio_file(path)
+}
+
+/// The name `--param portfolio=` takes for the built-in portfolio.
+pub const BUILT_IN_PORTFOLIO: &str = portfolio::BUILT_IN_NAME;
+

@@ -78,8 +78,8 @@ pub fn check_phase(ph: &Phase, index: usize) -> std::result::Result<(), String> 
         return Err("a plan cannot contain auto itself".to_string());
     }
     let info = super::super::find(&ph.solver).map_err(|e| e.to_string())?;
-    info.build(&ph.params).map_err(|e| e.to_string())?;
-    if ph.start != Start::Fresh && !info.caps.starts_from {
+    info.check_params(&ph.params).map_err(|e| e.to_string())?;
+    if ph.start != Start::Fresh && !info.starts_from() {
         return Err(format!(
             "only {} can start from an earlier sequence",
             startable()
@@ -158,7 +158,7 @@ pub fn parse_plan(plan: &str) -> Result<Vec<Phase>> {
 fn startable() -> String {
     let mut names: Vec<&str> = super::super::registry()
         .into_iter()
-        .filter(|i| i.caps.starts_from)
+        .filter(|i| i.starts_from())
         .map(|i| i.name)
         .collect();
     names.sort_by_key(|n| (n.len(), *n));

@@ -26,10 +26,13 @@ mod refine;
 mod tables;
 mod twins;
 
-pub use pass::CHILD_EVALS;
+#[cfg(any(test, feature = "internals"))]
 pub use refine::prefix_bounds;
+#[cfg(any(test, feature = "internals"))]
 pub use twins::interchangeable_order;
 
+use super::Build;
+use super::WarmStart;
 use super::{Budget, Caps, Context, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo};
 use crate::bound::qpath::{self, QPath};
 use crate::bound::{self, BoundOptions};
@@ -45,6 +48,24 @@ pub static INFO: SolverInfo = SolverInfo {
     name: "beam",
     summary: "iterative beam search with prefix dominance and bound pruning; proves optimality \
               when a beam is wide enough",
+    description: "The exact/anytime tree search, and the one that proves optimality on instances too large \
+for `exact`.
+
+- A short deterministic `ils` run (`warm_evals`) gives the incumbent.
+- Iterative beam search over the precedence fringe: prefixes with the same visited set and \
+last (cell, mode) are merged (prefix dominance), interchangeable cells are visited in index \
+order (`twins`), and every prefix whose lower bound cannot beat the incumbent is pruned.
+- Node bounds: the `sec` relaxation (assignment with Lagrangian subtour-elimination \
+multipliers sharpened by precedence: each prefix is charged the prices of the sets it must \
+still leave; `sec=false` falls back to the plain assignment duals), cluster bounds, and the \
+`qpath` bound (a position-indexed path relaxation priced by Lagrange multipliers; \
+`qpath=false` turns it off).
+- Widths double per pass and grow ×`growth` from 1024; after the pass of width \
+`exhaustive_from`, one pass without a width limit, stopped only by `memory_mb`.
+- A pass that never had to drop a prefix for its width was exhaustive: the result is then \
+reported as proven optimal. Within 60 s this proves ESC07–ESC63, br17.*, rbg048a, rbg050c, \
+rbg109a, prob.42, p43.1–p43.4, ft53.4 and ry48p.4 (p43.2 the slowest, at about 55 s). \
+`CELLSEQ_TRACE=1` prints each pass. Design: [notes/bounds.md](../notes/bounds.md).",
     params: &[
         ParamSpec {
             name: "max_width",
@@ -127,10 +148,9 @@ pub static INFO: SolverInfo = SolverInfo {
     ],
     caps: Caps {
         exact: true,
-        warm_start: true,
         ..Caps::NONE
     },
-    make: |p: &Params| Ok(Box::new(from_params(p))),
+    build: Build::WarmStart(|p: &Params| Ok(Box::new(from_params(p)))),
 };
 
 /// Builds the solver from validated parameters.
@@ -189,8 +209,11 @@ impl Solver for Beam {
     fn solve(&self, ctx: &mut Context) -> Result<Outcome> {
         self.search_from(ctx, None)
     }
-    fn solve_from(&self, ctx: &mut Context, start: Option<&Sequence>) -> Result<Outcome> {
-        self.search_from(ctx, start.cloned())
+}
+
+impl WarmStart for Beam {
+    fn warm_start(&self, ctx: &mut Context, start: &Sequence) -> Result<Outcome> {
+        self.search_from(ctx, Some(start.clone()))
     }
 }
 

@@ -1,12 +1,9 @@
 //! The refined node bound of one prefix (degree sums over the arcs still possible, cluster
 //! surcharges, subtour-elimination multipliers), and the bounds built on it.
 
-use super::MAX_CELLS;
 use super::prefix::{Prefix, first_prefixes};
-use super::tables::{Tables, tables};
+use super::tables::Tables;
 use crate::cost::CostModel;
-use crate::error::{Error, Result};
-use crate::model::Visit;
 
 /// The dynamic bound of a prefix, in reduced costs (see [`Tables`]): every unvisited cell is
 /// entered from an unvisited cell or the last one, and left to an unvisited cell or home; the
@@ -262,44 +259,56 @@ fn cluster_links<const W: usize>(
     }
 }
 
-/// The node bound (`refined`: potentials, subtour-elimination multipliers, degree sums and
-/// cluster surcharges) of every prefix of `seq`, in order, with the tables built as the beam
-/// builds them (`upper`: a known solution cost for the subgradient steps; no symmetry
-/// breaking). For tests: along an optimal sequence every value is at most the optimum.
-pub fn prefix_bounds(m: &CostModel, seq: &[Visit], upper: Option<f64>) -> Result<Vec<f64>> {
-    fn go<const W: usize>(m: &CostModel, seq: &[Visit], upper: Option<f64>) -> Result<Vec<f64>> {
-        let t = tables(m, true, true, false, upper)?;
-        let mut scratch = vec![(0.0, 0.0); m.n() + t.clusters.len()];
-        let mut out = Vec::with_capacity(seq.len());
-        let Some(v0) = seq.first() else {
-            return Ok(out);
-        };
-        let mut p = Prefix::<W>::first(m, &t, v0.cell, v0.mode, 0.0);
-        out.push(refined(m, &t, &p, &mut scratch));
-        for w in seq.windows(2) {
-            let (a, b) = (w[0], w[1]);
-            p.bits[b.cell / 64] |= 1 << (b.cell % 64);
-            p.node = m.node(b.cell, b.mode) as u32;
-            p.g += m.arc(a.cell, a.mode, b.cell, b.mode);
+/// The bounds the tests read, compiled for them only.
+#[cfg(any(test, feature = "internals"))]
+mod for_tests {
+    use super::*;
+    use crate::error::{Error, Result};
+    use crate::model::Visit;
+    use crate::solvers::beam::MAX_CELLS;
+    use crate::solvers::beam::tables::tables;
+
+    /// The node bound (`refined`: potentials, subtour-elimination multipliers, degree sums and
+    /// cluster surcharges) of every prefix of `seq`, in order, with the tables built as the beam
+    /// builds them (`upper`: a known solution cost for the subgradient steps; no symmetry
+    /// breaking). For tests: along an optimal sequence every value is at most the optimum.
+    pub fn prefix_bounds(m: &CostModel, seq: &[Visit], upper: Option<f64>) -> Result<Vec<f64>> {
+        fn go<const W: usize>(m: &CostModel, seq: &[Visit], upper: Option<f64>) -> Result<Vec<f64>> {
+            let t = tables(m, true, true, false, upper)?;
+            let mut scratch = vec![(0.0, 0.0); m.n() + t.clusters.len()];
+            let mut out = Vec::with_capacity(seq.len());
+            let Some(v0) = seq.first() else {
+                return Ok(out);
+            };
+            let mut p = Prefix::<W>::first(m, &t, v0.cell, v0.mode, 0.0);
             out.push(refined(m, &t, &p, &mut scratch));
+            for w in seq.windows(2) {
+                let (a, b) = (w[0], w[1]);
+                p.bits[b.cell / 64] |= 1 << (b.cell % 64);
+                p.node = m.node(b.cell, b.mode) as u32;
+                p.g += m.arc(a.cell, a.mode, b.cell, b.mode);
+                out.push(refined(m, &t, &p, &mut scratch));
+            }
+            Ok(out)
         }
-        Ok(out)
-    }
-    match m.n().div_ceil(64) {
-        0 | 1 => go::<1>(m, seq, upper),
-        2 => go::<2>(m, seq, upper),
-        3 | 4 => go::<4>(m, seq, upper),
-        5..=8 => go::<8>(m, seq, upper),
-        9..=16 => go::<16>(m, seq, upper),
-        _ => Err(Error::Solver {
-            solver: "beam".into(),
-            msg: format!(
-                "instance has {} cells; beam accepts at most {MAX_CELLS}",
-                m.n()
-            ),
-        }),
+        match m.n().div_ceil(64) {
+            0 | 1 => go::<1>(m, seq, upper),
+            2 => go::<2>(m, seq, upper),
+            3 | 4 => go::<4>(m, seq, upper),
+            5..=8 => go::<8>(m, seq, upper),
+            9..=16 => go::<16>(m, seq, upper),
+            _ => Err(Error::Solver {
+                solver: "beam".into(),
+                msg: format!(
+                    "instance has {} cells; beam accepts at most {MAX_CELLS}",
+                    m.n()
+                ),
+            }),
+        }
     }
 }
+#[cfg(any(test, feature = "internals"))]
+pub use for_tests::prefix_bounds;
 
 /// The smallest refined bound over all one-cell prefixes: a lower bound on the optimum.
 pub(super) fn first_level_bound<const W: usize>(m: &CostModel, t: &Tables) -> f64 {

@@ -67,6 +67,7 @@ fn may_lead(cl: &Closure, a: usize, b: usize) -> bool {
 /// the strict order "leads, then index", so the exchanges end. Cells with the same precedence
 /// (e.g. 1–3 of p43.1) are ordered by index; p43.2's cells 5 and 6 too (6 has one more
 /// predecessor). Empty when the precedence has a cycle.
+#[cfg(any(test, feature = "internals"))]
 pub fn interchangeable_order(m: &CostModel) -> Vec<(usize, usize)> {
     Closure::new(&m.dag)
         .map(|cl| twin_order(m, &cl))
