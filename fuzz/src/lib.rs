@@ -1,7 +1,7 @@
 //! Steps the fuzz targets share.
 
 use cellseq::formats::{self, Format};
-use cellseq::solvers::{self, Budget, NoObserver};
+use cellseq::{Solve, SolverKind};
 
 /// Parses `data` as an instance file of `format`; when it parses and validates (and has at
 /// most 200 cells), solves it with `greedy` under an evaluation budget and panics if that
@@ -14,13 +14,7 @@ pub fn parse_validate_solve(data: &[u8], format: Format) {
     if cellseq::validate::validate(&inst, "fuzz").is_err() || inst.n() > 200 {
         return;
     }
-    let budget = Budget {
-        time_limit: None,
-        max_evals: Some(20_000),
-    };
-    let obj = inst.default_objective();
-    let opts = Default::default();
-    if let Err(e) = solvers::run("greedy", &inst, obj, &opts, 1, budget, &mut NoObserver) {
+    if let Err(e) = Solve::new(SolverKind::Greedy).max_evals(20_000).run(&inst) {
         panic!("validated instance, but greedy fails: {e}");
     }
 }

@@ -2,7 +2,7 @@
 //!
 //! The codecs ([`gcode`], [`svg`], [`dxf`], and [`drawing`], the model both drawing readers
 //! produce) read real programs, extract a [`cellseq::model::Instance`] from them and write the
-//! program back in a new order; they run no solver. The [`pipeline`] does: groups in their
+//! program back in a new order; they run no solver. The [`optimize`] pipeline does: groups in their
 //! required order → instance → solver → the original order kept where it is not worse → verify
 //! → write atomically.
 

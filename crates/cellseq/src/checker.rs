@@ -1,6 +1,6 @@
 //! The independent checker: feasibility and a from-scratch report of a sequence.
 //!
-//! Deliberately shares no code with [`crate::cost::CostModel`] (the solvers' evaluator): it
+//! Deliberately shares no code with `crate::cost::CostModel` (the solvers' evaluator): it
 //! walks the raw instance, re-derives every move from the machine description, and so catches
 //! any disagreement between what a solver believes and what the sequence really costs.
 

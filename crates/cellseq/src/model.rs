@@ -3,7 +3,7 @@
 //! A geometric instance (cells with entry/exit points cut on a machine) and a matrix instance
 //! (TSPLIB SOP, PCGTSP: explicit costs between (cell, mode) pairs) are the same [`Instance`]
 //! type; only [`Instance::matrix`] tells them apart. Solvers never look at that difference
-//! directly: they go through [`crate::cost::CostModel`].
+//! directly: they go through `crate::cost::CostModel`.
 
 use crate::geom::Point3;
 use serde::{Deserialize, Serialize};

@@ -287,7 +287,7 @@ impl Solved {
     pub fn gap_percent(&self, best_known: f64) -> Option<f64> {
         (best_known > 0.0).then(|| 100.0 * (self.report.cost - best_known) / best_known)
     }
-    /// Raises the lower bound with [`bound::compute`] at cheap settings (instances of up to
+    /// Raises the lower bound with `bound::compute` at cheap settings (instances of up to
     /// [`BOUND_MAX_CELLS`] cells; nothing when the result is proven optimal).
     pub fn attach_bound(&mut self, inst: &Instance) {
         if inst.n() > BOUND_MAX_CELLS || self.proven_optimal {

@@ -7,7 +7,7 @@
 //! parse, solve, verify and write, shared among groups by size), solving one group with its
 //! share and keeping the group's original order unless the solver's order is strictly better
 //! ([`solve_group`]), and where the time went ([`Timings`]). [`gcode`] is the G-code pipeline,
-//! [`drawing`] the pipeline of SVG and DXF drawings.
+//! [`strokes`] the pipeline of SVG and DXF drawings.
 
 pub mod gcode;
 pub mod strokes;

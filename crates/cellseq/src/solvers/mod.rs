@@ -158,7 +158,7 @@ pub enum Needs {
 }
 
 /// What a solver promises about its results, declared in its registry entry; sub-runs, plans
-/// and tests read it. (Which start it can take is not a flag: it is the [`Build`] variant.)
+/// and tests read it. (Which start it can take is not a flag: it is the `Build` variant.)
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Caps {
     /// Never ends worse than `greedy` and keeps to an evaluation budget up to one pass or
@@ -221,11 +221,11 @@ impl SolverInfo {
     pub fn check_params(&self, given: &BTreeMap<String, String>) -> Result<Params> {
         self.build(given).map(|(p, _)| p)
     }
-    /// True when the solver searches from a given sequence ([`StartsFrom`]).
+    /// True when the solver searches from a given sequence (`StartsFrom`).
     pub fn starts_from(&self) -> bool {
         matches!(self.build, Build::StartsFrom(_))
     }
-    /// True when the solver takes a given sequence as its first incumbent ([`WarmStart`]).
+    /// True when the solver takes a given sequence as its first incumbent (`WarmStart`).
     pub fn warm_start(&self) -> bool {
         matches!(self.build, Build::WarmStart(_))
     }

@@ -23,16 +23,16 @@ pub struct Features {
     pub geometric: bool,
     /// True when the costs read the same backwards (every arc costs what the reverse arc
     /// does, cell directions flipped): on a cost matrix tested arc by arc
-    /// ([`crate::engine::lk::symmetric`]); on a geometric instance known from how its links
+    /// (`crate::engine::lk::symmetric`); on a geometric instance known from how its links
     /// are costed (the air length, or time with no linking at cutting feed:
-    /// [`crate::engine::large::applies`]), at any size.
+    /// `crate::engine::large::applies`), at any size.
     pub symmetric: bool,
     /// Ordered pairs of the precedence closure over n(n−1)/2
     /// ([`crate::precedence::closure_density`]).
     pub closure_density: f64,
     /// The closure density among the cells not ordered against every other cell (a fixed
     /// start and end left out): 0 when nothing but the ends is constrained
-    /// ([`crate::engine::atsp::free_density`]).
+    /// (`crate::engine::atsp::free_density`).
     pub free_density: f64,
     /// Share of the cells in the widest level of the precedence (cells at the same longest-path
     /// depth from a cell without predecessors are mutually unordered): a lower bound on the
@@ -47,7 +47,7 @@ pub struct Features {
 }
 
 impl Features {
-    /// The features of model `m`. Cost statistics read at most [`COST_SAMPLE_ARCS`] arcs
+    /// The features of model `m`. Cost statistics read at most `COST_SAMPLE_ARCS` arcs
     /// (forbidden arcs left out); the rest is exact within the limits of the functions named
     /// on each field.
     pub fn of(m: &CostModel) -> Features {

@@ -412,7 +412,7 @@ impl Solver for Auto {
 pub struct Explanation {
     /// The portfolio: `built-in` or the file's path.
     pub portfolio: String,
-    /// The rule chosen ([`PLAN_RULE`] when the `plan` parameter replaced the selection).
+    /// The rule chosen (`PLAN_RULE` when the `plan` parameter replaced the selection).
     pub rule: String,
     /// The instance's features.
     pub features: Features,
