@@ -6,6 +6,7 @@
 
 use crate::cost::CostModel;
 use crate::model::{Instance, Sequence};
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
 /// How much work a solver may do. Evaluation budgets make runs deterministic.
@@ -66,6 +67,7 @@ pub struct Context<'a> {
     /// Budget.
     pub budget: Budget,
     observer: &'a mut dyn Observer,
+    stop: Option<&'a AtomicBool>,
     start: Instant,
     evaluations: u64,
     best: f64,
@@ -86,10 +88,21 @@ impl<'a> Context<'a> {
             seed,
             budget,
             observer,
+            stop: None,
             start: Instant::now(),
             evaluations: 0,
             best: f64::INFINITY,
         }
+    }
+    /// The same context, also stopped as soon as `stop` is set (from another thread: a user's
+    /// Ctrl-C, a caller's cancel); the solver ends as at the end of its budget.
+    pub fn with_stop(mut self, stop: Option<&'a AtomicBool>) -> Self {
+        self.stop = stop;
+        self
+    }
+    /// The stop flag this context honours, for the contexts of sub-runs.
+    pub fn stop_flag(&self) -> Option<&'a AtomicBool> {
+        self.stop
     }
     /// Counts `k` evaluations.
     #[inline]
@@ -104,8 +117,11 @@ impl<'a> Context<'a> {
     pub fn elapsed(&self) -> f64 {
         self.start.elapsed().as_secs_f64()
     }
-    /// True when the budget is used up.
+    /// True when the budget is used up or the stop flag is set.
     pub fn exhausted(&self) -> bool {
+        if self.stop.is_some_and(|s| s.load(Ordering::Relaxed)) {
+            return true;
+        }
         if let Some(m) = self.budget.max_evals
             && self.evaluations >= m
         {

@@ -90,6 +90,23 @@ macro_rules! int_value {
 }
 int_value!(u8, u16, u32, u64, usize);
 
+macro_rules! signed_value {
+    ($($t:ty),*) => {$(
+        impl From<$t> for ParamValue {
+            /// A non-negative value is an [`ParamValue::Int`]; a negative one keeps its text, so
+            /// that the check refuses it by name ("must be a non-negative integer, got '-3'").
+            fn from(v: $t) -> Self {
+                if v >= 0 {
+                    ParamValue::Int(v as u64)
+                } else {
+                    ParamValue::Text(v.to_string())
+                }
+            }
+        }
+    )*};
+}
+signed_value!(i8, i16, i32, i64, isize);
+
 impl From<f64> for ParamValue {
     fn from(v: f64) -> Self {
         ParamValue::Float(v)

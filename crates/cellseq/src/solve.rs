@@ -31,6 +31,7 @@ use crate::params::{ParamValue, Params};
 use crate::solvers::{self, SolverKind};
 use std::collections::BTreeMap;
 use std::path::Path;
+use std::sync::atomic::AtomicBool;
 use std::time::Duration;
 
 pub use crate::context::{Budget, NoObserver, Observer, Progress, Trace};
@@ -84,6 +85,7 @@ pub struct Solve<'o> {
     objective: Option<Objective>,
     lower_bound: bool,
     observer: Option<&'o mut dyn Observer>,
+    stop: Option<&'o AtomicBool>,
 }
 
 impl Default for Solve<'_> {
@@ -103,6 +105,7 @@ impl<'o> Solve<'o> {
             objective: None,
             lower_bound: false,
             observer: None,
+            stop: None,
         }
     }
     /// The random seed.
@@ -156,6 +159,12 @@ impl<'o> Solve<'o> {
         self.observer = Some(observer);
         self
     }
+    /// Stops the solver as soon as `stop` is set (from another thread: a user's Ctrl-C, a
+    /// caller's cancel); it returns the best sequence found so far, checked as always.
+    pub fn stop_when(mut self, stop: &'o AtomicBool) -> Self {
+        self.stop = Some(stop);
+        self
+    }
     /// The solver chosen.
     pub fn solver(&self) -> SolverKind {
         self.solver
@@ -181,7 +190,7 @@ impl<'o> Solve<'o> {
             trace: &mut trace,
             user: self.observer,
         };
-        let r = solvers::run(
+        let r = solvers::run_until(
             info.name,
             inst,
             objective,
@@ -189,6 +198,7 @@ impl<'o> Solve<'o> {
             self.seed,
             self.budget,
             &mut tee,
+            self.stop,
         )?;
         let mut solved = Solved {
             solver: self.solver,

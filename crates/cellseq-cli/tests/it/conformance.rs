@@ -1,15 +1,16 @@
-//! Conformance of every registered solver, one test per solver (generated from a list that a
-//! test holds equal to the registry): feasibility on small fixtures, determinism under an
+//! Conformance of every registered solver (the registry's `SolverKind::ALL`, so a new solver is
+//! covered automatically): feasibility on small fixtures, determinism under an
 //! evaluation budget, the budget respected, improvement solvers never worse than their greedy
 //! start, a feasible sequence even from a tiny budget, reported cost equal to the checker's
 //! (enforced by `run`). A solver's test checks every fixture and reports all its failures
 //! together.
 
 use crate::common::instance_path;
+use cellseq::SolverKind;
 use cellseq::formats::load_instance;
 use cellseq::generate::generate;
 use cellseq::model::Instance;
-use cellseq::solvers::{Budget, NoObserver, registry, run};
+use cellseq::solvers::{Budget, NoObserver, run};
 use std::collections::BTreeMap;
 
 /// What a solver can do, as far as these tests need to know.
@@ -134,11 +135,6 @@ fn conforms_with(name: &str, params: &[(&str, &str)]) {
     assert!(f.is_empty(), "{} failures:\n{}", f.len(), f.join("\n"));
 }
 
-/// Runs the conformance checks of one solver with its default parameters.
-fn conforms(name: &str) {
-    conforms_with(name, &[]);
-}
-
 /// `ils` with several walks (their scattered starts, the turns and the per-walk records) and
 /// with a set SOP-3-exchange block length:
 /// the same checks as every solver's defaults.
@@ -154,52 +150,18 @@ fn ils_with_walks_conforms() {
     conforms_with("ils", &[("max-block", "18446744073709551615")]);
 }
 
-/// One test module per registry solver: `conformance::<solver>::conforms`.
-macro_rules! per_solver {
-    ($($module:ident => $name:literal),* $(,)?) => {
-        /// The solvers the tests below cover, in registry order.
-        const COVERED: &[&str] = &[$($name),*];
-        $(
-            mod $module {
-                #[test]
-                fn conforms() {
-                    super::conforms($name);
-                }
-            }
-        )*
-    };
-}
-
-per_solver! {
-    auto => "auto",
-    as_given => "as-given",
-    greedy => "greedy",
-    greedy_edge => "greedy-edge",
-    insertion => "insertion",
-    ils => "ils",
-    atsp => "atsp",
-    exact => "exact",
-    beam => "beam",
-    reopt => "reopt",
-    two_opt => "two-opt",
-    local_search => "local-search",
-    sa => "sa",
-    tabu => "tabu",
-    aco => "aco",
-    eacs => "eacs",
-    process => "process",
-    rules => "rules",
-    drawing => "drawing",
-}
-
+/// Every registry solver with its default parameters: the list is `SolverKind::ALL`, derived
+/// from the registry, so a new solver is covered without a line here. The solvers run in
+/// parallel and every failure of every solver is reported together.
 #[test]
-fn every_registry_solver_has_a_conformance_test() {
-    let names: Vec<&str> = registry().iter().map(|i| i.name).collect();
-    assert_eq!(
-        COVERED,
-        &names[..],
-        "add a line to `per_solver!` in tests/it/conformance.rs for each new solver"
-    );
+fn every_registry_solver_conforms() {
+    use rayon::prelude::*;
+    let none = BTreeMap::new();
+    let f: Vec<String> = SolverKind::ALL
+        .par_iter()
+        .flat_map(|k| failures(k.name(), &none))
+        .collect();
+    assert!(f.is_empty(), "{} failures:\n{}", f.len(), f.join("\n"));
 }
 
 #[test]

@@ -76,6 +76,7 @@ use crate::cost::CostModel;
 use crate::error::{Error, Result};
 use crate::model::{Instance, Objective, Sequence};
 use std::collections::BTreeMap;
+use std::sync::atomic::AtomicBool;
 
 pub use crate::context::{
     Budget, Context, NoObserver, Observer, Outcome, outcome_of,
@@ -335,7 +336,8 @@ pub fn sub_run(ctx: &mut Context, sub: Sub) -> Result<Outcome> {
     let (_, solver) = info.build(sub.params)?;
     let (instance, model) = sub.on.unwrap_or((ctx.instance, ctx.model));
     let mut quiet = NoObserver;
-    let mut inner = Context::new(instance, model, sub.seed, sub.budget, &mut quiet);
+    let mut inner = Context::new(instance, model, sub.seed, sub.budget, &mut quiet)
+        .with_stop(ctx.stop_flag());
     let out = solver.run(&mut inner, sub.start, info.name)?;
     ctx.count(inner.evaluations());
     Ok(out)
@@ -369,6 +371,21 @@ pub fn run(
     budget: Budget,
     observer: &mut dyn Observer,
 ) -> Result<RunResult> {
+    run_until(name, inst, objective, given, seed, budget, observer, None)
+}
+
+/// [`run`], also stopped (with the best found so far) as soon as `stop` is set.
+#[allow(clippy::too_many_arguments)]
+pub fn run_until(
+    name: &str,
+    inst: &Instance,
+    objective: Objective,
+    given: &BTreeMap<String, String>,
+    seed: u64,
+    budget: Budget,
+    observer: &mut dyn Observer,
+    stop: Option<&AtomicBool>,
+) -> Result<RunResult> {
     let info = find(name)?;
     let (_, solver) = info.build(given)?;
     let model = CostModel::new(inst, objective);
@@ -379,7 +396,7 @@ pub fn run(
         ));
     }
     let objective = model.objective();
-    let mut ctx = Context::new(inst, &model, seed, budget, observer);
+    let mut ctx = Context::new(inst, &model, seed, budget, observer).with_stop(stop);
     let outcome = solver.run(&mut ctx, None, name)?;
     let elapsed_s = ctx.elapsed();
     let evaluations = ctx.evaluations();
