@@ -140,6 +140,46 @@ fn fed(
     })
 }
 
+/// The R plane, the bottom, the first hole's X and Y (file units) and the steps between
+/// repeats: absolute, or in G91 R from the initial level `il`, Z from R and X/Y from `cur`.
+fn placement(
+    w: &Words,
+    n: &str,
+    absolute: bool,
+    wd: &Words4,
+    il: f64,
+    cur: [Option<f64>; 3],
+) -> Result<(f64, f64, f64, f64, f64, f64), String> {
+    let known_xy = |k: usize, c: char| {
+        cur[k].ok_or(format!(
+            "{n} needs {c}: the program does not know where the tool is in {c} (after \
+             G28/G30/G53); give {c} on the line"
+        ))
+    };
+    Ok(if absolute {
+        let aa = match w.get('X') {
+            Some(v) => v,
+            None => known_xy(0, 'X')?,
+        };
+        let bb = match w.get('Y') {
+            Some(v) => v,
+            None => known_xy(1, 'Y')?,
+        };
+        (wd.r, wd.z, aa, bb, 0.0, 0.0)
+    } else {
+        let r = wd.r + il;
+        let (x, y) = (known_xy(0, 'X')?, known_xy(1, 'Y')?);
+        (
+            r,
+            r + wd.z,
+            x,
+            y,
+            w.get('X').unwrap_or(0.0),
+            w.get('Y').unwrap_or(0.0),
+        )
+    })
+}
+
 /// Runs a canned-cycle line (motion mode `mode`): its holes, the retained words, the series'
 /// initial level and the position after. Errors name what LinuxCNC would refuse.
 pub(super) fn run(
@@ -194,34 +234,7 @@ pub(super) fn run(
     };
     let il = il_mm / s;
     let cur = pos.map(|v| v.map(|v| v / s));
-    let known_xy = |k: usize, c: char| {
-        cur[k].ok_or(format!(
-            "{n} needs {c}: the program does not know where the tool is in {c} (after \
-             G28/G30/G53); give {c} on the line"
-        ))
-    };
-    let (r, cc, mut aa, mut bb, ai, bi) = if st.absolute {
-        let aa = match w.get('X') {
-            Some(v) => v,
-            None => known_xy(0, 'X')?,
-        };
-        let bb = match w.get('Y') {
-            Some(v) => v,
-            None => known_xy(1, 'Y')?,
-        };
-        (wd.r, wd.z, aa, bb, 0.0, 0.0)
-    } else {
-        let r = wd.r + il;
-        let (x, y) = (known_xy(0, 'X')?, known_xy(1, 'Y')?);
-        (
-            r,
-            r + wd.z,
-            x,
-            y,
-            w.get('X').unwrap_or(0.0),
-            w.get('Y').unwrap_or(0.0),
-        )
-    };
+    let (r, cc, mut aa, mut bb, ai, bi) = placement(w, &n, st.absolute, &wd, il, cur)?;
     in_range('R', r * s)?;
     in_range('Z', cc * s)?;
     if r < cc {

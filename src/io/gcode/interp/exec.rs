@@ -27,6 +27,13 @@ pub(super) fn step(
     let (motion_g, nonmodal) = classify_g(&w)?;
     feed_speed_tool(&w, st, &mut info, has_m6)?;
     m_codes(&w, st, &mut info)?;
+    if w.has_g(4.0) && !w.get('P').is_some_and(|p| (0.0..=1e9).contains(&p)) {
+        return Err(
+            "G4 dwell without a time P from 0 to 10^9 s (LinuxCNC refuses a missing or \
+             negative one too); give P"
+                .into(),
+        );
+    }
     modal_g(&w, st, &mut info);
     if let Some(m) = motion_g {
         info.explicit_motion = true;
