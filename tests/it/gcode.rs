@@ -140,8 +140,23 @@ fn import_gives_valid_instance() {
     let inst = gcode::import(&p, false, 0.5, None).unwrap();
     cellseq::validate::validate(&inst, "mill.ngc").unwrap();
     assert_eq!(inst.n(), 12);
-    // tool block order: 7 T1 cells × 5 T2 holes
-    assert!(inst.precedence.len() >= 35);
+    // tool block order: each of the 7 T1 cells before each of the 5 T2 holes (the holes of
+    // different cycles are groups of their own, chained)
+    let mut reach = vec![vec![false; 12]; 12];
+    for &(a, b) in &inst.precedence {
+        reach[a][b] = true;
+    }
+    for k in 0..12 {
+        for i in 0..12 {
+            for j in 0..12 {
+                reach[i][j] |= reach[i][k] && reach[k][j];
+            }
+        }
+    }
+    let t1: Vec<usize> = (0..12).filter(|&c| inst.cells[c].tool == "T1").collect();
+    let t2: Vec<usize> = (0..12).filter(|&c| inst.cells[c].tool == "T2").collect();
+    assert_eq!((t1.len(), t2.len()), (7, 5));
+    assert!(t1.iter().all(|&a| t2.iter().all(|&b| reach[a][b])));
 }
 
 proptest! {

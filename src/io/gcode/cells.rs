@@ -327,6 +327,7 @@ pub fn split(p: &Program) -> Result<Layout, (usize, String)> {
     let start = known(&p.lines[header_end].pos_before);
     assign_runs(p, &mut cells, &blocks);
     let clearance = clearances(p, split, &cells, &blocks);
+    keep_high_exits_last(&mut cells, &clearance);
     Ok(Layout {
         split,
         header_end,
@@ -636,6 +637,22 @@ fn other_series(p: &Program, a: &GCell, b: &GCell) -> bool {
         || x.absolute != y.absolute
         || x.retract_old_z != y.retract_old_z
         || x.cycle != y.cycle
+}
+
+/// A run's last cell that rises above its block's clearance at its end (pcb2gcode's "all
+/// done" retract to the tool-change height before the footer's `M5` and dwell) stays the last
+/// of its run: elsewhere its rise would be followed by a descent, and the footer would need
+/// a rise of its own.
+fn keep_high_exits_last(cells: &mut [GCell], clearance: &[f64]) {
+    let n = cells.len();
+    for k in 0..n {
+        let last = k + 1 == n || cells[k + 1].run != cells[k].run;
+        let first = k == 0 || cells[k - 1].run != cells[k].run;
+        let c = &mut cells[k];
+        if last && !first && !c.lead && c.exit[2] > clearance[c.block] + EPS {
+            c.trail = true;
+        }
+    }
 }
 
 /// Per block, the highest rapid between two of its cells (else of its approach, else the
