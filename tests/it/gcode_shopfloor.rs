@@ -164,12 +164,17 @@ fn a_footer_dwell_keeps_its_height_so_the_new_order_survives() {
     let text = "G21 G90 G94\nG0 Z25\nM3 S10000\nG4 P1\nG0 Z1\n\
                 G0 X0 Y0\nG1 Z-0.1 F100\nG1 X5\nG0 Z1\n\
                 G0 X50 Y50\nG1 Z-0.1\nG1 X55\nG0 Z1\n\
-                G0 X6 Y0\nG1 Z-0.1\nG1 X9\nG4 P0\nG0 Z25\n\
+                G0 X6 Y0\nG1 Z-0.1\nG1 X9\nG0 Z1\n\
+                G0 X60 Y50\nG1 Z-0.1\nG1 X65\nG4 P0\nG0 Z25\n\
                 M5\nG4 P1\nM2\n";
     let p = gcode::parse("f.ngc", text).unwrap();
     let out = optimize(&p, &opts()).unwrap();
     assert_eq!(out.kept, Kept::Nothing, "{:?}", out.note);
     assert!(out.after.air_length < out.before.air_length);
+    // the cell that rises to the tool-change height stays last, the footer's dwell at Z25
+    assert_eq!(out.order.last(), Some(&3));
+    let tail: Vec<&str> = out.text.lines().rev().take(5).collect();
+    assert_eq!(tail, ["M2", "G4 P1", "M5", "G0 Z25", "G4 P0"]);
 }
 
 #[test]
