@@ -132,6 +132,13 @@ fn print_figures(before: &Figures, after: &Figures) {
     t.values("cut length mm", before.cut_length, after.cut_length);
 }
 
+/// Says that the figures are in mm when the program is not (they are converted).
+fn say_units(program: &str) {
+    if program != "mm" {
+        say!("units: the program is in {program} (G20); every figure above is converted to mm");
+    }
+}
+
 /// Runs `optimize`.
 pub fn optimize(a: OptimizeArgs) -> anyhow::Result<()> {
     if let Some(o) = &a.output {
@@ -228,6 +235,8 @@ fn optimize_gcode(a: &OptimizeArgs) -> anyhow::Result<()> {
             "total_s": allowance.started.elapsed().as_secs_f64(),
             "before": out.before,
             "after": out.after,
+            "units": "mm",
+            "program_units": gcode::program_units(&parsed.program),
         });
         say!("{}", serde_json::to_string_pretty(&v)?);
     } else {
@@ -270,6 +279,7 @@ fn optimize_gcode(a: &OptimizeArgs) -> anyhow::Result<()> {
             );
         }
         print_figures(&out.before, &out.after);
+        say_units(gcode::program_units(&parsed.program));
         let t = &out.timings;
         say!(
             "time: parse {:.3} s, solve {:.3} s, verify {:.3} s, write {:.3} s",
@@ -329,6 +339,9 @@ pub fn verify(a: VerifyArgs) -> anyhow::Result<()> {
             v.events
         );
         print_figures(&v.before, &v.after);
+        if let Ok(p) = gcode::interp::interpret(&ta) {
+            say_units(gcode::program_units(&p));
+        }
     }
     Ok(())
 }

@@ -101,7 +101,14 @@ fn panels_of(
         "gcode" => {
             let text = cellseq::files::read_text(path)?;
             let parsed = gcode::parse(&file, &text)?;
-            out.push(cellseq_lab::plot::program_panel(title, &parsed.program));
+            // coordinates are drawn in mm whatever the program's units: the title says so
+            let units = gcode::program_units(&parsed.program);
+            let title = if units == "mm" {
+                title.to_string()
+            } else {
+                format!("{title} ({units} program, drawn in mm)")
+            };
+            out.push(cellseq_lab::plot::program_panel(&title, &parsed.program));
             if optimized {
                 let o = cellseq_programs::optimize::gcode::optimize(
                     &parsed,

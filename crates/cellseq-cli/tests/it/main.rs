@@ -27,6 +27,7 @@ mod engine_props;
 mod figure_fonts;
 mod gcode;
 mod gcode_reverse;
+mod gcode_shopfloor;
 mod generated_suite;
 mod generators;
 mod golden;

@@ -153,7 +153,13 @@ fn cut_ranges(p: &Program, split: Split, safe: f64) -> Result<Vec<CutRange>, (us
                     }
                 }
                 Split::Flat => {
-                    if matches!(li.motion, Motion::Rapid | Motion::Home) || li.tool_change || li.end
+                    if li.motion == Motion::Cycle {
+                        ranges.push((s, i, false));
+                        ranges.push((i, i + 1, true));
+                        open = None;
+                    } else if matches!(li.motion, Motion::Rapid | Motion::Home)
+                        || li.tool_change
+                        || li.end
                     {
                         ranges.push((s, i, false));
                         open = None;
@@ -175,7 +181,13 @@ fn cut_ranges(p: &Program, split: Split, safe: f64) -> Result<Vec<CutRange>, (us
                     || (li.motion == Motion::Rapid
                         && matches!((li.pos_before[2], zafter), (Some(a), Some(b)) if b < safe - EPS && b < a - EPS))
             }
-            Split::Flat => li.motion == Motion::Feed && cuts_something(li),
+            Split::Flat => {
+                if li.motion == Motion::Cycle {
+                    ranges.push((i, i + 1, true));
+                    continue;
+                }
+                li.motion == Motion::Feed && cuts_something(li)
+            }
         };
         if starts {
             open = Some(i);
@@ -196,6 +208,11 @@ fn cut_ranges(p: &Program, split: Split, safe: f64) -> Result<Vec<CutRange>, (us
         ranges.push((s, e, false));
     }
     Ok(ranges)
+}
+
+/// True when every cut of the range ends where the program knows the position.
+fn grounded(p: &Program, r: &CutRange) -> bool {
+    (r.0..r.1).all(|i| p.lines[i].cuts.iter().all(|c| c.unknown & 0b111000 == 0))
 }
 
 /// What the moves of a cell cover: the box of its cuts, their length, the deepest point, the
@@ -260,6 +277,21 @@ pub fn split(p: &Program) -> Result<Layout, (usize, String)> {
     };
     let mut ranges = cut_ranges(p, split, safe)?;
     ranges.retain(|r| r.1 > r.0);
+    // cuts before the program first gives a full position (after G28 G91 Z0, say, a feed in X
+    // and Y at the height only the controller knows) stay where they are, in the header
+    let lead = ranges.iter().take_while(|r| !grounded(p, r)).count();
+    ranges.drain(..lead);
+    if let Some(r) = ranges.iter().find(|r| !grounded(p, r)) {
+        let line = (r.0..r.1)
+            .find(|&i| p.lines[i].cuts.iter().any(|c| c.unknown & 0b111000 != 0))
+            .unwrap_or(r.0);
+        return Err((
+            p.lines[line].line,
+            "feed move to a position the program does not know (after G28/G30/G53 between \
+             cuts): give X, Y and Z in an absolute move before it"
+                .into(),
+        ));
+    }
     if ranges.is_empty() {
         return Err((0, "no cutting moves found".into()));
     }
@@ -295,6 +327,7 @@ pub fn split(p: &Program) -> Result<Layout, (usize, String)> {
     let start = known(&p.lines[header_end].pos_before);
     assign_runs(p, &mut cells, &blocks);
     let clearance = clearances(p, split, &cells, &blocks);
+    keep_high_exits_last(&mut cells, &clearance);
     Ok(Layout {
         split,
         header_end,
@@ -382,6 +415,9 @@ fn cut_cell(
     (s, e, cycle): (usize, usize, bool),
     place: Place,
 ) -> Result<GCell, (usize, String)> {
+    if cycle {
+        return Ok(cycle_cell(p, s, place));
+    }
     let first = &p.lines[s];
     let last = &p.lines[e - 1];
     let st = first.before;
@@ -425,16 +461,11 @@ fn cut_cell(
         pts,
         planar,
     } = geometry(p, s, e, entry);
-    if cycle {
-        entry = p.lines[s].cuts[0].from;
-    }
-    let exit = if cycle { entry } else { exit };
     if !bbox[0].is_finite() {
         bbox = [entry[0], entry[1], entry[0], entry[1]];
     }
     let closed_xy = (pts[0][0] - exit[0]).hypot(pts[0][1] - exit[1]) < 1e-3;
-    let closed =
-        (planar && !cycle && closed_xy && pts.len() >= 4 && area(&pts).abs() > 1e-6).then_some(pts);
+    let closed = (planar && closed_xy && pts.len() >= 4 && area(&pts).abs() > 1e-6).then_some(pts);
     Ok(GCell {
         start: s,
         end: e,
@@ -455,6 +486,56 @@ fn cut_cell(
         depth: if depth.is_finite() { depth } else { entry[2] },
         closed,
     })
+}
+
+/// The cell of a canned-cycle line `s` (its holes): entered over its first hole at the height
+/// the original starts it from (in G91: where the original is, since its holes step from
+/// there), left over its last hole at the height it retracts to (where the program never sets
+/// G98/G99 and that height is not known, the higher of the two it can be). A cycle cell is
+/// never pinned: what its holes cut does not depend on where the tool comes from, and the
+/// writer puts the tool where each hole moves as in the original.
+fn cycle_cell(p: &Program, s: usize, place: Place) -> GCell {
+    let li = &p.lines[s];
+    // the line's own G90/G91 and G98/G99 apply to its holes
+    let st = li.after;
+    let (first, last) = (li.cuts[0], li.cuts[li.cuts.len() - 1]);
+    let r = match first.kind {
+        CutKind::Cycle { r, .. } => r,
+        _ => first.from[2],
+    };
+    let level = li.pos_before[2].or(st.cycle_il).unwrap_or(r);
+    let entry = match known(&li.pos_before) {
+        Some(b) if !st.absolute => b,
+        _ => [first.to[0], first.to[1], level],
+    };
+    let high = st.cycle_il.unwrap_or(level).max(r);
+    let exit = [last.to[0], last.to[1], li.pos_after[2].unwrap_or(high)];
+    let Geometry {
+        bbox,
+        cut_length,
+        depth,
+        ..
+    } = geometry(p, s, s + 1, entry);
+    GCell {
+        start: s,
+        end: s + 1,
+        prefix: place.prefix,
+        gap_start: place.gap_start,
+        run: 0,
+        lead: false,
+        trail: false,
+        pinned: false,
+        block: place.block,
+        tool: st.tool,
+        entry,
+        exit,
+        state: li.before,
+        cycle: true,
+        bbox,
+        cut_length,
+        depth,
+        closed: None,
+    }
 }
 
 /// The program's elements set at the start of a cell's gap (see [`GCell::gap_start`]).
@@ -521,7 +602,8 @@ fn assign_runs(p: &Program, cells: &mut [GCell], blocks: &[Block]) {
             (a.end..b.start).any(|g| ends_run(p, g))
         };
         let closes = setter(a) && start != k - 1;
-        if barrier || closes || prev_out != this_in || a.pinned || b.pinned {
+        if barrier || closes || prev_out != this_in || a.pinned || b.pinned || other_series(p, a, b)
+        {
             run += 1;
             start = k;
         }
@@ -534,6 +616,41 @@ fn assign_runs(p: &Program, cells: &mut [GCell], blocks: &[Block]) {
             let last = k + 1 == n || cells[k + 1].run != cells[k].run;
             cells[k].lead = first && !last;
             cells[k].trail = !first;
+        }
+    }
+}
+
+/// True when cells `a` and `b` (in program order) are not holes of one kind of canned cycle:
+/// a hole and a cell that is not, or holes of cycles that differ in code, distance mode,
+/// retract mode or the words R, Z, P, Q. Such cells are not reordered among each other: the
+/// cost model sees none of the heights the cycles retract to, so mixing them could only add
+/// lifts (and the series they start).
+fn other_series(p: &Program, a: &GCell, b: &GCell) -> bool {
+    if !a.cycle && !b.cycle {
+        return false;
+    }
+    if a.cycle != b.cycle {
+        return true;
+    }
+    let (x, y) = (&p.lines[a.start].after, &p.lines[b.start].after);
+    x.motion != y.motion
+        || x.absolute != y.absolute
+        || x.retract_old_z != y.retract_old_z
+        || x.cycle != y.cycle
+}
+
+/// A run's last cell that rises above its block's clearance at its end (pcb2gcode's "all
+/// done" retract to the tool-change height before the footer's `M5` and dwell) stays the last
+/// of its run: elsewhere its rise would be followed by a descent, and the footer would need
+/// a rise of its own.
+fn keep_high_exits_last(cells: &mut [GCell], clearance: &[f64]) {
+    let n = cells.len();
+    for k in 0..n {
+        let last = k + 1 == n || cells[k + 1].run != cells[k].run;
+        let first = k == 0 || cells[k - 1].run != cells[k].run;
+        let c = &mut cells[k];
+        if last && !first && !c.lead && c.exit[2] > clearance[c.block] + EPS {
+            c.trail = true;
         }
     }
 }

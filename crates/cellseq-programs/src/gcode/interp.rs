@@ -1,6 +1,7 @@
 //! A modal RS-274 interpreter: executes lines, tracks state and position, and lists the
 //! cutting moves each line makes (what verification compares).
 
+mod cycle;
 mod exec;
 mod motion;
 
@@ -37,8 +38,13 @@ pub struct State {
     pub motion: Option<u16>,
     /// G98 (true) or G99.
     pub retract_old_z: bool,
-    /// Retained canned-cycle R, Z, P, Q (file units).
+    /// Retained canned-cycle R, Z, P, Q words (file units), as LinuxCNC keeps them for the
+    /// next hole of the same cycle.
     pub cycle: [Option<f64>; 4],
+    /// The initial level (mm) of the series of canned cycles in progress (LinuxCNC's
+    /// `cycle_il`: the Z where the first cycle of an unbroken series started; G98 retracts to
+    /// it, G91 R planes are relative to it); `None` outside a series.
+    pub cycle_il: Option<f64>,
     /// Tool in the spindle.
     pub tool: u32,
     /// Selected (T word) tool.
@@ -127,6 +133,7 @@ impl Default for State {
             motion: None,
             retract_old_z: true,
             cycle: [None; 4],
+            cycle_il: None,
             tool: 0,
             selected: 0,
             path: None,
@@ -221,9 +228,10 @@ pub enum CutKind {
         /// P word (full turns), 1 by default.
         turns: u32,
     },
-    /// A canned-cycle hole: cycle code ×10, R and bottom Z (mm), P, Q (mm), L.
+    /// A canned-cycle hole: cycle code ×10, R plane, P, Q, L and where it retracts to; the
+    /// hole runs from `from` (at R) to `to` (the bottom).
     Cycle {
-        /// 730, 810 … 890.
+        /// 730, 810, 820, 830, 850, 860, 890.
         code: u16,
         /// R plane (mm).
         r: f64,
@@ -231,8 +239,13 @@ pub enum CutKind {
         p: f64,
         /// Peck Q (mm).
         q: f64,
-        /// Repeats.
+        /// Repeats of the line (L).
         l: u32,
+        /// Height the hole retracts to (mm): R under G99, the series' initial level under
+        /// G98 (when above R); `None` when the program never sets G98/G99 and the two differ.
+        clear: Option<f64>,
+        /// Length fed (mm): the pecks, re-entries and feed-outs of the cycle.
+        len: f64,
     },
 }
 
@@ -256,6 +269,9 @@ pub struct Cut {
     /// True when the move started from a position the program does not know on some axis
     /// (after G28/G30/G53): the unknown start coordinates are taken from the end point.
     pub partial: bool,
+    /// Axes the program does not know: bits 0–2 the start's X, Y, Z, bits 3–5 the end's (an
+    /// unknown end coordinate is stored as 0). Such moves are compared with the mask.
+    pub unknown: u8,
 }
 
 impl Cut {
@@ -283,7 +299,7 @@ impl Cut {
                 ang += (turns.max(1) - 1) as f64 * std::f64::consts::TAU;
                 (r * ang).hypot(self.to[c] - self.from[c])
             }
-            CutKind::Cycle { r, l, .. } => (r - self.to[2]).abs() * l.max(1) as f64,
+            CutKind::Cycle { len, .. } => len,
         }
     }
     /// XY bounding box `[xmin, ymin, xmax, ymax]` (arcs: conservative).
@@ -434,10 +450,11 @@ pub fn interpret(src: &str) -> Result<Program, (usize, String)> {
     let mut words = Vec::with_capacity(text.len());
     let mut has_m6 = false;
     let mut has_z = false;
+    let mut read = Reader::new(&text);
     for (i, l) in text.iter().enumerate() {
-        let w = tokenize(l).map_err(|e| (i + 1, e))?;
+        let w = read.line(i, l)?;
         has_m6 |= w.has_m(6.0);
-        has_z |= w.has('Z');
+        has_z |= w.has('Z') || is_cycle_line(&w);
         words.push(w);
     }
     let mut st = State::default();
@@ -466,21 +483,76 @@ pub fn interpret_each(
 ) -> Result<(bool, bool), (usize, String)> {
     let mut has_m6 = false;
     let mut has_z = false;
+    let first = src
+        .lines()
+        .map(|l| l.trim().to_string())
+        .find(|l| !l.is_empty());
+    let mut read = Reader::starting(first.as_deref());
     for (i, l) in src.lines().enumerate() {
         let l = super::lex::normalize(l).map_err(|e| (i + 1, e))?;
-        let w = tokenize(&l).map_err(|e| (i + 1, e))?;
+        let w = read.line(i, &l)?;
         has_m6 |= w.has_m(6.0);
-        has_z |= w.has('Z');
+        has_z |= w.has('Z') || is_cycle_line(&w);
     }
     let mut st = State::default();
     let mut pos: Pos = [Some(0.0); 3];
+    let mut read = Reader::starting(first.as_deref());
     for (i, l) in src.lines().enumerate() {
         let l = super::lex::normalize(l).map_err(|e| (i + 1, e))?;
-        let w = tokenize(&l).map_err(|e| (i + 1, e))?;
+        let w = read.line(i, &l)?;
         let info = step(i + 1, w, &mut st, &mut pos, has_m6).map_err(|e| (i + 1, e))?;
         f(i, &info, &l);
     }
     Ok((has_z, has_m6))
+}
+
+/// Reads lines into words in program order: parameters carry from line to line, and in a
+/// program that starts with a `%` line everything after the closing `%` is not part of the
+/// program (LinuxCNC ignores it): such lines read as empty and are copied as they are.
+struct Reader {
+    params: super::expr::Params,
+    /// The program's first non-blank line is `%`.
+    percent: bool,
+    /// The opening `%` has been read.
+    opened: bool,
+    /// The closing `%` has been read: the rest is not part of the program.
+    ended: bool,
+}
+
+impl Reader {
+    fn new(text: &[String]) -> Self {
+        Reader::starting(text.iter().map(|l| l.trim()).find(|l| !l.is_empty()))
+    }
+
+    fn starting(first: Option<&str>) -> Self {
+        Reader {
+            params: Default::default(),
+            percent: first == Some("%"),
+            opened: false,
+            ended: false,
+        }
+    }
+
+    /// The words of line `i` (0-based), errors with the 1-based line number.
+    fn line(&mut self, i: usize, l: &str) -> Result<Words, (usize, String)> {
+        if self.ended {
+            return Ok(Words::default());
+        }
+        if self.percent && l.trim() == "%" {
+            self.ended = self.opened;
+            self.opened = true;
+            return Ok(Words::default());
+        }
+        tokenize(l, &mut self.params).map_err(|e| (i + 1, e))
+    }
+}
+
+/// True when the line names a canned-cycle G code (its holes move in Z).
+fn is_cycle_line(w: &Words) -> bool {
+    w.all('G').any(|g| {
+        let c = (g * 10.0).round() as i64;
+        c == 730 || (810..=890).contains(&c)
+    })
 }
 
 fn close(a: f64, b: f64) -> bool {

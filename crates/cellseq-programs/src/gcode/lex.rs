@@ -1,4 +1,7 @@
-//! Splitting one RS-274 line into words, with comments removed.
+//! Splitting one RS-274 line into words, with comments removed, parameters and expressions
+//! evaluated (see [`super::expr`]).
+
+use super::expr::{self, Cursor, Param, Params};
 
 /// One parsed line: its words (upper-case letter, value) and whether it had any text.
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -13,6 +16,14 @@ pub struct Words {
     pub dialect: bool,
     /// True for GRBL's homing cycle `$H` (the position is unknown afterwards).
     pub homing: bool,
+    /// True for a program-number line (`O1001`, `O01001 (NAME)`): kept in place, no effect.
+    pub program_number: bool,
+    /// Parameter settings on the line (`#1=6.35`, `#<depth>=-2`), in line order, with the
+    /// values they were given; they take effect after the whole line is read.
+    pub assigns: Vec<(Param, f64)>,
+    /// True when a word's value came from a parameter, an expression or a function: the line
+    /// is written back with its evaluated numbers ([`Words::evaluated`]).
+    pub computed: bool,
 }
 
 impl Words {
@@ -40,6 +51,56 @@ impl Words {
     pub fn is_empty(&self) -> bool {
         self.words.is_empty()
     }
+
+    /// The line as it is written when its values were computed: the line number, the words
+    /// and parameter settings with the numbers they had in the original (each value exactly,
+    /// shortest form), then the original's comments. Where a line is written, its motion is
+    /// then the original's whatever parameters are in force there.
+    pub fn evaluated(&self, original: &str) -> String {
+        let mut s = String::new();
+        if let Some(n) = self.n {
+            s.push_str(&format!("N{} ", exact(n)));
+        }
+        for &(c, v) in &self.words {
+            s.push_str(&format!("{c}{} ", exact(v)));
+        }
+        for (p, v) in &self.assigns {
+            s.push_str(&format!("{p}={} ", exact(*v)));
+        }
+        for c in comments(original) {
+            s.push_str(c);
+            s.push(' ');
+        }
+        s.truncate(s.trim_end().len());
+        s
+    }
+}
+
+/// A number in its shortest exact form, never in exponent form (what G-code reads).
+pub fn exact(v: f64) -> String {
+    let s = format!("{v}");
+    if s == "-0" { "0".into() } else { s }
+}
+
+/// The comments of a line (`( … )` groups and a `;` tail), as written.
+fn comments(line: &str) -> Vec<&str> {
+    let mut out = Vec::new();
+    let mut start = None;
+    for (i, ch) in line.char_indices() {
+        match (ch, start) {
+            ('(', None) => start = Some(i),
+            (')', Some(s)) => {
+                out.push(&line[s..=i]);
+                start = None;
+            }
+            (';', None) => {
+                out.push(&line[i..]);
+                break;
+            }
+            _ => {}
+        }
+    }
+    out
 }
 
 /// The line with every whitespace character outside comments made an ASCII space (LinuxCNC
@@ -77,12 +138,15 @@ pub fn normalize(line: &str) -> Result<std::borrow::Cow<'_, str>, String> {
     Ok(std::borrow::Cow::Owned(out))
 }
 
-/// Tokenizes a line. Errors name the problem (the caller adds file and line).
+/// Tokenizes a line, evaluating parameters and expressions with `params` (the parameters the
+/// program has set before this line) and applying the line's parameter settings to them
+/// afterwards. Errors name the problem (the caller adds file and line).
 ///
-/// Handles `( … )` and `;` comments, `%` lines, spaces inside words, lower case. Refuses `#`
-/// parameters, `[ … ]` expressions, O-words and block delete `/`: cellseq does not expand them,
-/// and skipping them would silently change the program.
-pub fn tokenize(line: &str) -> Result<Words, String> {
+/// Handles `( … )` and `;` comments, `%` lines, spaces inside words, lower case, program
+/// numbers (`O1001`). Refuses O-word control flow (`o100 sub`, `call`, `if`, `while`,
+/// `repeat` …) and block delete `/`: cellseq does not expand them, and skipping them would
+/// silently change the program.
+pub fn tokenize(line: &str, params: &mut Params) -> Result<Words, String> {
     let mut out = Words::default();
     let trimmed = line.trim();
     if trimmed == "%" || trimmed.is_empty() {
@@ -101,7 +165,55 @@ pub fn tokenize(line: &str) -> Result<Words, String> {
         out.homing = rest.starts_with('H');
         return Ok(out);
     }
-    // strip comments
+    let code = strip_comments(line, &mut out)?;
+    let code: String = code
+        .chars()
+        .filter(|c| !c.is_whitespace())
+        .collect::<String>()
+        .to_ascii_lowercase();
+    let mut c = Cursor::new(code.as_bytes());
+    let mut assigns: Vec<(Param, f64)> = Vec::new();
+    while let Some(b) = c.peek() {
+        match b {
+            b'#' => assigns.push(expr::setting(&mut c, params)?),
+            b'o' if out.words.is_empty() && assigns.is_empty() => {
+                program_number(&mut c)?;
+                out.program_number = true;
+            }
+            b'o' => {
+                return Err(
+                    "an O-word inside a line; O-words (program numbers) must start their line"
+                        .into(),
+                );
+            }
+            b'/' => return Err("block delete '/' is not supported; remove the '/' lines or the '/' marks and try again".into()),
+            b'a'..=b'z' => {
+                c.i += 1;
+                let letter = (b as char).to_ascii_uppercase();
+                let v = expr::value(&mut c, params)
+                    .map_err(|e| format!("word '{letter}': {e}"))?;
+                if letter == 'N' {
+                    if out.n.is_some() || !out.words.is_empty() {
+                        return Err("line number N must come first, once".into());
+                    }
+                    out.n = Some(v);
+                } else {
+                    out.words.push((letter, v));
+                }
+            }
+            _ => return Err(format!("unexpected character '{}'", b as char)),
+        }
+    }
+    out.computed = c.computed;
+    for (p, v) in &assigns {
+        params.set(p.clone(), *v);
+    }
+    out.assigns = assigns;
+    Ok(out)
+}
+
+/// The line without its comments (noting that it had one), refusing unbalanced ones.
+fn strip_comments(line: &str, out: &mut Words) -> Result<String, String> {
     let mut code = String::with_capacity(line.len());
     let mut depth = 0usize;
     for ch in line.chars() {
@@ -126,41 +238,61 @@ pub fn tokenize(line: &str) -> Result<Words, String> {
     if depth > 0 {
         return Err("unclosed comment".into());
     }
-    let chars: Vec<char> = code.chars().filter(|c| !c.is_whitespace()).collect();
-    let mut i = 0;
-    while i < chars.len() {
-        let c = chars[i].to_ascii_uppercase();
-        match c {
-            '#' => return Err("'#' parameters are not supported (expand them first)".into()),
-            '[' | ']' => return Err("expressions '[...]' are not supported".into()),
-            'O' => return Err("O-words (subroutines, program numbers) are not supported (expand them first)".into()),
-            '/' => return Err("block delete '/' is not supported; remove the '/' lines or the '/' marks and try again".into()),
-            'A'..='Z' => {}
-            _ => return Err(format!("unexpected character '{}'", chars[i])),
-        }
-        i += 1;
-        let start = i;
-        while i < chars.len() && (chars[i].is_ascii_digit() || matches!(chars[i], '.' | '-' | '+'))
-        {
-            i += 1;
-        }
-        let num: String = chars[start..i].iter().collect();
-        let v: f64 = num
-            .parse()
-            .map_err(|_| format!("word '{c}' has no valid number ('{num}')"))?;
-        if !v.is_finite() {
-            return Err(format!("word '{c}' has a non-finite value"));
-        }
-        if c == 'N' {
-            if out.n.is_some() || !out.words.is_empty() {
-                return Err("line number N must come first, once".into());
-            }
-            out.n = Some(v);
-        } else {
-            out.words.push((c, v));
-        }
+    Ok(code)
+}
+
+/// An O-word at the start of a line: a program number alone on its line (Fanuc, Haas, Mach3
+/// `O1001`, `O01001 (NAME)`) is accepted; O-word control flow and a number followed by other
+/// words are refused, naming the construct.
+fn program_number(c: &mut Cursor) -> Result<(), String> {
+    const KEYWORDS: [&str; 15] = [
+        "sub",
+        "endsub",
+        "call",
+        "do",
+        "while",
+        "endwhile",
+        "if",
+        "elseif",
+        "else",
+        "endif",
+        "break",
+        "continue",
+        "repeat",
+        "endrepeat",
+        "return",
+    ];
+    let all = c.rest();
+    c.i += 1;
+    let name_end = if c.peek() == Some(b'<') {
+        all.find('>').map(|k| k + 1).unwrap_or(all.len())
+    } else {
+        1 + all[1..]
+            .find(|ch: char| !(ch.is_ascii_digit() || ch == '.'))
+            .unwrap_or(all.len() - 1)
+    };
+    let (name, rest) = all.split_at(name_end);
+    let name = name.to_ascii_uppercase();
+    if let Some(k) = KEYWORDS.iter().find(|k| rest.starts_with(*k)) {
+        return Err(format!(
+            "O-word control flow '{name} {k}' (subroutines, calls, loops, conditionals) is not \
+             supported: expand it into straight-line G-code first (the program without \
+             O-words), or run the program as it is"
+        ));
     }
-    Ok(out)
+    if name.len() < 2 || name.starts_with("O<") || name[1..].parse::<f64>().is_err() {
+        return Err(format!(
+            "O-word '{name}' is neither a program number nor a control-flow line; remove it"
+        ));
+    }
+    if !rest.is_empty() {
+        return Err(format!(
+            "program number {name} followed by other words on its line (LinuxCNC refuses it: \
+             \"Unknown control command in o word\"); put the words on a line of their own"
+        ));
+    }
+    c.i = c.i - 1 + all.len();
+    Ok(())
 }
 
 #[cfg(test)]
@@ -169,20 +301,67 @@ mod tests {
 
     #[test]
     fn words_and_comments() {
-        let w = tokenize("N10 g1 x1.5 Y-.5 (cut) F 100 ; tail").unwrap();
+        let t = |l: &str| tokenize(l, &mut Params::default());
+        let w = t("N10 g1 x1.5 Y-.5 (cut) F 100 ; tail").unwrap();
         assert_eq!(w.n, Some(10.0));
         assert_eq!(
             w.words,
             vec![('G', 1.0), ('X', 1.5), ('Y', -0.5), ('F', 100.0)]
         );
         assert!(w.has_comment);
-        assert!(tokenize("G1 X#1").is_err());
-        assert!(tokenize("o100 sub").is_err());
-        assert!(tokenize("G1 X(").is_err());
-        assert!(tokenize("G1 X").is_err());
-        assert!(tokenize("$H").unwrap().homing);
-        assert!(tokenize("$X").unwrap().dialect);
-        assert!(tokenize("$J=G91 X1 F100").is_err());
+        assert!(t("G1 X#1").is_err());
+        assert!(t("o100 sub").is_err());
+        assert!(t("G1 X(").is_err());
+        assert!(t("G1 X").is_err());
+        assert!(t("$H").unwrap().homing);
+        assert!(t("$X").unwrap().dialect);
+        assert!(t("$J=G91 X1 F100").is_err());
+    }
+
+    #[test]
+    fn program_numbers_are_accepted_control_flow_is_refused() {
+        let t = |l: &str| tokenize(l, &mut Params::default());
+        for ok in ["O1001 (NAME)", "O01001", "o 1003", "N5 O2"] {
+            let w = t(ok).unwrap();
+            assert!(w.program_number && w.words.is_empty(), "{ok}");
+        }
+        for (bad, says) in [
+            ("o100 sub", "'O100 sub'"),
+            ("O100 call [1] [2]", "'O100 call'"),
+            ("o<loop> while [#1 LT 3]", "'O<LOOP> while'"),
+            ("o101 endif", "'O101 endif'"),
+            ("O1001 G21 G0 X2", "followed by other words"),
+            ("G0 X1 O5", "inside a line"),
+        ] {
+            let e = t(bad).map(|_| ()).unwrap_err();
+            assert!(e.contains(says), "{bad}: {e}");
+        }
+    }
+
+    #[test]
+    fn parameters_take_effect_after_the_line() {
+        let mut p = Params::default();
+        let w = tokenize("#1 = 6.350 #2=[#1*2]", &mut p);
+        // #1 is not set yet while the line is read
+        assert!(w.is_err());
+        let mut p = Params::default();
+        tokenize("#1 = 6.350", &mut p).unwrap();
+        let w = tokenize("G1 Z-#1 X[#1 * 0.5] #1=2 (c1) ; tail", &mut p).unwrap();
+        assert_eq!(w.words, vec![('G', 1.0), ('Z', -6.35), ('X', 3.175)]);
+        assert!(w.computed);
+        assert_eq!(
+            w.evaluated("G1 Z-#1 X[#1 * 0.5] #1=2 (c1) ; tail"),
+            "G1 Z-6.35 X3.175 #1=2 (c1) ; tail"
+        );
+        let w = tokenize("G1 X#1", &mut p).unwrap();
+        assert_eq!(w.words[1], ('X', 2.0));
+        let w = tokenize("#<Depth> = -1.5", &mut p).unwrap();
+        assert!(!w.computed && w.assigns.len() == 1);
+        assert_eq!(
+            tokenize("Z#<depth>", &mut p).unwrap().words,
+            vec![('Z', -1.5)]
+        );
+        assert!(tokenize("#5221 = 3", &mut p).is_err());
     }
 
     #[test]

@@ -10,6 +10,7 @@
 //! machine state, as multisets, and no new motion; and measures air travel, lifts and time.
 
 pub mod cells;
+pub mod expr;
 pub mod interp;
 pub mod lex;
 pub mod reverse;
@@ -49,6 +50,25 @@ pub fn parse(file: &str, text: &str) -> Result<Parsed> {
         program,
         layout,
     })
+}
+
+/// The units the program cuts in: `"mm"` (G21, or no G20), `"inch"` (G20 at every cut) or
+/// `"mm and inch"`. Whatever they are, positions, lengths and feeds are read into mm, and
+/// every figure cellseq reports for a program is in mm (and mm/min).
+pub fn program_units(p: &Program) -> &'static str {
+    let (mut mm, mut inch) = (false, false);
+    for li in p.lines.iter().filter(|l| !l.cuts.is_empty()) {
+        if li.after.metric {
+            mm = true;
+        } else {
+            inch = true;
+        }
+    }
+    match (mm, inch) {
+        (_, false) => "mm",
+        (false, true) => "inch",
+        (true, true) => "mm and inch",
+    }
 }
 
 /// The safe height used to count lifts (`None` for 2-D programs).

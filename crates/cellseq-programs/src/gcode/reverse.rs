@@ -164,7 +164,7 @@ pub fn write_reversed(p: &Program, has_z: bool, c: &GCell, plan: &Plan, out: &mu
     // non-motion lines before the feed moves, in order
     for i in c.start..plan.first {
         if p.lines[i].motion == Motion::None {
-            out.push_str(&p.text[i]);
+            out.push_str(&super::write::line_text(p, i));
             out.push('\n');
         }
     }
@@ -182,7 +182,7 @@ pub fn write_reversed(p: &Program, has_z: bool, c: &GCell, plan: &Plan, out: &mu
         let li = &p.lines[i];
         if li.motion == Motion::None {
             if li.before == li.after {
-                out.push_str(&p.text[i]);
+                out.push_str(&super::write::line_text(p, i));
                 out.push('\n');
             }
             continue;
@@ -255,7 +255,7 @@ pub fn write_reversed(p: &Program, has_z: bool, c: &GCell, plan: &Plan, out: &mu
     // non-motion lines after the feed moves, in order (the Z-only rapids became one move)
     for i in plan.last + 1..c.end {
         if p.lines[i].motion == Motion::None {
-            out.push_str(&p.text[i]);
+            out.push_str(&super::write::line_text(p, i));
             out.push('\n');
         }
     }

@@ -96,7 +96,7 @@ impl Measure {
                     f.lifts += 1;
                 }
                 if li.motion == Motion::Cycle {
-                    f.lifts += 1;
+                    f.lifts += li.cuts.len();
                 }
             }
             None => match li.motion {
@@ -139,8 +139,11 @@ fn key(c: &Cut, tol: f64) -> Vec<i64> {
             p,
             q: qq,
             l,
+            clear,
+            ..
         } => {
             k.extend([2, code as i64, q(r), q(p), q(qq), l as i64]);
+            k.extend(clear.map_or([0, 0], |c| [1, q(c)]));
         }
     }
     k.extend(c.from.iter().chain(c.to.iter()).map(|&v| q(v)));
@@ -178,6 +181,8 @@ fn same(a: &Cut, b: &Cut, tol: f64) -> bool {
                 p: p1,
                 q: q1,
                 l: l1,
+                clear: e1,
+                ..
             },
             CutKind::Cycle {
                 code: c2,
@@ -185,8 +190,20 @@ fn same(a: &Cut, b: &Cut, tol: f64) -> bool {
                 p: p2,
                 q: q2,
                 l: l2,
+                clear: e2,
+                ..
             },
-        ) => c1 == c2 && l1 == l2 && close(r1, r2) && close(p1, p2) && close(q1, q2),
+        ) => {
+            c1 == c2
+                && l1 == l2
+                && close(r1, r2)
+                && close(p1, p2)
+                && close(q1, q2)
+                && match (e1, e2) {
+                    (Some(a), Some(b)) => close(a, b),
+                    (a, b) => a.is_none() && b.is_none(),
+                }
+        }
         _ => false,
     };
     pts && kinds
@@ -331,7 +348,7 @@ impl Digest {
                 }
                 let c = oriented(c, tol, undirected_match);
                 d.cuts
-                    .push((hash128(&(key(&c, tol), c.partial, t)), i as u32, j as u32));
+                    .push((hash128(&(key(&c, tol), c.unknown, t)), i as u32, j as u32));
             }
             for (e, h) in events(li, text) {
                 if e {
@@ -507,7 +524,7 @@ fn match_cuts(
             let hit = ub.iter().enumerate().position(|(k, y)| {
                 !taken[k]
                     && get(&mb, y).is_some_and(|(cb, tb)| {
-                        ta == tb && ca.partial == cb.partial && same(&ca, &cb, tol)
+                        ta == tb && ca.unknown == cb.unknown && same(&ca, &cb, tol)
                     })
             });
             hit.map(|k| taken[k] = true).is_some()
@@ -708,22 +725,27 @@ fn events(li: &LineInfo, text: &str) -> Vec<(bool, u128)> {
 /// Same events with the same state (see [`equivalent`]); returns how many were compared.
 fn same_events(a: &Digest, b: &Digest) -> Result<usize, String> {
     let (ea, fa, eb, fb) = (&a.exact, &a.fewer, &b.exact, &b.fewer);
-    for (x, y) in ea.iter().zip(eb) {
-        if x.0 != y.0 {
-            return Err(format!(
-                "events differ (dwell, pause, user M code, coordinate-system change or \
-                 controller line, with the machine state): original line {} vs line {}",
-                x.1, y.1
-            ));
-        }
-    }
-    if ea.len() != eb.len() {
-        return Err(format!(
-            "event counts differ (dwells, pauses, user M codes, coordinate-system changes, \
-             controller lines): {} vs {}",
+    // the first event of one program that the other lacks (sorted multisets)
+    let lone = |line: usize, of: &str, other: &str| {
+        format!(
+            "events differ (dwell with its height, pause, user M code, coordinate-system change \
+             or controller line, with the machine state): {of} line {line} has no match in \
+             {other} ({} vs {} events)",
             ea.len(),
             eb.len()
-        ));
+        )
+    };
+    let (mut i, mut j) = (0, 0);
+    while i < ea.len() || j < eb.len() {
+        match (ea.get(i), eb.get(j)) {
+            (Some(x), Some(y)) if x.0 == y.0 => (i, j) = (i + 1, j + 1),
+            (Some(x), Some(y)) if x.0 < y.0 => {
+                return Err(lone(x.1, "the original's", "the output"));
+            }
+            (Some(x), None) => return Err(lone(x.1, "the original's", "the output")),
+            (_, Some(y)) => return Err(lone(y.1, "the output's", "the original")),
+            (None, None) => break,
+        }
     }
     // fb must be a sub-multiset of fa
     let mut i = 0;

@@ -1,11 +1,26 @@
 //! Writing the program back in a new cell order.
 
 use super::cells::{
-    Block, GCell, Layout, Split, entry_state, free_bits, is_boundary, is_motion_g, vertical,
+    Block, Layout, Split, entry_state, free_bits, is_boundary, is_motion_g, vertical,
 };
-use super::interp::{CutKind, Motion, Program, State, el, known};
+use super::interp::{Motion, Program, State, el, known};
 use super::reverse::{Plan, write_reversed};
+use std::borrow::Cow;
 use std::fmt::Write as _;
+
+mod cycles;
+
+/// Line `i` as the output writes it: as written, or, when its values came from parameters or
+/// expressions, with the numbers they had in the original ([`super::lex::Words::evaluated`]),
+/// so that it moves the same wherever it is written.
+pub fn line_text(p: &Program, i: usize) -> Cow<'_, str> {
+    let w = &p.lines[i].words;
+    if w.computed {
+        Cow::Owned(w.evaluated(&p.text[i]))
+    } else {
+        Cow::Borrowed(&p.text[i])
+    }
+}
 
 /// Formats a number for G-code (no exponent, at most `dec` decimals, trailing zeros trimmed).
 pub fn num(v: f64, dec: usize) -> String {
@@ -178,7 +193,7 @@ fn stripped(p: &Program, i: usize) -> Option<String> {
 
 fn gap_line(p: &Program, i: usize, out: &mut String) {
     if p.lines[i].motion == Motion::None {
-        out.push_str(&p.text[i]);
+        out.push_str(&line_text(p, i));
         out.push('\n');
     } else if let Some(s) = stripped(p, i) {
         out.push_str(&s);
@@ -195,6 +210,12 @@ struct Writer<'a> {
     pos: Option<[f64; 3]>,
     /// The output's motion mode (×10, as in [`State::motion`]); `Some(u16::MAX)` when unknown.
     motion: Option<u16>,
+    /// The initial level (mm) of the output's series of canned cycles in progress
+    /// ([`State::cycle_il`]); `None` outside a series.
+    il: Option<f64>,
+    /// The canned-cycle words R, Z, P, Q the output keeps for its next hole
+    /// ([`State::cycle`]).
+    kept: [Option<f64>; 4],
 }
 
 impl Writer<'_> {
@@ -206,14 +227,16 @@ impl Writer<'_> {
     /// Lines `[s, e)` of the original, unchanged.
     fn verbatim(&mut self, s: usize, e: usize) {
         for i in s..e {
-            self.out.push_str(&self.p.text[i]);
+            self.out.push_str(&line_text(self.p, i));
             self.out.push('\n');
+            let z0 = self.pos.map(|q| q[2]);
             if self.p.lines[i].motion != Motion::None {
                 self.pos = self.track(i);
             }
             if self.p.lines[i].explicit_motion {
                 self.motion = self.p.lines[i].after.motion;
             }
+            self.note_series(i, z0);
         }
         if e > s {
             self.cur = self.p.lines[e - 1].after;
@@ -250,7 +273,54 @@ impl Writer<'_> {
         let li = &self.p.lines[g];
         if li.motion == Motion::None && li.explicit_motion {
             self.motion = li.after.motion;
+            self.note_series(g, None);
         }
+    }
+
+    /// What line `i`, written as it is with the output's height `z0` before it, does to the
+    /// output's series of canned cycles: a cycle line starts one at `z0` where none is in
+    /// progress (as LinuxCNC does) and keeps the words it used; any other motion, G80 and G53
+    /// end the series.
+    fn note_series(&mut self, i: usize, z0: Option<f64>) {
+        let li = &self.p.lines[i];
+        if li.motion == Motion::Cycle {
+            if self.il.is_none() {
+                self.il = z0;
+            }
+            self.kept = li.after.cycle;
+        } else if li.explicit_motion
+            || matches!(li.motion, Motion::Rapid | Motion::Feed)
+            || (li.motion == Motion::Home && li.words.has_g(53.0))
+        {
+            self.il = None;
+        }
+    }
+
+    /// Makes the output's motion mode the original's `want` before lines `[s, e)` are copied
+    /// as written, when one of them moves without naming its motion code before one that
+    /// does (G80 to leave a canned cycle, else the mode's code alone).
+    fn motion_for(&mut self, lines: impl Iterator<Item = usize>, want: Option<u16>) {
+        if self.motion == want {
+            return;
+        }
+        let p = self.p;
+        let needs = lines
+            .filter(|&i| p.lines[i].motion != Motion::None || p.lines[i].explicit_motion)
+            .take(1)
+            .any(|i| !p.lines[i].explicit_motion);
+        if !needs {
+            return;
+        }
+        match want {
+            None => self.line("G80"),
+            Some(m) if m < 700 => self.line(&format!("G{}", motion_code(m))),
+            // a cycle continued by the copied lines: they are the original's cells, never here
+            Some(_) => return,
+        }
+        if want.is_none() || want.is_some_and(|m| m < 700) {
+            self.il = None;
+        }
+        self.motion = want;
     }
 
     fn reach(&mut self, target: &State, free: u32) -> Result<(), String> {
@@ -313,6 +383,7 @@ impl Writer<'_> {
         }
         self.pos = pos;
         self.motion = Some(0);
+        self.il = None;
     }
 
     /// The block's preamble when the output enters the block at another cell than its first:
@@ -336,6 +407,13 @@ impl Writer<'_> {
                     && !(vertical(p, g) && p.lines[g].pos_after[2].is_some_and(|z| z >= low - 1e-9))
             })
             .unwrap_or(first_start);
+        let verbatim: Vec<usize> = b
+            .preamble
+            .iter()
+            .copied()
+            .filter(|&g| g <= last || g < across)
+            .collect();
+        self.motion_for(verbatim.iter().copied(), p.lines[b.gap_start].before.motion);
         for &g in &b.preamble {
             if g <= last || g < across {
                 self.verbatim(g, g + 1);
@@ -371,9 +449,11 @@ pub fn write_checked(
         cur: p.lines[l.header_end].before,
         pos: known(&p.lines[l.header_end].pos_before),
         motion: p.lines[l.header_end].before.motion,
+        il: p.lines[l.header_end].before.cycle_il,
+        kept: p.lines[l.header_end].before.cycle,
     };
-    for t in &p.text[..l.header_end] {
-        w.out.push_str(t);
+    for i in 0..l.header_end {
+        w.out.push_str(&line_text(p, i));
         w.out.push('\n');
     }
     let z = matches!(l.split, Split::Z { .. });
@@ -411,6 +491,7 @@ pub fn write_checked(
             if enter && first == ci && plan.is_none() {
                 // the block's own approach to its first cell, as written
                 w.reach(&p.lines[b.gap_start].before, 0)?;
+                w.motion_for(b.gap_start..c.start, p.lines[b.gap_start].before.motion);
                 w.verbatim(b.gap_start, c.start);
             } else {
                 if enter {
@@ -442,25 +523,17 @@ pub fn write_checked(
                     // goes over at the higher of here and the entry, then to the entry's Z
                     p.has_z.then_some(f64::NEG_INFINITY)
                 };
-                if c.cycle {
-                    // a canned cycle moves over its hole by itself, at the height it starts
-                    // from: at least the height the original started it from
-                    let h = p.lines[c.start].pos_before[2].unwrap_or(entry[2]);
-                    w.link(entry, z.then_some(h), true);
-                } else {
+                if !c.cycle {
+                    // (a canned cycle makes its own approach: see `cycle_cell`)
                     w.link(entry, clear, false);
                 }
             }
         }
         block = c.block;
         let before = &p.lines[c.start].before;
-        let motion_ok = w.motion == before.motion && w.cur.cycle == before.cycle;
-        if c.cycle && !motion_ok {
-            cycle_line(p, c, &mut w.out);
-            w.pos = known(&p.lines[c.start].pos_after);
-            w.motion = None;
-        } else if c.cycle {
-            w.verbatim(c.start, c.end);
+        let motion_ok = w.motion == before.motion;
+        if c.cycle {
+            w.cycle_cell(l, c);
         } else {
             match plan {
                 Some(pl) => {
@@ -472,6 +545,7 @@ pub fn write_checked(
                     w.motion = p.lines[c.end - 1].after.motion;
                 }
             }
+            w.il = None;
             w.pos = Some(plan.map(|pl| pl.exit).unwrap_or(c.exit));
         }
         w.cur = p.lines[c.end - 1].after;
@@ -489,7 +563,10 @@ pub fn write_checked(
             target.set = (target.set & !(el::TOOL | el::TLC)) | (w.cur.set & (el::TOOL | el::TLC));
             w.reach(&target, 0)?;
             if z {
-                let h = l.clearance[block];
+                // up to the block's clearance, or to where the original's last cell left the
+                // tool when that is higher (a footer's dwell then runs at the original's height)
+                let h = l.clearance[block]
+                    .max(p.lines[l.footer_start].pos_before[2].unwrap_or(f64::NEG_INFINITY));
                 if w.pos.is_none_or(|q| q[2] < h - 1e-9) {
                     let s = format!("G0 Z{}", units(&w.cur, h));
                     if w.cur.absolute {
@@ -501,6 +578,7 @@ pub fn write_checked(
                 }
             }
         }
+        w.motion_for(l.footer_start..n, p.lines[l.footer_start].before.motion);
         w.verbatim(l.footer_start, n);
     }
     Ok(w.out)
@@ -521,41 +599,6 @@ pub fn write(
     })
 }
 
-/// A canned-cycle hole written with every word it uses, then G80.
-fn cycle_line(p: &Program, c: &GCell, out: &mut String) {
-    let li = &p.lines[c.start];
-    let cut = li.cuts[0];
-    if let CutKind::Cycle { code, l: reps, .. } = cut.kind {
-        let s = li.after.scale();
-        let mut line = format!(
-            "G{} X{} Y{} Z{} R{}",
-            motion_code(code),
-            num(cut.to[0] / s, 9),
-            num(cut.to[1] / s, 9),
-            exact(li.after.cycle[1].unwrap_or(0.0)),
-            exact(li.after.cycle[0].unwrap_or(0.0)),
-        );
-        if let Some(pv) = li.after.cycle[2] {
-            let _ = write!(line, " P{}", exact(pv));
-        }
-        if let Some(q) = li.after.cycle[3] {
-            let _ = write!(line, " Q{}", exact(q));
-        }
-        if reps > 1 {
-            let _ = write!(line, " L{reps}");
-        }
-        for &(ch, v) in &li.words.words {
-            let motion = ch == 'G' && is_motion_g(v);
-            if !motion && !matches!(ch, 'X' | 'Y' | 'Z' | 'R' | 'P' | 'Q' | 'L') {
-                let _ = write!(line, " {ch}{}", exact(v));
-            }
-        }
-        out.push_str(&line);
-        out.push('\n');
-    }
-    out.push_str("G80\n");
-}
-
 /// Copies lines `[s, e)`; with `fix`, the first motion line gets its modal motion code
 /// explicitly (a link before it changed the motion mode).
 fn body(p: &Program, s: usize, e: usize, fix: bool, out: &mut String) {
@@ -567,11 +610,11 @@ fn body(p: &Program, s: usize, e: usize, fix: bool, out: &mut String) {
             if !li.explicit_motion
                 && let Some(mode) = li.before.motion
             {
-                let _ = writeln!(out, "G{} {}", motion_code(mode), strip_n(&p.text[i]));
+                let _ = writeln!(out, "G{} {}", motion_code(mode), strip_n(&line_text(p, i)));
                 continue;
             }
         }
-        out.push_str(&p.text[i]);
+        out.push_str(&line_text(p, i));
         out.push('\n');
     }
 }

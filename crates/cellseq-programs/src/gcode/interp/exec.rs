@@ -27,6 +27,13 @@ pub(super) fn step(
     let (motion_g, nonmodal) = classify_g(&w)?;
     feed_speed_tool(&w, st, &mut info, has_m6)?;
     m_codes(&w, st, &mut info)?;
+    if w.has_g(4.0) && !w.get('P').is_some_and(|p| (0.0..=1e9).contains(&p)) {
+        return Err(
+            "G4 dwell without a time P from 0 to 10^9 s (LinuxCNC refuses a missing or \
+             negative one too); give P"
+                .into(),
+        );
+    }
     modal_g(&w, st, &mut info);
     if let Some(m) = motion_g {
         info.explicit_motion = true;
@@ -37,6 +44,11 @@ pub(super) fn step(
         return Ok(finish(info, w, st, pos));
     }
     let run_motion = axes || (info.explicit_motion && motion_g != Some(800));
+    // any motion but a canned cycle (and G80) ends a series of cycles (LinuxCNC's
+    // `cycle_il_flag`)
+    if motion_g == Some(800) || (run_motion && st.motion.is_some_and(|m| m < 700)) {
+        st.cycle_il = None;
+    }
     if run_motion {
         motion::run(&w, axes, st, pos, &mut info)?;
     }
@@ -125,7 +137,18 @@ fn classify_g(w: &Words) -> Result<(Option<u16>, Option<u16>), String> {
         }
         let code = code as u16;
         match code {
-            0 | 10 | 20 | 30 | 730 | 810..=890 if code.is_multiple_of(10) || code == 730 => {
+            740 | 840 | 870 | 880 => {
+                return Err(format!(
+                    "canned cycle G{g} ({}) is not supported (supported: G73, G81, G82, G83, \
+                     G85, G86, G89); replace it with plain moves",
+                    match code {
+                        740 | 840 => "tapping",
+                        870 => "back boring",
+                        _ => "boring with a manual stop",
+                    }
+                ));
+            }
+            0 | 10 | 20 | 30 | 730 | 810..=830 | 850 | 860 | 890 => {
                 if motion_g.is_some() {
                     return Err("two motion G codes on one line".into());
                 }
@@ -171,10 +194,22 @@ fn feed_speed_tool(
     has_m6: bool,
 ) -> Result<(), String> {
     if let Some(f) = w.get('F') {
+        if !(f == 0.0 || (1e-3..=1e9).contains(&f)) {
+            return Err(format!(
+                "feed F{} out of range (0, or 0.001 to 10^9 per minute)",
+                cellseq::validate::show(f)
+            ));
+        }
         st.feed = f;
         st.set |= el::FEED;
     }
     if let Some(s) = w.get('S') {
+        if !(0.0..=1e9).contains(&s) {
+            return Err(format!(
+                "spindle speed S{} out of range (0 to 10^9)",
+                cellseq::validate::show(s)
+            ));
+        }
         st.speed = s;
         st.set |= el::SPEED;
     }
@@ -332,8 +367,14 @@ fn non_modal(
             Ok(true)
         }
         Some(280) | Some(300) => {
+            // with axis words: to the point they name (the intermediate point), then only
+            // those axes to the stored position; without: every axis
             info.motion = Motion::Home;
-            *pos = [None; 3];
+            for (k, c) in ['X', 'Y', 'Z'].into_iter().enumerate() {
+                if !axes || w.has(c) {
+                    pos[k] = None;
+                }
+            }
             Ok(true)
         }
         Some(530) if axes => {
@@ -341,6 +382,7 @@ fn non_modal(
                 return Err("G53 needs G0 or G1".into());
             }
             info.motion = Motion::Home;
+            st.cycle_il = None;
             for (k, c) in ['X', 'Y', 'Z'].into_iter().enumerate() {
                 if w.has(c) {
                     pos[k] = None;

@@ -1,22 +1,39 @@
 //! A line's motion in the current motion mode: straight moves (G0, G1), arcs (G2, G3) with
-//! their centre from R or I/J/K, and canned-cycle holes (G73, G81–G89).
+//! their centre from R or I/J/K; canned-cycle holes are [`super::cycle`]'s.
 
 use super::super::lex::Words;
 use super::{Cut, CutKind, LineInfo, Motion, Pos, State, close, dist, known, plane_axes};
+use cellseq::validate::MAX_COORD;
 
 /// The position the line's X, Y, Z words name (mm), absolute or relative to `pos`.
 pub(super) fn target(w: &Words, scale: f64, pos: &Pos, absolute: bool) -> Result<Pos, String> {
     let mut t = *pos;
     for (k, c) in ['X', 'Y', 'Z'].into_iter().enumerate() {
         if let Some(v) = w.get(c) {
-            t[k] = if absolute {
-                Some(v * scale)
+            let p = if absolute {
+                v * scale
             } else {
-                Some(pos[k].ok_or("incremental move from an unknown position")? + v * scale)
+                pos[k].ok_or("incremental move from an unknown position")? + v * scale
             };
+            t[k] = Some(in_range(c, p)?);
         }
     }
     Ok(t)
+}
+
+/// A coordinate (mm) within the limit every command shares ([`MAX_COORD`]), else the error
+/// naming the axis: the same rule `import` applies to the instance it builds.
+pub(super) fn in_range(axis: char, mm: f64) -> Result<f64, String> {
+    if mm.is_finite() && mm.abs() <= MAX_COORD {
+        Ok(mm)
+    } else {
+        Err(format!(
+            "{axis} coordinate {} mm is out of range (at most {} mm from the origin, after \
+             offsets and incremental moves); correct the number",
+            cellseq::validate::show(mm),
+            cellseq::validate::show(MAX_COORD)
+        ))
+    }
 }
 
 /// Runs the motion of a line that has axis words or an explicit motion code.
@@ -33,12 +50,12 @@ pub(super) fn run(
     match mode {
         0 | 10 => straight(w, mode, st, pos, info),
         20 | 30 => arc(w, mode, axes, st, pos, info),
-        _ => cycle(w, mode, axes, st, pos, info),
+        _ => super::cycle::run(w, mode, axes, st, pos, info),
     }
 }
 
 /// A cut in the current state, with its geometry still to be filled in.
-fn cut_base(st: &State) -> Cut {
+pub(super) fn cut_base(st: &State) -> Cut {
     Cut {
         tool: st.tool,
         kind: CutKind::Line,
@@ -48,6 +65,7 @@ fn cut_base(st: &State) -> Cut {
         speed: if st.spindle == 5 { 0.0 } else { st.speed },
         offset: st.offset,
         partial: false,
+        unknown: 0,
     }
 }
 
@@ -74,12 +92,10 @@ fn straight(
         }
     } else {
         info.motion = Motion::Feed;
-        let to = known(&t).ok_or(
-            "feed move to a position the program does not know (after G28/G30/G53: \
-             give X, Y and Z in an absolute move first)",
-        )?;
-        // after G28/G30/G53 an axis the move does not name is where the controller
-        // left it: the move is kept in place and compared with that axis unknown
+        // after G28/G30/G53 an axis the program has not named since is where the controller
+        // left it: the move is compared with that axis unknown (start and end), and the
+        // cells keep such moves in place
+        let to = [0, 1, 2].map(|k| t[k].unwrap_or(0.0));
         let from = [0, 1, 2].map(|k| pos[k].unwrap_or(to[k]));
         if st.feed <= 0.0 {
             return Err("feed move with no feed rate (F); add an F word before the first feed move and try again (LinuxCNC refuses it too)".into());
@@ -88,6 +104,9 @@ fn straight(
         c.from = from;
         c.to = to;
         c.partial = known(pos).is_none();
+        c.unknown = (0..3)
+            .map(|k| (pos[k].is_none() as u8) << k | (t[k].is_none() as u8) << (k + 3))
+            .fold(0, |a, b| a | b);
         info.cuts.push(c);
     }
     *pos = t;
@@ -116,8 +135,11 @@ fn arc(
     let to = known(&t).ok_or("arc to an unknown position")?;
     let cw = mode == 20;
     let center = arc_center(w, st, cw, from, to)?;
+    for (k, v) in center.iter().enumerate() {
+        in_range(['I', 'J', 'K'][k], *v)?;
+    }
     let turns = match w.get('P') {
-        Some(p) if p >= 1.0 && close(p, p.round()) => p as u32,
+        Some(p) if (1.0..=1e6).contains(&p) && close(p, p.round()) => p as u32,
         Some(p) => return Err(format!("bad arc turn count P{p}")),
         None => 1,
     };
@@ -192,65 +214,4 @@ fn arc_center(
         }
     }
     Ok(center)
-}
-
-/// A canned cycle (G73, G81–G89): retains R, Z, P, Q; with axis words, one hole (L repeats)
-/// drilled from R to Z, then the retract (G98: the old Z, G99: R).
-fn cycle(
-    w: &Words,
-    mode: u16,
-    axes: bool,
-    st: &mut State,
-    pos: &mut Pos,
-    info: &mut LineInfo,
-) -> Result<(), String> {
-    if !st.absolute {
-        return Err("canned cycles in incremental mode (G91) are not supported".into());
-    }
-    if st.plane != 17 {
-        return Err("canned cycles outside the XY plane (G17) are not supported".into());
-    }
-    if st.cutter_comp {
-        return Err("canned cycle with cutter compensation on".into());
-    }
-    for (k, c) in ['R', 'Z', 'P', 'Q'].into_iter().enumerate() {
-        if let Some(v) = w.get(c) {
-            st.cycle[k] = Some(v);
-        }
-    }
-    if !axes {
-        return Ok(());
-    }
-    let scale = st.scale();
-    let r = st.cycle[0].ok_or("canned cycle without R")? * scale;
-    let z = st.cycle[1].ok_or("canned cycle without Z")? * scale;
-    if st.feed <= 0.0 {
-        return Err("canned cycle with no feed rate (F); add an F word before the first feed move and try again (LinuxCNC refuses it too)".into());
-    }
-    let l = match w.get('L') {
-        Some(l) if l >= 1.0 && close(l, l.round()) => l as u32,
-        Some(l) => return Err(format!("bad repeat count L{l}")),
-        None => 1,
-    };
-    let old = known(pos).ok_or("canned cycle from an unknown position")?;
-    let x = w.get('X').map(|v| v * scale).unwrap_or(old[0]);
-    let y = w.get('Y').map(|v| v * scale).unwrap_or(old[1]);
-    let mut c = cut_base(st);
-    c.from = [x, y, r];
-    c.to = [x, y, z];
-    c.kind = CutKind::Cycle {
-        code: mode,
-        r,
-        p: st.cycle[2].unwrap_or(0.0),
-        q: st.cycle[3].unwrap_or(0.0) * scale,
-        l,
-    };
-    info.cuts.push(c);
-    info.motion = Motion::Cycle;
-    let top = old[2].max(r);
-    info.rapid_len = (old[0] - x).hypot(old[1] - y) + (top - r) * 2.0;
-    info.xy_rapid_z = None;
-    let endz = if st.retract_old_z { top } else { r };
-    *pos = [Some(x), Some(y), Some(endz)];
-    Ok(())
 }
