@@ -30,6 +30,7 @@
 
 pub mod bound;
 pub mod check;
+pub mod clock;
 pub mod construct;
 pub mod cost;
 pub mod engine;
