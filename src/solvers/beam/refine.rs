@@ -4,6 +4,7 @@
 use super::MAX_CELLS;
 use super::prefix::{Prefix, first_prefixes};
 use super::tables::{Tables, tables};
+use crate::clock::Deadline;
 use crate::cost::CostModel;
 use crate::error::{Error, Result};
 use crate::model::Visit;
@@ -268,7 +269,7 @@ fn cluster_links<const W: usize>(
 /// breaking). For tests: along an optimal sequence every value is at most the optimum.
 pub fn prefix_bounds(m: &CostModel, seq: &[Visit], upper: Option<f64>) -> Result<Vec<f64>> {
     fn go<const W: usize>(m: &CostModel, seq: &[Visit], upper: Option<f64>) -> Result<Vec<f64>> {
-        let t = tables(m, true, true, false, upper)?;
+        let t = tables(m, true, true, false, upper, Deadline::NONE)?.expect("no deadline");
         let mut scratch = vec![(0.0, 0.0); m.n() + t.clusters.len()];
         let mut out = Vec::with_capacity(seq.len());
         let Some(v0) = seq.first() else {
