@@ -16,6 +16,7 @@
 //! order, so it applies to geometric instances without precedence that use one tool; on any
 //! other instance the `greedy-edge` solver returns the nearest-neighbour `greedy` sequence.
 
+use crate::clock::Deadline;
 use crate::cost::CostModel;
 use crate::engine::solution::flip_mode;
 use crate::model::{Sequence, Visit};
@@ -212,8 +213,17 @@ impl<'a> Level<'a> {
             .collect()
     }
 
-    /// Joins the items by a nearest-neighbour walk from the home point.
-    fn walk(self, count: &mut dyn FnMut(u64)) -> Sequence {
+    /// The items one after another as they are (variant 0): the quick completion once the
+    /// clock has run out (any order is feasible where greedy matching applies).
+    fn in_turn(&self, used: &[bool], seq: &mut Sequence) {
+        for (i, _) in self.items.iter().enumerate().filter(|(i, _)| !used[*i]) {
+            self.emit(i as u32, 0, seq);
+        }
+    }
+
+    /// Joins the items by a nearest-neighbour walk from the home point; once `deadline`
+    /// passes, the items not joined yet follow in turn.
+    fn walk(self, count: &mut dyn FnMut(u64), deadline: Deadline) -> Sequence {
         let mut per_item = vec![0usize; self.items.len()];
         for &(i, _) in &self.vars {
             per_item[i as usize] += 1;
@@ -224,7 +234,12 @@ impl<'a> Level<'a> {
         let mut stale = 0usize;
         let mut seq: Sequence = Vec::with_capacity(self.m.n());
         let mut left = self.items.len();
+        let mut clock = super::ticker(deadline);
         while left > 0 {
+            if clock.passed() {
+                self.in_turn(&used, &mut seq);
+                return seq;
+            }
             if stale * 2 > live.len() {
                 live.retain(|&k| !used[self.vars[k as usize].0 as usize]);
                 tree = self.tree(&live);
@@ -275,6 +290,17 @@ impl<'a> Level<'a> {
 /// The greedy matching sequence with `k` candidates per item end (see the module docs).
 /// Call only when [`applicable`] holds.
 pub fn sequence(m: &CostModel, k: usize, count: &mut dyn FnMut(u64)) -> Sequence {
+    sequence_until(m, k, count, Deadline::NONE)
+}
+
+/// Like [`sequence`]; once `deadline` passes (checked between rounds and in the walk), what
+/// is built is joined in turn instead.
+pub fn sequence_until(
+    m: &CostModel,
+    k: usize,
+    count: &mut dyn FnMut(u64),
+    deadline: Deadline,
+) -> Sequence {
     let items: Vec<Item> = (0..m.n())
         .map(|c| Item {
             seq: vec![Visit::new(c, 0)],
@@ -285,6 +311,11 @@ pub fn sequence(m: &CostModel, k: usize, count: &mut dyn FnMut(u64)) -> Sequence
     let mut level = Level::new(m, items);
     // rounds while they still merge at least an eighth of the items
     while level.items.len() > 1 {
+        if deadline.passed() {
+            let mut seq = Vec::with_capacity(m.n());
+            level.in_turn(&vec![false; level.items.len()], &mut seq);
+            return seq;
+        }
         let before = level.items.len();
         let items = level.round(k, count);
         let after = items.len();
@@ -293,5 +324,5 @@ pub fn sequence(m: &CostModel, k: usize, count: &mut dyn FnMut(u64)) -> Sequence
             break;
         }
     }
-    level.walk(count)
+    level.walk(count, deadline)
 }
