@@ -111,7 +111,7 @@ pub fn compute(m: &CostModel, opt: &BoundOptions) -> Bounds {
             dense_bounds(m, opt, &cl, &g, t0, &mut parts);
         }
     } else if m.is_geometric() && !dl.passed() {
-        let v = knn::knn_in_bound(m, opt.knn.max(1));
+        let v = knn::knn_in_bound_until(m, opt.knn.max(1), dl);
         parts.push(BoundValue {
             name: "degree_knn",
             value: constant + v,
