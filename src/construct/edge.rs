@@ -126,8 +126,15 @@ impl<'a> Level<'a> {
         }
     }
 
-    /// One matching round: the chains it builds, as the next level's items.
-    fn round(self, k: usize, count: &mut dyn FnMut(u64)) -> Vec<Item> {
+    /// One matching round: the chains it builds, as the next level's items; the level as it
+    /// is when `deadline` passes while the candidate links are gathered (the costly part:
+    /// about a second at 10⁵ cells).
+    fn round(
+        self,
+        k: usize,
+        count: &mut dyn FnMut(u64),
+        deadline: Deadline,
+    ) -> Result<Vec<Item>, Self> {
         let lv = &self;
         let all: Vec<u32> = (0..self.vars.len() as u32).collect();
         let tree = self.tree(&all);
@@ -135,6 +142,9 @@ impl<'a> Level<'a> {
         let mut links: Vec<(f64, u32, u32)> = (0..self.vars.len() as u32)
             .into_par_iter()
             .flat_map_iter(|a| {
+                if deadline.passed() {
+                    return Vec::new();
+                }
                 let (ia, va) = lv.vars[a as usize];
                 let last = lv.ends(ia, va).1;
                 let p = lv.m.exit(lv.m.node(last.cell, last.mode));
@@ -152,6 +162,10 @@ impl<'a> Level<'a> {
             })
             .collect();
         count(links.len() as u64);
+        if deadline.passed() {
+            drop(links);
+            return Err(self);
+        }
         links.par_sort_unstable_by(|x, y| {
             x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)).then(x.2.cmp(&y.2))
         });
@@ -208,9 +222,10 @@ impl<'a> Level<'a> {
         for (h, slot) in untouched {
             next[slot] = items[h].take();
         }
-        next.into_iter()
+        Ok(next
+            .into_iter()
             .map(|it| it.expect("every slot filled"))
-            .collect()
+            .collect())
     }
 
     /// The items one after another as they are (variant 0): the quick completion once the
@@ -317,7 +332,14 @@ pub fn sequence_until(
             return seq;
         }
         let before = level.items.len();
-        let items = level.round(k, count);
+        let items = match level.round(k, count, deadline) {
+            Ok(items) => items,
+            Err(cut) => {
+                let mut seq = Vec::with_capacity(m.n());
+                cut.in_turn(&vec![false; cut.items.len()], &mut seq);
+                return seq;
+            }
+        };
         let after = items.len();
         level = Level::new(m, items);
         if after * 8 > before * 7 {
