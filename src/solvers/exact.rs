@@ -85,6 +85,7 @@ impl Solver for Exact {
             used: 0,
             levels: Vec::with_capacity(n),
             pred_mask,
+            sort_per_key: 0.0,
         };
         let mut first = Level::default();
         let mut ideals = 0u64;
@@ -142,6 +143,9 @@ struct Dp {
     used: u64,
     levels: Vec<Level>,
     pred_mask: Vec<u128>,
+    /// Seconds per state of the last level's sort: the next sort is not started when the
+    /// time left would not cover it (a sort cannot stop halfway; a level holds millions).
+    sort_per_key: f64,
 }
 
 impl Dp {
@@ -153,8 +157,15 @@ impl Dp {
         let mut next = Level::default();
         let mut evals = 0u64;
         // deterministic iteration: the states of the previous level sorted (grouped by ideal)
+        if let Some(left) = ctx.deadline().remaining()
+            && left.as_secs_f64() < self.sort_per_key * prev.len() as f64
+        {
+            return Err(out_of_budget(k, n));
+        }
+        let sorting = std::time::Instant::now();
         let mut keys: Vec<Key> = prev.keys().copied().collect();
         keys.sort_unstable();
+        self.sort_per_key = sorting.elapsed().as_secs_f64() / keys.len().max(1) as f64;
         // one ideal's entries (last node, cost), in the order ties were always broken in:
         // last cell from the highest index down, modes in order
         let mut entries: Vec<(u32, f64)> = Vec::new();
