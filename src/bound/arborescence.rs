@@ -68,7 +68,10 @@ impl Heaps {
         }
         self.push(a);
         self.push(b);
-        let (a, b) = if self.key[b as usize] < self.key[a as usize] {
+        // ties go to the lower edge index, as in the recursive form: the same arborescence
+        // where several have the least weight
+        let (ka, kb) = (self.key[a as usize], self.key[b as usize]);
+        let (a, b) = if kb < ka || (kb == ka && b < a) {
             (b, a)
         } else {
             (a, b)
