@@ -4,6 +4,7 @@
 //! take a [`Context`] for their budget and counter, and the solvers receive one from
 //! [`crate::solvers::run`] or from a sub-run ([`crate::solvers::sub_run`]).
 
+pub use crate::clock::Deadline;
 use crate::cost::CostModel;
 use crate::model::{Instance, Sequence};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -71,6 +72,9 @@ pub struct Context<'a> {
     start: Instant,
     evaluations: u64,
     best: f64,
+    /// A cheap lower bound on the optimum ([`floor`]), computed on the first report: a run
+    /// whose best meets it is done.
+    floor: Option<f64>,
 }
 
 impl<'a> Context<'a> {
@@ -92,6 +96,7 @@ impl<'a> Context<'a> {
             start: Instant::now(),
             evaluations: 0,
             best: f64::INFINITY,
+            floor: None,
         }
     }
     /// The same context, also stopped as soon as `stop` is set (from another thread: a user's
@@ -117,9 +122,21 @@ impl<'a> Context<'a> {
     pub fn elapsed(&self) -> f64 {
         self.start.elapsed().as_secs_f64()
     }
-    /// True when the budget is used up or the stop flag is set.
+    /// The end of the wall-clock budget (none without a time limit): what long computations
+    /// below the solvers (bounds, tables, constructions) check.
+    pub fn deadline(&self) -> Deadline {
+        Deadline::from(self.start, self.budget.time_limit)
+    }
+    /// The wall-clock time left, or `None` without a time limit.
+    pub fn remaining(&self) -> Option<Duration> {
+        self.budget
+            .time_limit
+            .map(|t| t.saturating_sub(self.start.elapsed()))
+    }
+    /// True when the budget is used up, the stop flag is set, or when the best reported cost meets the model's
+    /// [`floor`] (it is optimal: nothing is left to search for).
     pub fn exhausted(&self) -> bool {
-        if self.stop.is_some_and(|s| s.load(Ordering::Relaxed)) {
+        if self.stop.is_some_and(|s| s.load(Ordering::Relaxed)) || self.solved() {
             return true;
         }
         if let Some(m) = self.budget.max_evals
@@ -134,9 +151,18 @@ impl<'a> Context<'a> {
         }
         false
     }
+    /// True when the best reported cost meets the model's [`floor`]: it is optimal.
+    #[inline]
+    pub fn solved(&self) -> bool {
+        self.floor
+            .is_some_and(|f| self.best <= f + 1e-9 * f.abs().max(1.0))
+    }
     /// Reports a solution cost; the observer hears of it when it improves the best.
     pub fn report(&mut self, cost: f64) {
         if cost < self.best - 1e-9 * cost.abs().max(1.0) {
+            if self.floor.is_none() {
+                self.floor = Some(floor(self.model));
+            }
             self.best = cost;
             let p = Progress {
                 evaluations: self.evaluations,
@@ -151,6 +177,35 @@ impl<'a> Context<'a> {
     pub fn best(&self) -> f64 {
         self.best
     }
+}
+
+/// A lower bound on the cost of every sequence that costs O(nodes) given the model's cheapest
+/// arcs ([`CostModel::least_arcs`], built once per model; without them the arcs count as 0):
+/// the constant, the cheapest start and finish, and every cell but one entered by its
+/// cheapest arc (in its cheapest mode), the dearest of those left out. Exact with one cell,
+/// with all-zero arcs and with all costs equal: a run that meets it can stop.
+pub fn floor(m: &CostModel) -> f64 {
+    let n = m.n();
+    let nodes = |c: usize| (0..m.modes(c)).map(move |md| (md, m.node(c, md)));
+    let least = |it: &mut dyn Iterator<Item = f64>| it.fold(f64::INFINITY, f64::min);
+    if n == 0 {
+        return m.constant();
+    }
+    if n == 1 {
+        let only = least(&mut nodes(0).map(|(md, _)| m.start(0, md) + m.finish(0, md)));
+        return m.constant() + only;
+    }
+    let start = least(&mut (0..n).flat_map(|c| nodes(c).map(move |(md, _)| m.start(c, md))));
+    let finish = least(&mut (0..n).flat_map(|c| nodes(c).map(move |(md, _)| m.finish(c, md))));
+    let entered = m.least_arcs().map_or(0.0, |la| {
+        let per: Vec<f64> = (0..n)
+            .map(|c| least(&mut nodes(c).map(|(_, nd)| la.inn[nd])))
+            .collect();
+        let top = per.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        per.iter().sum::<f64>() - top
+    });
+    let f = m.constant() + start + finish + entered;
+    if f.is_finite() { f } else { m.constant() }
 }
 
 /// What a solver returns.

@@ -76,6 +76,7 @@ macro_rules! internal {
 internal!(bound, construct, context, cost, engine, solvers);
 
 pub mod checker;
+pub mod clock;
 pub mod error;
 pub mod files;
 pub mod formats;

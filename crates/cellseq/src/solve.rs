@@ -22,6 +22,7 @@
 
 use crate::bound::{self, BoundOptions};
 use crate::checker::Report;
+use crate::clock::Deadline;
 use crate::cost::CostModel;
 use crate::error::{Error, Result};
 use crate::files::write_atomic;
@@ -35,6 +36,10 @@ use std::sync::atomic::AtomicBool;
 use std::time::Duration;
 
 pub use crate::context::{Budget, NoObserver, Observer, Progress, Trace};
+
+/// Share of a time limit kept for the lower bound when [`Solve::lower_bound`] is on: the
+/// solver gets the rest, so the limit covers the whole solve.
+pub const BOUND_SHARE: f64 = 0.05;
 
 /// Largest instance (cells) for which [`Solve::lower_bound`] computes a bound after solving.
 pub const BOUND_MAX_CELLS: usize = 200_000;
@@ -190,13 +195,19 @@ impl<'o> Solve<'o> {
             trace: &mut trace,
             user: self.observer,
         };
+        // the limit covers the bound too: the solver gets all but the bound's share
+        let deadline = Deadline::after(self.budget.time_limit);
+        let mut budget = self.budget;
+        if self.lower_bound {
+            budget.time_limit = budget.time_limit.map(|t| t.mul_f64(1.0 - BOUND_SHARE));
+        }
         let r = solvers::run_until(
             info.name,
             inst,
             objective,
             params.values(),
             self.seed,
-            self.budget,
+            budget,
             &mut tee,
             self.stop,
         )?;
@@ -214,7 +225,7 @@ impl<'o> Solve<'o> {
             trace: trace.points,
         };
         if self.lower_bound {
-            solved.attach_bound(inst);
+            solved.attach_bound_within(inst, deadline);
         }
         Ok(solved)
     }
@@ -300,7 +311,11 @@ impl Solved {
     /// Raises the lower bound with `bound::compute` at cheap settings (instances of up to
     /// [`BOUND_MAX_CELLS`] cells; nothing when the result is proven optimal).
     pub fn attach_bound(&mut self, inst: &Instance) {
-        if inst.n() > BOUND_MAX_CELLS || self.proven_optimal {
+        self.attach_bound_within(inst, Deadline::NONE);
+    }
+    /// [`Solved::attach_bound`] within `deadline`: a bound not done by then is left out.
+    pub fn attach_bound_within(&mut self, inst: &Instance, deadline: Deadline) {
+        if inst.n() > BOUND_MAX_CELLS || self.proven_optimal || deadline.passed() {
             return;
         }
         let model = CostModel::new(inst, self.objective);
@@ -309,6 +324,7 @@ impl Solved {
             lagrangian_max_cells: 200,
             assignment_max_cells: 1000,
             upper: Some(self.report.cost),
+            deadline,
             ..Default::default()
         };
         let b = bound::compute(&model, &opts).best;

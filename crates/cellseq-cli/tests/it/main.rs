@@ -46,4 +46,5 @@ mod safe_writes;
 mod safety_outputs;
 mod svg;
 mod svg_layers;
+mod time_limits;
 mod two_level;

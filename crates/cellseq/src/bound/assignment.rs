@@ -3,6 +3,7 @@
 //! a cyclic permutation, hence an assignment, so the optimum assignment is a lower bound.
 
 use super::cells::CellGraph;
+use crate::clock::Deadline;
 
 /// Solves the assignment problem on a dense square matrix (`INFINITY` = forbidden).
 /// Returns the optimal value and the column of each row, or `None` if no finite assignment
@@ -27,6 +28,16 @@ pub struct Assignment {
 /// Like [`hungarian`], and also returns the dual potentials `u`, `v` (reduced costs
 /// `cost(i, j) - u[i] - v[j]` are non-negative; `Σu + Σv` = the optimal value).
 pub fn hungarian_duals(d: usize, cost: impl Fn(usize, usize) -> f64) -> Option<Assignment> {
+    hungarian_duals_until(d, cost, Deadline::NONE)
+}
+
+/// Like [`hungarian_duals`], or `None` once `deadline` passes (checked before each of the d
+/// augmentations, each O(d²)).
+pub fn hungarian_duals_until(
+    d: usize,
+    cost: impl Fn(usize, usize) -> f64,
+    deadline: Deadline,
+) -> Option<Assignment> {
     if d == 0 {
         return Some(Assignment {
             value: 0.0,
@@ -57,6 +68,9 @@ pub fn hungarian_duals(d: usize, cost: impl Fn(usize, usize) -> f64) -> Option<A
     let mut p = vec![0usize; d + 1];
     let mut way = vec![0usize; d + 1];
     for i in 1..=d {
+        if deadline.passed() {
+            return None;
+        }
         p[0] = i;
         let mut j0 = 0usize;
         let mut minv = vec![inf; d + 1];

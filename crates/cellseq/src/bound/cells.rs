@@ -1,6 +1,7 @@
 //! The cell graph used by the dense bounds: min-over-modes arc costs between cells plus a
 //! home node, with every arc that precedence forbids removed (set to infinity).
 
+use crate::clock::Deadline;
 use crate::cost::CostModel;
 use crate::precedence::Closure;
 
@@ -19,6 +20,11 @@ pub struct CellGraph {
 impl CellGraph {
     /// Builds the graph: O(nodes²) arc evaluations.
     pub fn new(m: &CostModel, cl: &Closure) -> CellGraph {
+        Self::new_until(m, cl, Deadline::NONE).expect("no deadline")
+    }
+
+    /// Like [`CellGraph::new`], or `None` once `deadline` passes (checked once per cell).
+    pub fn new_until(m: &CostModel, cl: &Closure, deadline: Deadline) -> Option<CellGraph> {
         let n = m.n();
         let d = n + 1;
         let mut cost = vec![f64::INFINITY; d * d];
@@ -35,6 +41,9 @@ impl CellGraph {
             }
         }
         for i in 0..n {
+            if deadline.passed() {
+                return None;
+            }
             for j in 0..n {
                 if !cl.arc_allowed(i, j) {
                     continue;
@@ -48,7 +57,7 @@ impl CellGraph {
                 cost[i * d + j] = best;
             }
         }
-        CellGraph { n, cost }
+        Some(CellGraph { n, cost })
     }
 
     /// Number of graph nodes (cells + home).

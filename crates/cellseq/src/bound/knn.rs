@@ -6,6 +6,7 @@
 //! run at cutting feed, lifted moves and tool changes travel at least the planar distance at
 //! rapid), so `min(best found, r · rate)` is a valid lower bound on the cheapest entry.
 
+use crate::clock::{Deadline, Ticker};
 use crate::cost::CostModel;
 use crate::model::Objective;
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
@@ -14,6 +15,12 @@ use std::num::NonZero;
 /// Σ over cells of a lower bound on the cheapest way into the cell, plus a lower bound on
 /// the final move home; excludes the model's constant.
 pub fn knn_in_bound(m: &CostModel, k: usize) -> f64 {
+    knn_in_bound_until(m, k, Deadline::NONE)
+}
+
+/// Like [`knn_in_bound`], with the cells whose turn comes after `deadline` left out of the
+/// sum (every term is a cost ≥ 0, so the partial sum is a bound too).
+pub fn knn_in_bound_until(m: &CostModel, k: usize, deadline: Deadline) -> f64 {
     let n = m.n();
     let nodes = m.nodes();
     if n == 0 {
@@ -35,7 +42,11 @@ pub fn knn_in_bound(m: &CostModel, k: usize) -> f64 {
         _ => 1.0,
     };
     let mut total = 0.0;
+    let mut clock = Ticker::new(deadline, 256);
     for j in 0..n {
+        if clock.passed() {
+            break;
+        }
         let mut cell_best = f64::INFINITY;
         let first_ok = m.dag.preds[j].is_empty();
         for mj in 0..m.modes(j) {

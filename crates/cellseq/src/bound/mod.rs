@@ -22,6 +22,7 @@ pub mod knn;
 pub mod qpath;
 pub mod sec;
 
+use crate::clock::Deadline;
 use crate::cost::CostModel;
 use crate::precedence::Closure;
 use cells::CellGraph;
@@ -49,6 +50,9 @@ pub struct BoundOptions {
     pub knn: usize,
     /// A known solution cost (with the constant), used to size subgradient steps.
     pub upper: Option<f64>,
+    /// When to stop: a bound not started by then is skipped, one under way stops (the
+    /// subgradient bounds keep their best iterate; the assignment is dropped).
+    pub deadline: Deadline,
 }
 
 impl Default for BoundOptions {
@@ -62,6 +66,7 @@ impl Default for BoundOptions {
             sec_work: 1e8,
             knn: 16,
             upper: None,
+            deadline: Deadline::NONE,
         }
     }
 }
@@ -88,74 +93,22 @@ pub struct Bounds {
     pub best_name: &'static str,
 }
 
-/// Computes every affordable lower bound of the model's optimum.
+/// Computes every affordable lower bound of the model's optimum, within `opt.deadline`.
 pub fn compute(m: &CostModel, opt: &BoundOptions) -> Bounds {
     let n = m.n();
     let mut parts = Vec::new();
     let constant = m.constant();
     let t0 = Instant::now();
-    let closure = (n <= opt.dense_max_cells)
+    let dl = opt.deadline;
+    let closure = (n <= opt.dense_max_cells && !dl.passed())
         .then(|| Closure::new(&m.dag))
         .flatten();
     if let Some(cl) = closure {
-        let g = CellGraph::new(m, &cl);
-        let integral = g.integral() && constant.fract() == 0.0;
-        let round = |v: f64| {
-            if integral { (v - 1e-6).ceil() } else { v }
-        };
-        let mi: f64 = g.min_in().iter().filter(|c| c.is_finite()).sum();
-        let mo: f64 = g.min_out().iter().filter(|c| c.is_finite()).sum();
-        parts.push(BoundValue {
-            name: "degree",
-            value: round(constant + mi.max(mo)),
-            seconds: t0.elapsed().as_secs_f64(),
-        });
-        if n <= opt.assignment_max_cells {
-            let t = Instant::now();
-            if let Some(a) = assignment::assignment_bound(&g) {
-                parts.push(BoundValue {
-                    name: "assignment",
-                    value: round(constant + a),
-                    seconds: t.elapsed().as_secs_f64(),
-                });
-            }
+        if let Some(g) = CellGraph::new_until(m, &cl, dl) {
+            dense_bounds(m, opt, &cl, &g, t0, &mut parts);
         }
-        if n <= opt.lagrangian_max_cells && opt.lagrangian_iterations > 0 {
-            let t = Instant::now();
-            let upper = opt.upper.map(|u| u - constant);
-            if let Some(l) = arborescence::lagrangian_bound(&g, opt.lagrangian_iterations, upper) {
-                parts.push(BoundValue {
-                    name: "lagrangian",
-                    value: round(constant + l.bound),
-                    seconds: t.elapsed().as_secs_f64(),
-                });
-            }
-        }
-        let iters = sec::affordable_iterations(n, opt.sec_work, 300);
-        if n <= opt.assignment_max_cells && iters >= 10 {
-            let t = Instant::now();
-            let upper = opt.upper.map(|u| u - constant);
-            if let Some(s) = sec::sec_bound(&g, Some(&cl), upper, iters, 4 * n + 16) {
-                parts.push(BoundValue {
-                    name: "sec",
-                    value: round(constant + s.value),
-                    seconds: t.elapsed().as_secs_f64(),
-                });
-            }
-        }
-        let iters = qpath::affordable_iterations(m, opt.qpath_work, 300);
-        if iters >= 10 {
-            let t = Instant::now();
-            if let Some(q) = qpath::QPath::new(m, opt.upper, iters) {
-                parts.push(BoundValue {
-                    name: "qpath",
-                    value: round(q.root),
-                    seconds: t.elapsed().as_secs_f64(),
-                });
-            }
-        }
-    } else if m.is_geometric() {
-        let v = knn::knn_in_bound(m, opt.knn.max(1));
+    } else if m.is_geometric() && !dl.passed() {
+        let v = knn::knn_in_bound_until(m, opt.knn.max(1), dl);
         parts.push(BoundValue {
             name: "degree_knn",
             value: constant + v,
@@ -177,6 +130,74 @@ pub fn compute(m: &CostModel, opt: &BoundOptions) -> Bounds {
         parts,
         best: best.value,
         best_name: best.name,
+    }
+}
+
+/// The bounds on the dense cell graph `g`, each started only before `opt.deadline`.
+fn dense_bounds(
+    m: &CostModel,
+    opt: &BoundOptions,
+    cl: &Closure,
+    g: &CellGraph,
+    t0: Instant,
+    parts: &mut Vec<BoundValue>,
+) {
+    let n = m.n();
+    let constant = m.constant();
+    let dl = opt.deadline;
+    let integral = g.integral() && constant.fract() == 0.0;
+    let round = |v: f64| {
+        if integral { (v - 1e-6).ceil() } else { v }
+    };
+    let mi: f64 = g.min_in().iter().filter(|c| c.is_finite()).sum();
+    let mo: f64 = g.min_out().iter().filter(|c| c.is_finite()).sum();
+    parts.push(BoundValue {
+        name: "degree",
+        value: round(constant + mi.max(mo)),
+        seconds: t0.elapsed().as_secs_f64(),
+    });
+    let upper = opt.upper.map(|u| u - constant);
+    if n <= opt.assignment_max_cells && !dl.passed() {
+        let t = Instant::now();
+        if let Some(a) = assignment::hungarian_duals_until(g.size(), |i, j| g.c(i, j), dl) {
+            parts.push(BoundValue {
+                name: "assignment",
+                value: round(constant + a.value),
+                seconds: t.elapsed().as_secs_f64(),
+            });
+        }
+    }
+    if n <= opt.lagrangian_max_cells && opt.lagrangian_iterations > 0 && !dl.passed() {
+        let t = Instant::now();
+        if let Some(l) = arborescence::lagrangian_bound(g, opt.lagrangian_iterations, upper, dl) {
+            parts.push(BoundValue {
+                name: "lagrangian",
+                value: round(constant + l.bound),
+                seconds: t.elapsed().as_secs_f64(),
+            });
+        }
+    }
+    let iters = sec::affordable_iterations(n, opt.sec_work, 300);
+    if n <= opt.assignment_max_cells && iters >= 10 && !dl.passed() {
+        let t = Instant::now();
+        if let Some(s) = sec::sec_bound_until(g, Some(cl), upper, iters, 4 * n + 16, dl) {
+            parts.push(BoundValue {
+                name: "sec",
+                value: round(constant + s.value),
+                seconds: t.elapsed().as_secs_f64(),
+            });
+        }
+    }
+    let iters = qpath::affordable_iterations(m, opt.qpath_work, 300);
+    if iters >= 10 && !dl.passed() {
+        let t = Instant::now();
+        if let Some(q) = qpath::QPath::shifted(m, opt.upper, iters, None, dl) {
+            parts.push(BoundValue {
+                name: "qpath",
+                value: round(q.root),
+                seconds: t.elapsed().as_secs_f64(),
+            });
+        }
     }
 }
 

@@ -13,6 +13,7 @@
 //! least `h(p, l) + Σ_U λ` ([`QPath::completion`]). Dense precedence (narrow windows) makes the
 //! bound strong: on rbg048a the root value is 348.8 against an optimum of 351.
 
+use crate::clock::Deadline;
 use crate::cost::CostModel;
 use crate::precedence::Closure;
 
@@ -190,7 +191,7 @@ impl QPath {
     /// known solution with the constant, when given) and keeps the table of the best
     /// multipliers. `None` when the precedence has a cycle or the instance is empty.
     pub fn new(m: &CostModel, upper: Option<f64>, iterations: usize) -> Option<QPath> {
-        QPath::shifted(m, upper, iterations, None)
+        QPath::shifted(m, upper, iterations, None, Deadline::NONE)
     }
 
     /// Like [`QPath::new`] on the arc costs `c(i, j) − μ(i, j)`, where `shift = (μ, Σ μ_S,
@@ -198,12 +199,15 @@ impl QPath {
     /// (cells and home, `n + 1` columns) and `Σ μ_S` is added to the root value (every set
     /// must be left). The subgradient starts from the multipliers `λ₀`. A prefix's completion
     /// ([`QPath::completion`]) then bounds the rest in the shifted costs only: add `Σ μ_S`
-    /// over the sets that the rest must still leave.
+    /// over the sets that the rest must still leave. The subgradient steps stop at
+    /// `deadline` with the best multipliers so far; `None` when it passes before the first
+    /// step.
     pub fn shifted(
         m: &CostModel,
         upper: Option<f64>,
         iterations: usize,
         shift: Option<(&[f64], f64, &[f64])>,
+        deadline: Deadline,
     ) -> Option<QPath> {
         let n = m.n();
         if n == 0 {
@@ -237,6 +241,12 @@ impl QPath {
         let mut stale = 0;
         let mut done = 0;
         for it in 0..iterations.max(1) {
+            if deadline.passed() {
+                if it == 0 {
+                    return None;
+                }
+                break;
+            }
             done = it + 1;
             g.dp(&lambda, &mut dp);
             let walk = g.root(&lambda, &dp, &mut count);

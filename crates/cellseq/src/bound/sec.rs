@@ -23,6 +23,7 @@
 
 use super::assignment::{self, Assignment};
 use super::cells::CellGraph;
+use crate::clock::Deadline;
 use crate::precedence::Closure;
 use rustc_hash::FxHashMap;
 
@@ -95,6 +96,19 @@ pub fn sec_bound(
     iterations: usize,
     max_sets: usize,
 ) -> Option<SecBound> {
+    sec_bound_until(g, closure, upper, iterations, max_sets, Deadline::NONE)
+}
+
+/// Like [`sec_bound`], stopping at `deadline` with the best multipliers so far (every
+/// iterate is a valid bound); `None` when not even the first assignment was done.
+pub fn sec_bound_until(
+    g: &CellGraph,
+    closure: Option<&Closure>,
+    upper: Option<f64>,
+    iterations: usize,
+    max_sets: usize,
+    deadline: Deadline,
+) -> Option<SecBound> {
     let n = g.n;
     let d = n + 1;
     let mut f = Family::default();
@@ -106,7 +120,14 @@ pub fn sec_bound(
     for it in 0..iterations.max(1) {
         done = it + 1;
         let ma = arc_multipliers(n, &f.sets, &f.pi, &f.mu);
-        let a = assignment::hungarian_duals(d, |i, j| g.c(i, j) - ma[i * d + j])?;
+        let Some(a) =
+            assignment::hungarian_duals_until(d, |i, j| g.c(i, j) - ma[i * d + j], deadline)
+        else {
+            if deadline.passed() {
+                break;
+            }
+            return None;
+        };
         let value = a.value + f.mu.iter().sum::<f64>();
         if best
             .as_ref()

@@ -16,6 +16,7 @@
 //! order, so it applies to geometric instances without precedence that use one tool; on any
 //! other instance the `greedy-edge` solver returns the nearest-neighbour `greedy` sequence.
 
+use crate::clock::Deadline;
 use crate::cost::CostModel;
 use crate::engine::solution::flip_mode;
 use crate::model::{Sequence, Visit};
@@ -125,8 +126,15 @@ impl<'a> Level<'a> {
         }
     }
 
-    /// One matching round: the chains it builds, as the next level's items.
-    fn round(self, k: usize, count: &mut dyn FnMut(u64)) -> Vec<Item> {
+    /// One matching round: the chains it builds, as the next level's items; the level as it
+    /// is when `deadline` passes while the candidate links are gathered (the costly part:
+    /// about a second at 10⁵ cells).
+    fn round(
+        self,
+        k: usize,
+        count: &mut dyn FnMut(u64),
+        deadline: Deadline,
+    ) -> Result<Vec<Item>, Self> {
         let lv = &self;
         let all: Vec<u32> = (0..self.vars.len() as u32).collect();
         let tree = self.tree(&all);
@@ -134,6 +142,9 @@ impl<'a> Level<'a> {
         let mut links: Vec<(f64, u32, u32)> = (0..self.vars.len() as u32)
             .into_par_iter()
             .flat_map_iter(|a| {
+                if deadline.passed() {
+                    return Vec::new();
+                }
                 let (ia, va) = lv.vars[a as usize];
                 let last = lv.ends(ia, va).1;
                 let p = lv.m.exit(lv.m.node(last.cell, last.mode));
@@ -151,6 +162,10 @@ impl<'a> Level<'a> {
             })
             .collect();
         count(links.len() as u64);
+        if deadline.passed() {
+            drop(links);
+            return Err(self);
+        }
         links.par_sort_unstable_by(|x, y| {
             x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)).then(x.2.cmp(&y.2))
         });
@@ -207,13 +222,23 @@ impl<'a> Level<'a> {
         for (h, slot) in untouched {
             next[slot] = items[h].take();
         }
-        next.into_iter()
+        Ok(next
+            .into_iter()
             .map(|it| it.expect("every slot filled"))
-            .collect()
+            .collect())
     }
 
-    /// Joins the items by a nearest-neighbour walk from the home point.
-    fn walk(self, count: &mut dyn FnMut(u64)) -> Sequence {
+    /// The items one after another as they are (variant 0): the quick completion once the
+    /// clock has run out (any order is feasible where greedy matching applies).
+    fn in_turn(&self, used: &[bool], seq: &mut Sequence) {
+        for (i, _) in self.items.iter().enumerate().filter(|(i, _)| !used[*i]) {
+            self.emit(i as u32, 0, seq);
+        }
+    }
+
+    /// Joins the items by a nearest-neighbour walk from the home point; once `deadline`
+    /// passes, the items not joined yet follow in turn.
+    fn walk(self, count: &mut dyn FnMut(u64), deadline: Deadline) -> Sequence {
         let mut per_item = vec![0usize; self.items.len()];
         for &(i, _) in &self.vars {
             per_item[i as usize] += 1;
@@ -224,7 +249,12 @@ impl<'a> Level<'a> {
         let mut stale = 0usize;
         let mut seq: Sequence = Vec::with_capacity(self.m.n());
         let mut left = self.items.len();
+        let mut clock = super::ticker(deadline);
         while left > 0 {
+            if clock.passed() {
+                self.in_turn(&used, &mut seq);
+                return seq;
+            }
             if stale * 2 > live.len() {
                 live.retain(|&k| !used[self.vars[k as usize].0 as usize]);
                 tree = self.tree(&live);
@@ -275,6 +305,17 @@ impl<'a> Level<'a> {
 /// The greedy matching sequence with `k` candidates per item end (see the module docs).
 /// Call only when [`applicable`] holds.
 pub fn sequence(m: &CostModel, k: usize, count: &mut dyn FnMut(u64)) -> Sequence {
+    sequence_until(m, k, count, Deadline::NONE)
+}
+
+/// Like [`sequence`]; once `deadline` passes (checked between rounds and in the walk), what
+/// is built is joined in turn instead.
+pub fn sequence_until(
+    m: &CostModel,
+    k: usize,
+    count: &mut dyn FnMut(u64),
+    deadline: Deadline,
+) -> Sequence {
     let items: Vec<Item> = (0..m.n())
         .map(|c| Item {
             seq: vec![Visit::new(c, 0)],
@@ -285,13 +326,25 @@ pub fn sequence(m: &CostModel, k: usize, count: &mut dyn FnMut(u64)) -> Sequence
     let mut level = Level::new(m, items);
     // rounds while they still merge at least an eighth of the items
     while level.items.len() > 1 {
+        if deadline.passed() {
+            let mut seq = Vec::with_capacity(m.n());
+            level.in_turn(&vec![false; level.items.len()], &mut seq);
+            return seq;
+        }
         let before = level.items.len();
-        let items = level.round(k, count);
+        let items = match level.round(k, count, deadline) {
+            Ok(items) => items,
+            Err(cut) => {
+                let mut seq = Vec::with_capacity(m.n());
+                cut.in_turn(&vec![false; cut.items.len()], &mut seq);
+                return seq;
+            }
+        };
         let after = items.len();
         level = Level::new(m, items);
         if after * 8 > before * 7 {
             break;
         }
     }
-    level.walk(count)
+    level.walk(count, deadline)
 }

@@ -6,6 +6,7 @@
 //! the best exact arc cost found, so each step is exact and costs O(log n) in practice.
 //! Matrix instances scan the ready cells.
 
+use crate::clock::Deadline;
 use crate::cost::CostModel;
 use crate::model::{Objective, Sequence, Visit};
 use kiddo::{MutableKdTree, SquaredEuclidean};
@@ -36,11 +37,22 @@ impl Fringe {
 
 /// Greedy over an explicit matrix: scans every ready (cell, mode).
 pub fn matrix(m: &CostModel, count: &mut dyn FnMut(u64)) -> Sequence {
+    matrix_until(m, count, Deadline::NONE)
+}
+
+/// Like [`matrix`]; once `deadline` passes, the rest of the cells follow in a quick feasible
+/// order ([`super::complete`]).
+pub fn matrix_until(m: &CostModel, count: &mut dyn FnMut(u64), deadline: Deadline) -> Sequence {
     let n = m.n();
     let mut fringe = Fringe::new(m);
     let mut ready: Vec<usize> = (0..n).filter(|&c| fringe.missing[c] == 0).collect();
     let mut seq: Sequence = Vec::with_capacity(n);
+    let mut clock = super::ticker(deadline);
     while !ready.is_empty() {
+        if clock.passed() {
+            super::complete(m, &mut seq);
+            return seq;
+        }
         let mut best = (f64::INFINITY, usize::MAX, 0usize, 0usize);
         for (i, &c) in ready.iter().enumerate() {
             for md in 0..m.modes(c) {
@@ -197,7 +209,17 @@ impl ToolTrees {
 
 /// Greedy over a geometric instance with one k-d tree per tool.
 pub fn geometric(m: &CostModel, count: &mut dyn FnMut(u64)) -> Sequence {
+    geometric_until(m, count, Deadline::NONE)
+}
+
+/// Like [`geometric`]; once `deadline` passes, the rest of the cells follow in a quick
+/// feasible order ([`super::complete`]).
+pub fn geometric_until(m: &CostModel, count: &mut dyn FnMut(u64), deadline: Deadline) -> Sequence {
+    if deadline.passed() {
+        return super::fastest(m);
+    }
     let n = m.n();
+    let mut clock = super::ticker(deadline);
     let mut trees = ToolTrees::new(m);
     let ntools = trees.trees.len();
     let mut fringe = Fringe::new(m);
@@ -217,6 +239,10 @@ pub fn geometric(m: &CostModel, count: &mut dyn FnMut(u64)) -> Sequence {
     let mut done = vec![false; n];
     let mut order: Vec<usize> = Vec::with_capacity(ntools);
     while seq.len() < n {
+        if clock.passed() {
+            super::complete(m, &mut seq);
+            return seq;
+        }
         let prev = seq.last().copied();
         let mut best = (f64::INFINITY, usize::MAX);
         let cost_to = |nd: usize| -> f64 {

@@ -24,6 +24,7 @@
 //! is in); with points instead of strokes 0.75 × at 10^5. `local-search` starting from it
 //! reaches 0.70–0.72 × the walk at 10^5 cells in 10 s, against 0.895 × from the walk itself.
 
+use crate::clock::Deadline;
 use crate::cost::CostModel;
 use crate::engine::order::OrderList;
 use crate::engine::{Costs, Slot};
@@ -212,10 +213,45 @@ fn place(costs: &Costs, path: &Path, a: u32, c: usize) -> (f64, u32) {
     best
 }
 
+/// Most modes of one cell whose points the grids are searched around.
+const MAX_SEARCH_MODES: usize = 64;
+
+/// Appends `rest` (cells in a topological order, none in `seq` yet) to `seq`, each in its
+/// cheapest mode after the one before.
+fn append_in_order(m: &CostModel, seq: &mut Sequence, rest: &[u32]) {
+    for &c in rest {
+        let c = c as usize;
+        let cost = |md: usize| match seq.last() {
+            None => m.start(c, md),
+            Some(p) => m.arc(p.cell, p.mode, c, md),
+        };
+        let md = (0..m.modes(c))
+            .min_by(|&a, &b| cost(a).total_cmp(&cost(b)))
+            .unwrap_or(0);
+        seq.push(Visit::new(c, md));
+    }
+}
+
 /// The insertion sequence (see the module documentation); `k` feasible places next to nearby
 /// cells per cell on geometric instances, the topological order drawn from `seed`.
 pub fn sequence(m: &CostModel, k: usize, seed: u64, count: &mut dyn FnMut(u64)) -> Sequence {
+    sequence_until(m, k, seed, count, Deadline::NONE)
+}
+
+/// Like [`sequence`]; once `deadline` passes, the cells not inserted yet follow at the end in
+/// their topological order, each in its cheapest mode there ([`super::complete`]).
+pub fn sequence_until(
+    m: &CostModel,
+    k: usize,
+    seed: u64,
+    count: &mut dyn FnMut(u64),
+    deadline: Deadline,
+) -> Sequence {
+    if deadline.passed() {
+        return super::fastest(m);
+    }
     let n = m.n();
+    let mut clock = super::ticker(deadline);
     let costs = Costs::open(m);
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let order = topological(m, &mut rng);
@@ -226,7 +262,12 @@ pub fn sequence(m: &CostModel, k: usize, seed: u64, count: &mut dyn FnMut(u64)) 
     let head = path.list.sentinel();
     let mut grids = m.is_geometric().then(|| (Grid::new(m), Grid::new(m)));
     let mut inserted: Vec<u32> = Vec::with_capacity(n);
-    for &c in &order {
+    for (i, &c) in order.iter().enumerate() {
+        if clock.passed() {
+            let mut seq = path.sequence();
+            append_in_order(m, &mut seq, &order[i..]);
+            return seq;
+        }
         let cu = c as usize;
         let after = m.dag.preds[cu]
             .iter()
@@ -252,8 +293,10 @@ pub fn sequence(m: &CostModel, k: usize, seed: u64, count: &mut dyn FnMut(u64)) 
         match &grids {
             Some((exits, entries)) => {
                 // after q where q's exit is near an entry of c; before q where q's entry is
-                // near an exit of c
-                for md in 0..m.modes(cu) {
+                // near an exit of c; from an evenly spaced share of a cell's modes when it has
+                // many (each place tries every mode: O(modes²) per cell otherwise)
+                let step = m.modes(cu).div_ceil(MAX_SEARCH_MODES);
+                for md in (0..m.modes(cu)).step_by(step) {
                     let nd = m.node(cu, md);
                     for (grid, at, before) in
                         [(exits, m.entry(nd), false), (entries, m.exit(nd), true)]

@@ -3,6 +3,7 @@
 //! Geometric instances use kiddo k-d trees over entry and exit points (no n × n matrix);
 //! matrix instances rank the cheapest arcs of the matrix.
 
+use crate::clock::Deadline;
 use crate::cost::CostModel;
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
 use rayon::prelude::*;
@@ -38,6 +39,13 @@ impl Neighbours {
 
     /// Builds lists of `k` neighbours per cell.
     pub fn new(m: &CostModel, k: usize) -> Self {
+        Self::new_until(m, k, Deadline::NONE)
+    }
+
+    /// Like [`Neighbours::new`]; the cells whose turn comes after `deadline` get empty lists
+    /// (a search over them finds fewer moves, none wrong): on 10⁵ geometric cells the lists
+    /// take about a second.
+    pub fn new_until(m: &CostModel, k: usize, deadline: Deadline) -> Self {
         let k = k.min(m.n().saturating_sub(1));
         if k == 0 {
             return Neighbours {
@@ -46,9 +54,9 @@ impl Neighbours {
             };
         }
         if m.is_geometric() {
-            geometric(m, k)
+            geometric(m, k, deadline)
         } else {
-            matrix(m, k)
+            matrix(m, k, deadline)
         }
     }
 }
@@ -63,30 +71,63 @@ fn min_cost(m: &CostModel, a: usize, b: usize) -> f64 {
     best
 }
 
-fn matrix(m: &CostModel, k: usize) -> Neighbours {
+fn matrix(m: &CostModel, k: usize, deadline: Deadline) -> Neighbours {
     let n = m.n();
-    let mut cost = vec![0.0f64; n * n];
-    for a in 0..n {
-        for b in 0..n {
-            cost[a * n + b] = if a == b {
-                f64::INFINITY
-            } else {
-                min_cost(m, a, b)
-            };
-        }
-    }
-    let pick = |f: &dyn Fn(usize) -> f64| -> Vec<u32> {
+    // one row or column of cheapest arcs at a time: O(n) memory besides the lists (an n × n
+    // table doubled the memory of the largest matrix instances)
+    let mut line = vec![0.0f64; n];
+    let pick = |line: &[f64]| -> Vec<u32> {
+        let by = |x: &u32, y: &u32| {
+            line[*x as usize]
+                .total_cmp(&line[*y as usize])
+                .then(x.cmp(y))
+        };
         let mut v: Vec<u32> = (0..n as u32).collect();
-        v.sort_by(|&x, &y| f(x as usize).total_cmp(&f(y as usize)).then(x.cmp(&y)));
-        v.truncate(k);
+        if k < n {
+            v.select_nth_unstable_by(k, by);
+            v.truncate(k);
+            // a list keeps k entries, not the n it was chosen from (n² memory in all)
+            v.shrink_to_fit();
+        }
+        v.sort_by(by);
         v
     };
-    let out = (0..n).map(|a| pick(&|b| cost[a * n + b])).collect();
-    let inn = (0..n).map(|b| pick(&|a| cost[a * n + b])).collect();
+    let cost = |a: usize, b: usize| {
+        if a == b {
+            f64::INFINITY
+        } else {
+            min_cost(m, a, b)
+        }
+    };
+    let mut out = Vec::with_capacity(n);
+    for a in 0..n {
+        if deadline.passed() {
+            out.push(Vec::new());
+            continue;
+        }
+        for (b, x) in line.iter_mut().enumerate() {
+            *x = cost(a, b);
+        }
+        out.push(pick(&line));
+    }
+    let mut inn = Vec::with_capacity(n);
+    for b in 0..n {
+        if deadline.passed() {
+            inn.push(Vec::new());
+            continue;
+        }
+        for (a, x) in line.iter_mut().enumerate() {
+            *x = cost(a, b);
+        }
+        inn.push(pick(&line));
+    }
     Neighbours { out, inn }
 }
 
-fn geometric(m: &CostModel, k: usize) -> Neighbours {
+/// Most modes of one cell its neighbours are searched from (see [`geometric`]).
+const MAX_QUERY_MODES: usize = 64;
+
+fn geometric(m: &CostModel, k: usize, deadline: Deadline) -> Neighbours {
     let n = m.n();
     // immutable trees: built once, and robust to many coincident or collinear points
     let build = |exit: bool| -> ImmutableKdTree<f64, 2> {
@@ -102,9 +143,14 @@ fn geometric(m: &CostModel, k: usize) -> Neighbours {
     let exits = build(true);
     let query = |tree: &ImmutableKdTree<f64, 2>, c: usize, use_exit: bool| -> Vec<u32> {
         let mut want = k * 2 + 1;
+        // a cell of many modes (a contour with thousands of start points) is queried from an
+        // evenly spaced share of them: its own points fill every query around it, and
+        // querying from each one with a growing count is O(modes · nodes)
+        let modes = m.modes(c);
+        let step = modes.div_ceil(MAX_QUERY_MODES);
         loop {
             let mut best: Vec<(f64, u32)> = Vec::new();
-            for md in 0..m.modes(c) {
+            for md in (0..modes).step_by(step) {
                 let nd = m.node(c, md);
                 let p = if use_exit { m.exit(nd) } else { m.entry(nd) };
                 let kk = want.min(m.nodes());
@@ -140,11 +186,23 @@ fn geometric(m: &CostModel, k: usize) -> Neighbours {
     // independent per cell: built in parallel, identical whatever the number of threads
     let out = (0..n)
         .into_par_iter()
-        .map(|c| query(&entries, c, true))
+        .map(|c| {
+            if deadline.passed() {
+                Vec::new()
+            } else {
+                query(&entries, c, true)
+            }
+        })
         .collect();
     let inn = (0..n)
         .into_par_iter()
-        .map(|c| query(&exits, c, false))
+        .map(|c| {
+            if deadline.passed() {
+                Vec::new()
+            } else {
+                query(&exits, c, false)
+            }
+        })
         .collect();
     Neighbours { out, inn }
 }

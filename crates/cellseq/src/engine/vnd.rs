@@ -7,7 +7,7 @@ use super::moves::{
 use super::sop3x::{Labels, forward};
 use super::window::ModeWindow;
 use super::{Costs, Neighbours, Solution};
-use crate::context::Context;
+use crate::context::{Context, Deadline};
 use std::collections::VecDeque;
 
 /// Improvement threshold (relative) below which a delta does not count as an improvement.
@@ -78,10 +78,16 @@ pub const MODE_WINDOW: usize = 5;
 impl<'a> Search<'a> {
     /// An engine with `k` neighbours per cell.
     pub fn new(c: Costs<'a>, k: usize) -> Self {
+        Self::new_until(c, k, Deadline::NONE)
+    }
+
+    /// Like [`Search::new`], with the neighbour lists cut off at `deadline`
+    /// ([`Neighbours::new_until`]).
+    pub fn new_until(c: Costs<'a>, k: usize, deadline: Deadline) -> Self {
         let n = c.m.n();
         Search {
             c,
-            nb: Neighbours::new(c.m, k),
+            nb: Neighbours::new_until(c.m, k, deadline),
             max_block: if n <= 120 {
                 n
             } else if n <= LAZY_REACH_CELLS {

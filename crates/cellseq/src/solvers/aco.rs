@@ -8,6 +8,7 @@
 use super::Build;
 use super::start::{greedy_solution, outcome};
 use super::{Caps, Context, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo};
+use crate::clock::Ticker;
 use crate::engine::modes::mode_dp;
 use crate::engine::vnd::Search;
 use crate::engine::{Costs, Solution, cheaper};
@@ -202,7 +203,13 @@ impl Aco {
         let mut ready: Vec<usize> = (0..n).filter(|&c| missing[c] == 0).collect();
         let mut seq: Sequence = Vec::with_capacity(n);
         let mut w: Vec<(f64, usize)> = Vec::new();
+        // O(n) per step: past the deadline the ant ends with a quick feasible completion
+        let mut clock = Ticker::new(ctx.deadline(), 16);
         while !ready.is_empty() {
+            if clock.passed() {
+                crate::construct::complete(m, &mut seq);
+                break;
+            }
             let cur = seq.last().map(|v| (v.cell, v.mode));
             w.clear();
             let mut total = 0.0;
@@ -262,13 +269,13 @@ impl Solver for Aco {
         let c = Costs::open(m);
         let mut rng = ChaCha8Rng::seed_from_u64(ctx.seed);
         let mut best = greedy_solution(ctx, &c);
-        if n < 2 {
+        if n < 2 || ctx.deadline().passed() {
             return Ok(outcome(m, &best));
         }
         let scale = best.cost.abs().max(1e-9);
         let mut tau = Pheromone::new(n, 1.0 / (n as f64 * scale));
         let eps = 1e-3 * scale / n as f64;
-        let mut search = Search::new(c, self.k);
+        let mut search = Search::new_until(c, self.k, ctx.deadline());
         let mut last_improve = 0u64;
         for iter in 1..=self.iters {
             if ctx.exhausted() || iter - last_improve > self.stall {

@@ -7,7 +7,7 @@ use super::start::{greedy_solution, outcome};
 use super::{Caps, Context, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo};
 use crate::engine::atsp::cands::{Rank, candidates};
 use crate::engine::atsp::or3::Or3;
-use crate::engine::atsp::patch::{ApGraph, construct};
+use crate::engine::atsp::patch::{ApGraph, construct_until};
 use crate::engine::modes::mode_dp;
 use crate::engine::{Costs, Neighbours, Solution};
 use crate::error::Result;
@@ -114,13 +114,22 @@ impl Atsp {
     fn start(&self, ctx: &mut Context, c: &Costs) -> (Solution, Neighbours) {
         let m = ctx.model;
         let greedy = greedy_solution(ctx, c);
+        if ctx.deadline().passed() {
+            let none = vec![Vec::new(); m.n()];
+            let nb = Neighbours {
+                out: none.clone(),
+                inn: none,
+            };
+            return (greedy, nb);
+        }
         if m.n() < 2 || m.n() > self.ap_max_cells || ctx.exhausted() {
-            return (greedy, Neighbours::new(m, self.k));
+            return (greedy, Neighbours::new_until(m, self.k, ctx.deadline()));
         }
         let modes: Vec<u32> = (0..m.n()).map(|c| greedy.mode[c]).collect();
         let g = ApGraph::new(m, &modes);
-        let Some((order, ap, evals)) = construct(m, &g, self.greedy_patch) else {
-            return (greedy, Neighbours::new(m, self.k));
+        let Some((order, ap, evals)) = construct_until(m, &g, self.greedy_patch, ctx.deadline())
+        else {
+            return (greedy, Neighbours::new_until(m, self.k, ctx.deadline()));
         };
         ctx.count(evals);
         let seq: Vec<Visit> = order
@@ -157,6 +166,9 @@ impl Solver for Atsp {
         let m = ctx.model;
         let c = Costs::open(m);
         let (mut s, nb) = self.start(ctx, &c);
+        if ctx.deadline().passed() {
+            return Ok(outcome(m, &s));
+        }
         let mut or3 = Or3::new(c, &nb);
         or3.push_all(&s);
         or3.descend(&mut s, ctx);

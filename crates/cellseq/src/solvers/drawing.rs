@@ -69,17 +69,18 @@ impl Solver for Drawing {
         if !m.is_geometric() {
             return fallback(ctx);
         }
-        let start = crate::construct::greedy::geometric(m, &mut |k| ctx.count(k));
-        if !flat(m) || start.len() < 4 {
+        let deadline = ctx.deadline();
+        let start = crate::construct::greedy::geometric_until(m, &mut |k| ctx.count(k), deadline);
+        if !flat(m) || start.len() < 4 || deadline.passed() {
             let out = outcome_of(m, start);
             ctx.report(out.cost);
-            if !flat(m) {
+            if !flat(m) && !deadline.passed() {
                 return fallback_from(ctx, out);
             }
             return Ok(out);
         }
         ctx.report(m.evaluate(&start));
-        let nb = Neighbours::new(m, self.k);
+        let nb = Neighbours::new_until(m, self.k, ctx.deadline());
         let mut p = Path::new(m, start, nb.merged());
         let all: Vec<u32> = p.t.iter().map(|v| v.cell as u32).collect();
         p.descend(ctx, all);

@@ -26,6 +26,7 @@ use super::StartsFrom;
 use super::aco::{COLONY, Pheromone};
 use super::start::{greedy_solution, outcome};
 use super::{Caps, Context, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo};
+use crate::clock::Ticker;
 use crate::engine::crossover::Crossover;
 use crate::engine::lk::Lk;
 use crate::engine::modes::mode_dp;
@@ -217,7 +218,14 @@ impl Eacs {
         }
         let mut seq: Sequence = Vec::with_capacity(n);
         let mut evals = 0u64;
+        // O(n) per step: the clock is read every few steps, and past the deadline the ant
+        // ends with a quick feasible completion
+        let mut clock = Ticker::new(ctx.deadline(), 16);
         while !ant.ready.is_empty() {
+            if clock.passed() {
+                crate::construct::complete(m, &mut seq);
+                break;
+            }
             let cur = seq.last().map(|v: &Visit| (v.cell, v.mode));
             let exploit = rng.random::<f64>() < q0;
             // the successor of the current cell in the best solution
@@ -368,7 +376,10 @@ impl Eacs {
             Some(s) => s,
             None => greedy_solution(ctx, &c),
         };
-        let mut search = Search::new(c, self.k);
+        if ctx.deadline().passed() {
+            return Ok(outcome(m, &best));
+        }
+        let mut search = Search::new_until(c, self.k, ctx.deadline());
         search.vnd(&mut best, ctx);
         let mut lk = Lk::when(self.lk, &c, 12, 3);
         if let Some(lk) = lk.as_mut() {

@@ -3,7 +3,6 @@
 
 use super::Build;
 use super::{Caps, Context, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo};
-use crate::construct::greedy;
 use crate::error::Result;
 
 pub use crate::construct::edge::{applicable, sequence};
@@ -40,11 +39,10 @@ impl Solver for GreedyEdge {
     fn solve(&self, ctx: &mut Context) -> Result<Outcome> {
         let m = ctx.model;
         let seq = if applicable(m) {
-            sequence(m, self.k, &mut |k| ctx.count(k))
-        } else if m.is_geometric() {
-            greedy::geometric(m, &mut |k| ctx.count(k))
+            let deadline = ctx.deadline();
+            crate::construct::edge::sequence_until(m, self.k, &mut |k| ctx.count(k), deadline)
         } else {
-            greedy::matrix(m, &mut |k| ctx.count(k))
+            super::start::greedy_start(ctx)
         };
         Ok(super::outcome_of(m, seq))
     }

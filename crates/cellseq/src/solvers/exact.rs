@@ -11,6 +11,7 @@
 
 use super::Build;
 use super::{Caps, Context, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo};
+use crate::clock::Ticker;
 use crate::error::{Error, Result};
 use crate::model::Visit;
 use rustc_hash::FxHashMap;
@@ -57,24 +58,23 @@ pub struct Exact {
     pub max_cells: usize,
 }
 
-/// One DP entry: the last node, the node before it (`NO_PRED` at the start) and the cost.
-type Entry = (u32, u32, f64);
-type Level = FxHashMap<u128, Vec<Entry>>;
+/// A DP state: the ideal (cells visited, as bits) and its last node.
+type Key = (u128, u32);
+/// Per state: the node before the last (`NO_PRED` at the start) and the cheapest cost.
+type Level = FxHashMap<Key, (u32, f64)>;
 
 /// The predecessor of a path's first node.
 const NO_PRED: u32 = u32::MAX;
 
-const BYTES_PER_IDEAL: u64 = 80;
-const BYTES_PER_ENTRY: u64 = 16;
+/// Memory of one state in a level's table (key, value and the table's control byte, at its
+/// load factor). The states of all levels live in flat tables: no allocation per ideal, so a
+/// run cut off by its deadline frees millions of them at once rather than one by one.
+const BYTES_PER_STATE: u64 = 56;
 
 impl Solver for Exact {
     fn solve(&self, ctx: &mut Context) -> Result<Outcome> {
         let m = ctx.model;
         let n = m.n();
-        let err = |msg: String| Error::Solver {
-            solver: "exact".into(),
-            msg,
-        };
         if n > self.max_cells {
             return Err(err(format!(
                 "instance has {n} cells; the exact DP accepts at most {} (use another solver)",
@@ -84,112 +84,186 @@ impl Solver for Exact {
         let pred_mask: Vec<u128> = (0..n)
             .map(|c| m.dag.preds[c].iter().fold(0u128, |a, &p| a | 1u128 << p))
             .collect();
-        let limit = self.memory_mb.saturating_mul(1 << 20);
-        let mut used: u64 = 0;
-        let mut levels: Vec<Level> = Vec::with_capacity(n);
+        let mut dp = Dp {
+            limit: self.memory_mb.saturating_mul(1 << 20),
+            memory_mb: self.memory_mb,
+            used: 0,
+            levels: Vec::with_capacity(n),
+            pred_mask,
+            sort_per_key: 0.0,
+        };
         let mut first = Level::default();
+        let mut ideals = 0u64;
         for v in 0..n {
-            if pred_mask[v] == 0 {
-                let e: Vec<Entry> = (0..m.modes(v))
-                    .map(|md| (m.node(v, md) as u32, NO_PRED, m.start(v, md)))
-                    .collect();
-                used += BYTES_PER_IDEAL + BYTES_PER_ENTRY * e.len() as u64;
-                first.insert(1u128 << v, e);
+            if dp.pred_mask[v] == 0 {
+                ideals += 1;
+                for md in 0..m.modes(v) {
+                    first.insert(
+                        (1u128 << v, m.node(v, md) as u32),
+                        (NO_PRED, m.start(v, md)),
+                    );
+                }
             }
         }
-        ctx.count(first.len() as u64);
-        levels.push(first);
+        dp.used += BYTES_PER_STATE * first.len() as u64;
+        ctx.count(ideals);
+        dp.levels.push(first);
+        // the clock is read between subsets too: one level can hold millions of them
+        let mut clock = Ticker::new(ctx.deadline(), 4);
         for k in 1..n {
-            let prev = &levels[k - 1];
-            let mut next = Level::default();
-            let mut evals = 0u64;
-            // deterministic iteration: sort the ideals of the previous level
-            let mut keys: Vec<&u128> = prev.keys().collect();
-            keys.sort_unstable();
-            for &s in keys {
-                let entries = &prev[&s];
-                for v in 0..n {
-                    if s >> v & 1 == 1 || pred_mask[v] & !s != 0 {
-                        continue;
-                    }
-                    let t = s | 1u128 << v;
-                    let slot = next.entry(t).or_insert_with(|| {
-                        used += BYTES_PER_IDEAL;
-                        Vec::new()
-                    });
-                    for mv in 0..m.modes(v) {
-                        let nv = m.node(v, mv) as u32;
-                        // the cheapest way in, and where from (the first of equal costs)
-                        let mut best = (f64::INFINITY, NO_PRED);
-                        for &(u, _, cu) in entries {
-                            let (cu_cell, cu_mode) = m.cell_mode(u as usize);
-                            let c = cu + m.arc(cu_cell, cu_mode, v, mv);
-                            if c < best.0 {
-                                best = (c, u);
-                            }
-                        }
-                        evals += entries.len() as u64;
-                        match slot.iter_mut().find(|e| e.0 == nv) {
-                            Some(e) => {
-                                if best.0 < e.2 {
-                                    (e.1, e.2) = (best.1, best.0);
-                                }
-                            }
-                            None => {
-                                used += BYTES_PER_ENTRY;
-                                slot.push((nv, best.1, best.0));
-                            }
-                        }
-                    }
+            dp.next_level(ctx, k, &mut clock)?;
+        }
+        let seq = dp.read_back(ctx, n)?;
+        let cost = m.evaluate(&seq);
+        ctx.report(cost);
+        Ok(Outcome {
+            sequence: seq,
+            cost,
+            proven_optimal: true,
+            lower_bound: Some(cost),
+        })
+    }
+}
+
+/// An error of the `exact` solver.
+fn err(msg: String) -> Error {
+    Error::Solver {
+        solver: "exact".into(),
+        msg,
+    }
+}
+
+/// The refusal when the budget ends at subset size `k + 1` of `n`.
+fn out_of_budget(k: usize, n: usize) -> Error {
+    err(format!(
+        "budget exhausted at subset size {} of {n} before optimality was proven",
+        k + 1
+    ))
+}
+
+/// The DP's tables and memory account.
+struct Dp {
+    limit: u64,
+    memory_mb: u64,
+    used: u64,
+    levels: Vec<Level>,
+    pred_mask: Vec<u128>,
+    /// Seconds per state of the last level's sort: the next sort is not started when the
+    /// time left would not cover it (a sort cannot stop halfway; a level holds millions).
+    sort_per_key: f64,
+}
+
+impl Dp {
+    /// Level `k` (ideals of k + 1 cells) from level `k − 1`.
+    fn next_level(&mut self, ctx: &mut Context, k: usize, clock: &mut Ticker) -> Result<()> {
+        let m = ctx.model;
+        let n = m.n();
+        let prev = &self.levels[k - 1];
+        let mut next = Level::default();
+        let mut evals = 0u64;
+        // deterministic iteration: the states of the previous level sorted (grouped by ideal)
+        if let Some(left) = ctx.deadline().remaining()
+            && left.as_secs_f64() < self.sort_per_key * prev.len() as f64
+        {
+            return Err(out_of_budget(k, n));
+        }
+        let sorting = std::time::Instant::now();
+        let mut keys: Vec<Key> = prev.keys().copied().collect();
+        keys.sort_unstable();
+        self.sort_per_key = sorting.elapsed().as_secs_f64() / keys.len().max(1) as f64;
+        // one ideal's entries (last node, cost), in the order ties were always broken in:
+        // last cell from the highest index down, modes in order
+        let mut entries: Vec<(u32, f64)> = Vec::new();
+        let mut i = 0;
+        while i < keys.len() {
+            if clock.passed() {
+                return Err(out_of_budget(k, n));
+            }
+            let s = keys[i].0;
+            let j = i + keys[i..].iter().take_while(|key| key.0 == s).count();
+            entries.clear();
+            entries.extend(keys[i..j].iter().map(|key| (key.1, prev[key].1)));
+            entries.sort_by_key(|e| {
+                let (c, md) = m.cell_mode(e.0 as usize);
+                (std::cmp::Reverse(c), md)
+            });
+            i = j;
+            for v in 0..n {
+                if s >> v & 1 == 1 || self.pred_mask[v] & !s != 0 {
+                    continue;
                 }
-                if used > limit {
-                    return Err(err(format!(
-                        "memory estimate passed the limit of {} MiB at subset size {} of {n} \
-                         ({} subsets so far); raise memory_mb or use another solver",
-                        self.memory_mb,
-                        k + 1,
-                        next.len()
-                    )));
+                let t = s | 1u128 << v;
+                for mv in 0..m.modes(v) {
+                    // the cheapest way in, and where from (the first of equal costs)
+                    let mut best = (f64::INFINITY, NO_PRED);
+                    for &(u, cu) in &entries {
+                        let (cu_cell, cu_mode) = m.cell_mode(u as usize);
+                        let c = cu + m.arc(cu_cell, cu_mode, v, mv);
+                        if c < best.0 {
+                            best = (c, u);
+                        }
+                    }
+                    evals += entries.len() as u64;
+                    let key = (t, m.node(v, mv) as u32);
+                    match next.get_mut(&key) {
+                        Some(e) => {
+                            if best.0 < e.1 {
+                                *e = (best.1, best.0);
+                            }
+                        }
+                        None => {
+                            self.used += BYTES_PER_STATE;
+                            next.insert(key, (best.1, best.0));
+                        }
+                    }
                 }
             }
-            ctx.count(evals);
-            if ctx.exhausted() {
+            if self.used > self.limit {
                 return Err(err(format!(
-                    "budget exhausted at subset size {} of {n} before optimality was proven",
-                    k + 1
+                    "memory estimate passed the limit of {} MiB at subset size {} of {n} \
+                     ({} states so far); raise memory_mb or use another solver",
+                    self.memory_mb,
+                    k + 1,
+                    next.len()
                 )));
             }
-            levels.push(next);
         }
-        // close the path
-        let full = &levels[n - 1];
-        let (&all, entries) = full
-            .iter()
-            .next()
-            .ok_or_else(|| err("no feasible order".into()))?;
-        let mut best = (f64::INFINITY, NO_PRED);
-        for &(u, _, cu) in entries {
+        ctx.count(evals);
+        if ctx.exhausted() {
+            return Err(out_of_budget(k, n));
+        }
+        self.levels.push(next);
+        Ok(())
+    }
+
+    /// The optimal sequence: the cheapest complete state with its finish, then back along
+    /// the stored predecessors (exact, no re-evaluation of costs).
+    fn read_back(&self, ctx: &Context, n: usize) -> Result<Vec<Visit>> {
+        let m = ctx.model;
+        let full = &self.levels[n - 1];
+        let mut best = (f64::INFINITY, NO_PRED, 0u128);
+        for (&(all, u), &(_, cu)) in full {
             let (c, md) = m.cell_mode(u as usize);
             let total = cu + m.finish(c, md);
             if total < best.0 || (total == best.0 && u < best.1) {
-                best = (total, u);
+                best = (total, u, all);
             }
+        }
+        if full.is_empty() {
+            return Err(err("no feasible order".into()));
         }
         if best.1 == NO_PRED {
             // only when every complete path costs infinity or NaN, which validation rules out
             return Err(err("no complete order has a finite cost".into()));
         }
-        // walk back along the stored predecessors: exact, no re-evaluation of costs
         let mut seq = Vec::with_capacity(n);
-        let mut s = all;
-        let mut u = best.1;
+        let (mut s, mut u) = (best.2, best.1);
         for k in (0..n).rev() {
             let (c, md) = m.cell_mode(u as usize);
             seq.push(Visit::new(c, md));
-            let pred = levels[k]
-                .get(&s)
-                .and_then(|es| es.iter().find(|e| e.0 == u))
-                .map(|e| e.1)
+            let pred = self.levels[k]
+                .get(&(s, u))
+                .map(|e| e.0)
                 .ok_or_else(|| err("internal error: DP state missing on the way back".into()))?;
             if k == 0 {
                 break;
@@ -201,13 +275,6 @@ impl Solver for Exact {
             u = pred;
         }
         seq.reverse();
-        let cost = m.evaluate(&seq);
-        ctx.report(cost);
-        Ok(Outcome {
-            sequence: seq,
-            cost,
-            proven_optimal: true,
-            lower_bound: Some(cost),
-        })
+        Ok(seq)
     }
 }

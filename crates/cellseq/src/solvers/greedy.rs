@@ -37,11 +37,7 @@ pub struct Greedy {
 
 impl Solver for Greedy {
     fn solve(&self, ctx: &mut Context) -> Result<Outcome> {
-        let seq = if ctx.model.is_geometric() {
-            geometric(ctx.model, &mut |k| ctx.count(k))
-        } else {
-            matrix(ctx.model, &mut |k| ctx.count(k))
-        };
+        let seq = super::start::greedy_start(ctx);
         let out = outcome_of(ctx.model, seq);
         ctx.report(out.cost);
         Ok(out)

@@ -450,6 +450,9 @@ impl Ils {
             Some(s) => s,
             None => greedy_solution(ctx, &c),
         };
+        if ctx.deadline().passed() {
+            return Ok(outcome(m, &cur));
+        }
         let (mut search, mut lk) = self.descend(ctx, c, &mut cur);
         let mut best = cur.clone();
         ctx.report(best.cost + m.constant());
@@ -592,7 +595,7 @@ impl Ils {
         c: Costs<'a>,
         cur: &mut Solution,
     ) -> (Search<'a>, Option<Lk>) {
-        let mut search = Search::new(c, self.k);
+        let mut search = Search::new_until(c, self.k, ctx.deadline());
         if self.max_block > 0 {
             search.max_block = self.max_block;
         }

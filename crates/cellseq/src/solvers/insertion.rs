@@ -47,7 +47,14 @@ impl Solver for Insertion {
             });
         }
         let seed = ctx.seed;
-        let seq = sequence(ctx.model, self.k, seed, &mut |e| ctx.count(e));
+        let deadline = ctx.deadline();
+        let seq = crate::construct::insertion::sequence_until(
+            ctx.model,
+            self.k,
+            seed,
+            &mut |e| ctx.count(e),
+            deadline,
+        );
         Ok(outcome_of(ctx.model, seq))
     }
 }

@@ -162,10 +162,13 @@ impl Solver for LocalSearch {
         let m = ctx.model;
         let c = Costs::open(m);
         let mut s = best_start(ctx, &c, 8);
+        if ctx.deadline().passed() {
+            return Ok(outcome(m, &s));
+        }
         if ctx.exhausted() {
             return Ok(outcome(m, &s));
         }
-        let mut search = Search::new(c, self.k);
+        let mut search = Search::new_until(c, self.k, ctx.deadline());
         if self.max_block > 0 {
             search.max_block = self.max_block;
         }

@@ -331,12 +331,19 @@ impl<'s> Sub<'s> {
 /// Runs a sub-solver: builds it from the registry (refusing a start it cannot take), runs it
 /// in a context of its own (its clock starts now; no observer), and adds its evaluations to
 /// `ctx` when it succeeds. The caller decides whether to [`Context::report`] its cost.
+///
+/// The sub-run never outlives the caller's deadline: its time limit is the smaller of its own
+/// and what is left of the caller's (a sub-run without a time limit gets the caller's rest).
 pub fn sub_run(ctx: &mut Context, sub: Sub) -> Result<Outcome> {
     let info = find(sub.name)?;
     let (_, solver) = info.build(sub.params)?;
     let (instance, model) = sub.on.unwrap_or((ctx.instance, ctx.model));
     let mut quiet = NoObserver;
-    let mut inner = Context::new(instance, model, sub.seed, sub.budget, &mut quiet)
+    let mut budget = sub.budget;
+    if let Some(left) = ctx.remaining() {
+        budget.time_limit = Some(budget.time_limit.map_or(left, |t| t.min(left)));
+    }
+    let mut inner = Context::new(instance, model, sub.seed, budget, &mut quiet)
         .with_stop(ctx.stop_flag());
     let out = solver.run(&mut inner, sub.start, info.name)?;
     ctx.count(inner.evaluations());

@@ -269,15 +269,18 @@ impl Reopt {
         let m = ctx.model;
         let n = m.n();
         let c = Costs::open(m);
-        let mut search = Search::new(c, self.k);
+        let fresh = start.is_none();
         let mut s = match start {
             Some(s) => s,
-            None => {
-                let mut s = greedy_solution(ctx, &c);
-                search.vnd(&mut s, ctx);
-                s
-            }
+            None => greedy_solution(ctx, &c),
         };
+        if ctx.deadline().passed() {
+            return Ok(outcome(m, &s));
+        }
+        let mut search = Search::new_until(c, self.k, ctx.deadline());
+        if fresh {
+            search.vnd(&mut s, ctx);
+        }
         ctx.report(s.cost + m.constant());
         if n < 2 {
             return Ok(outcome(m, &s));

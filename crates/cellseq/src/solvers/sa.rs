@@ -299,8 +299,8 @@ impl Solver for Sa {
         self.anneal.run(ctx, &c, &mut s, None, &mut rng);
         let open = Costs::open(m);
         let mut s = Solution::new(&open, &s.sequence());
-        if self.polish {
-            let mut search = Search::new(open, 10);
+        if self.polish && !ctx.deadline().passed() {
+            let mut search = Search::new_until(open, 10, ctx.deadline());
             search.vnd(&mut s, ctx);
         }
         // never end worse than the start under the true objective

@@ -1,6 +1,7 @@
 //! Shared pieces of the improvement solvers: start solutions and result reporting.
 
 use super::{Context, Outcome, outcome_of};
+use crate::clock::Ticker;
 use crate::construct::{edge, greedy, insertion};
 use crate::cost::CostModel;
 use crate::engine::{Costs, Solution};
@@ -9,12 +10,14 @@ use rand::RngExt;
 use rand_chacha::ChaCha8Rng;
 
 /// The deterministic greedy start (the `greedy` solver's sequence).
+/// Once the run's deadline passes, the rest of the cells follow in a quick feasible order.
 pub fn greedy_start(ctx: &mut Context) -> Sequence {
     let m = ctx.model;
+    let deadline = ctx.deadline();
     if m.is_geometric() {
-        greedy::geometric(m, &mut |k| ctx.count(k))
+        greedy::geometric_until(m, &mut |k| ctx.count(k), deadline)
     } else {
-        greedy::matrix(m, &mut |k| ctx.count(k))
+        greedy::matrix_until(m, &mut |k| ctx.count(k), deadline)
     }
 }
 
@@ -36,7 +39,8 @@ pub fn greedy_solution(ctx: &mut Context, c: &Costs) -> Solution {
 /// costs seconds there).
 pub fn best_start(ctx: &mut Context, c: &Costs, k: usize) -> Solution {
     if c.m.n() > EDGE_ONLY_CELLS && edge::applicable(c.m) {
-        let seq = edge::sequence(c.m, k, &mut |k| ctx.count(k));
+        let deadline = ctx.deadline();
+        let seq = edge::sequence_until(c.m, k, &mut |k| ctx.count(k), deadline);
         let s = Solution::new(c, &seq);
         ctx.report(s.cost + c.m.constant());
         return s;
@@ -48,7 +52,8 @@ pub fn best_start(ctx: &mut Context, c: &Costs, k: usize) -> Solution {
         && !ctx.exhausted()
     {
         let seed = ctx.seed;
-        let seq = insertion::sequence(c.m, k, seed, &mut |k| ctx.count(k));
+        let deadline = ctx.deadline();
+        let seq = insertion::sequence_until(c.m, k, seed, &mut |k| ctx.count(k), deadline);
         let t = Solution::new(c, &seq);
         if t.cost < s.cost {
             ctx.report(t.cost + c.m.constant());
@@ -56,7 +61,8 @@ pub fn best_start(ctx: &mut Context, c: &Costs, k: usize) -> Solution {
         }
     }
     if edge::applicable(c.m) && !ctx.exhausted() {
-        let seq = edge::sequence(c.m, k, &mut |k| ctx.count(k));
+        let deadline = ctx.deadline();
+        let seq = edge::sequence_until(c.m, k, &mut |k| ctx.count(k), deadline);
         let t = Solution::new(c, &seq);
         if t.cost < s.cost {
             ctx.report(t.cost + c.m.constant());
@@ -88,7 +94,12 @@ pub fn random_start(
     let mut missing: Vec<u32> = m.dag.preds.iter().map(|p| p.len() as u32).collect();
     let mut ready: Vec<usize> = (0..n).filter(|&c| missing[c] == 0).collect();
     let mut seq: Sequence = Vec::with_capacity(n);
+    let mut clock = Ticker::new(ctx.deadline(), 16);
     while !ready.is_empty() {
+        if clock.passed() {
+            crate::construct::complete(m, &mut seq);
+            return seq;
+        }
         let mut top: Vec<(f64, usize, usize, usize)> = Vec::with_capacity(4);
         for (idx, &c) in ready.iter().enumerate() {
             for md in 0..m.modes(c) {

@@ -177,7 +177,10 @@ impl Solver for Tabu {
         let greedy = greedy_start(ctx);
         let mut best = Solution::new(&c, &greedy);
         ctx.report(best.cost + m.constant());
-        let search = Search::new(c, self.k);
+        if ctx.deadline().passed() {
+            return Ok(outcome(m, &best));
+        }
+        let search = Search::new_until(c, self.k, ctx.deadline());
         let tenure = if self.tenure == 0 {
             5 + n / 20
         } else {
@@ -189,7 +192,7 @@ impl Solver for Tabu {
             .flat_map(|x| (0..m.modes(x)).map(move |md| (x, md)))
             .collect();
         firsts.truncate(self.starts);
-        let mut polish = Search::new(c, self.k);
+        let mut polish = Search::new_until(c, self.k, ctx.deadline());
         for start in 0..self.starts {
             if ctx.exhausted() {
                 break;

@@ -42,7 +42,10 @@ impl Solver for TwoOpt {
         let m = ctx.model;
         let c = Costs::open(m);
         let mut s = greedy_solution(ctx, &c);
-        let mut search = Search::new(c, self.k);
+        if ctx.deadline().passed() {
+            return Ok(outcome(m, &s));
+        }
+        let mut search = Search::new_until(c, self.k, ctx.deadline());
         while search.two_opt(&mut s, ctx) {
             ctx.report(s.cost + m.constant());
         }

@@ -9,7 +9,8 @@
 //! at `D` is a path; where the precedence forbids it, [`repair`] sorts it topologically,
 //! keeping the patched order wherever the precedence allows.
 
-use crate::bound::assignment::{Assignment, hungarian_duals};
+use crate::bound::assignment::{Assignment, hungarian_duals, hungarian_duals_until};
+use crate::clock::Deadline;
 use crate::cost::CostModel;
 use crate::model::CostMatrix;
 use std::cmp::Reverse;
@@ -218,8 +219,18 @@ pub fn repair(m: &CostModel, order: &[u32]) -> Vec<u32> {
 /// potentials) and the number of arc costs looked at; `None` when the assignment or the
 /// patching finds no finite arcs.
 pub fn construct(m: &CostModel, g: &ApGraph, greedy: bool) -> Option<(Vec<u32>, Assignment, u64)> {
+    construct_until(m, g, greedy, Deadline::NONE)
+}
+
+/// Like [`construct`], or `None` when `deadline` passes during the assignment (O(n³)).
+pub fn construct_until(
+    m: &CostModel,
+    g: &ApGraph,
+    greedy: bool,
+    deadline: Deadline,
+) -> Option<(Vec<u32>, Assignment, u64)> {
     let d = (g.n + 1) as u64;
-    let ap = g.assignment()?;
+    let ap = hungarian_duals_until(g.n + 1, |i, j| g.c(i, j), deadline)?;
     let (tour, evals) = if greedy {
         patch_greedy(g, &ap.col)?
     } else {

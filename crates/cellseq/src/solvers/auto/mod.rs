@@ -329,6 +329,8 @@ impl Solver for Auto {
         let mut budget = ctx.budget;
         if budget.time_limit.is_none() && budget.max_evals.is_none() {
             budget.time_limit = Some(Duration::from_secs_f64(self.seconds));
+            // on the run's own clock too, so that no phase (a sub-run) outlives it
+            ctx.budget.time_limit = budget.time_limit;
         }
         let mut best: Option<Outcome> = None;
         let keep = |best: &mut Option<Outcome>, o: Outcome| {
@@ -362,21 +364,17 @@ impl Solver for Auto {
         }
         let plan = choice.plan(after_beam);
         let mut last: Option<Outcome> = None;
-        let twin = if plan.iter().any(|p| p.reversed) {
-            ctx.instance.reversed_matrix().map(|i| {
-                let m = CostModel::new(&i, ctx.model.objective());
-                (i, m)
-            })
-        } else {
-            None
-        };
+        // the instance travelled backwards, built when a phase first needs it (a copy of the
+        // matrix: none when the time runs out before)
+        let mut twin: Option<Option<(Instance, CostModel)>> = None;
         for (i, ph) in plan.iter().enumerate() {
             // past the time limit, a later phase would only overrun it (its construction alone
             // can take seconds on large instances): stop with the best so far
             let late = budget
                 .time_limit
                 .is_some_and(|t| ctx.elapsed() >= t.as_secs_f64());
-            if late && best.is_some() {
+            // a best that meets the model's floor is optimal: nothing is left to do
+            if (late || ctx.solved()) && best.is_some() {
                 break;
             }
             let b = share(budget, ctx.evaluations(), ctx.elapsed(), ph.share);
@@ -387,7 +385,17 @@ impl Solver for Auto {
             };
             // how often this solver ran before in the plan: its seed's repeat index
             let repeat = plan[..i].iter().filter(|p| p.solver == ph.solver).count() as u64;
-            let on = if ph.reversed { twin.as_ref() } else { None };
+            if ph.reversed && twin.is_none() {
+                twin = Some(ctx.instance.reversed_matrix().map(|i| {
+                    let m = CostModel::new(&i, ctx.model.objective());
+                    (i, m)
+                }));
+            }
+            let on = if ph.reversed {
+                twin.as_ref().and_then(|t| t.as_ref())
+            } else {
+                None
+            };
             let run = Run {
                 name: &ph.solver,
                 given: &ph.params,

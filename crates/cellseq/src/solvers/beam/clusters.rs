@@ -3,14 +3,20 @@
 
 use crate::bound::assignment;
 use crate::bound::cells::CellGraph;
+use crate::clock::Deadline;
 
 /// Disjoint clusters of cells for the bound: subtours of the assignment relaxation, found
 /// hierarchically (contract every subtour that avoids home into one group, solve the
 /// assignment on the groups again, repeat), then the laminar family is cut so that the root
 /// surcharge (Σ of entering + leaving surcharges, reduced costs `r`) is largest: each cluster
 /// is kept whole or replaced by its best sub-family.
-pub(super) fn choose_clusters(g: &CellGraph, r: &dyn Fn(usize, usize) -> f64) -> Vec<Vec<u32>> {
-    let (tree, groups) = cluster_tree(g);
+/// The hierarchy stops at `deadline` with the rounds done.
+pub(super) fn choose_clusters(
+    g: &CellGraph,
+    r: &dyn Fn(usize, usize) -> f64,
+    deadline: Deadline,
+) -> Vec<Vec<u32>> {
+    let (tree, groups) = cluster_tree(g, deadline);
     best_cut(g, r, &tree, &groups)
 }
 
@@ -23,7 +29,7 @@ type Groups = Vec<(Vec<u32>, Option<usize>)>;
 /// The hierarchy of assignment subtours: contract every subtour that avoids home into one
 /// group, solve the assignment on the groups again, repeat (at most 16 rounds). Returns the
 /// tree of clusters and the last groups (cells, with their tree node when merged).
-fn cluster_tree(g: &CellGraph) -> (Tree, Groups) {
+fn cluster_tree(g: &CellGraph, deadline: Deadline) -> (Tree, Groups) {
     let n = g.n;
     // tree of clusters: cells and children
     let mut tree: Tree = Vec::new();
@@ -49,9 +55,11 @@ fn cluster_tree(g: &CellGraph) -> (Tree, Groups) {
                 cost[a * k + b] = best;
             }
         }
-        let Some(asg) = assignment::hungarian(k, |a, b| cost[a * k + b]) else {
+        let Some(asg) = assignment::hungarian_duals_until(k, |a, b| cost[a * k + b], deadline)
+        else {
             break;
         };
+        let asg = (asg.value, asg.col);
         let home = groups.iter().position(|gr| gr.0.contains(&(n as u32)));
         let mut seen = vec![false; k];
         let mut next: Groups = Vec::new();

@@ -237,6 +237,20 @@ impl Beam {
     }
 }
 
+/// The outcome when the clock ran out before the search could start: the incumbent, if any.
+fn incumbent_only(m: &CostModel, best: Option<(f64, Sequence)>) -> Result<Outcome> {
+    let (cost, sequence) = best.ok_or_else(|| Error::Solver {
+        solver: "beam".into(),
+        msg: "no feasible sequence found before the time limit".into(),
+    })?;
+    Ok(Outcome {
+        sequence,
+        cost,
+        proven_optimal: false,
+        lower_bound: Some(m.constant()),
+    })
+}
+
 /// Work budget (arc evaluations) of the qpath multipliers' subgradient steps.
 const QPATH_WORK: f64 = 4e8;
 
@@ -266,13 +280,19 @@ fn qpath_relaxation(ctx: &Context, t: &Tables, upper: Option<f64>) -> Option<QPa
     (iters >= 10)
         .then(|| {
             if t.mu_arc.is_empty() {
-                QPath::new(m, upper, iters)
+                QPath::shifted(m, upper, iters, None, ctx.deadline())
             } else {
                 // on the costs net of the subtour-elimination multipliers: a walk no
                 // longer gains by looping inside an expensive-to-leave set
                 let total: f64 = t.sec_sets.iter().map(|s| s.1).sum();
                 let l0 = vec![0.0; m.n()];
-                QPath::shifted(m, upper, iters, Some((&t.mu_arc, total, &l0)))
+                QPath::shifted(
+                    m,
+                    upper,
+                    iters,
+                    Some((&t.mu_arc, total, &l0)),
+                    ctx.deadline(),
+                )
             }
         })
         .flatten()
@@ -295,13 +315,18 @@ impl Beam {
         if let Some((c, _)) = &best {
             ctx.report(*c);
         }
-        let t = tables(
+        let built = tables(
             m,
             self.potentials,
             self.sec,
             self.twins,
             best.as_ref().map(|b| b.0),
+            ctx.deadline(),
         )?;
+        let Some(t) = built else {
+            // the clock ran out while the bound's tables were built: the incumbent stands
+            return incumbent_only(m, best);
+        };
         let mut root_lb = self.first_level_lb::<W>(m, &t);
         let qp = if self.qpath {
             qpath_relaxation(ctx, &t, best.as_ref().map(|b| b.0))
@@ -420,6 +445,7 @@ impl Beam {
                     lagrangian_iterations: 150,
                     qpath_work: 0.0,
                     upper: best.as_ref().map(|b| b.0),
+                    deadline: ctx.deadline(),
                     ..BoundOptions::default()
                 };
                 *root_lb = root_lb.max(bound::compute(m, &opts).best);

@@ -267,6 +267,7 @@ mod for_tests {
     use crate::model::Visit;
     use crate::solvers::beam::MAX_CELLS;
     use crate::solvers::beam::tables::tables;
+    use crate::clock::Deadline;
 
     /// The node bound (`refined`: potentials, subtour-elimination multipliers, degree sums and
     /// cluster surcharges) of every prefix of `seq`, in order, with the tables built as the beam
@@ -274,7 +275,7 @@ mod for_tests {
     /// breaking). For tests: along an optimal sequence every value is at most the optimum.
     pub fn prefix_bounds(m: &CostModel, seq: &[Visit], upper: Option<f64>) -> Result<Vec<f64>> {
         fn go<const W: usize>(m: &CostModel, seq: &[Visit], upper: Option<f64>) -> Result<Vec<f64>> {
-            let t = tables(m, true, true, false, upper)?;
+            let t = tables(m, true, true, false, upper, Deadline::NONE)?.expect("no deadline");
             let mut scratch = vec![(0.0, 0.0); m.n() + t.clusters.len()];
             let mut out = Vec::with_capacity(seq.len());
             let Some(v0) = seq.first() else {

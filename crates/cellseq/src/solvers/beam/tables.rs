@@ -7,6 +7,7 @@ use super::twins::{TWIN_MAX_CELLS, twin_order};
 use crate::bound::assignment::{self, Assignment};
 use crate::bound::cells::CellGraph;
 use crate::bound::sec::{self, SecBound};
+use crate::clock::Deadline;
 use crate::cost::CostModel;
 use crate::error::{Error, Result};
 use crate::precedence::Closure;
@@ -118,22 +119,30 @@ const POTENTIAL_MAX_CELLS: usize = 600;
 const SEC_WORK: f64 = 2e8;
 
 /// `upper`: cost of a known solution (constant included), for the subgradient steps.
+/// `Ok(None)` when `deadline` passes before the tables are built (the root relaxation cut off
+/// by it leaves weaker potentials, not none).
 pub(super) fn tables(
     m: &CostModel,
     use_potentials: bool,
     use_sec: bool,
     twins: bool,
     upper: Option<f64>,
-) -> Result<Tables> {
+    deadline: Deadline,
+) -> Result<Option<Tables>> {
     let n = m.n();
     let words = n.div_ceil(64).max(1);
     let cl = Closure::new(&m.dag).ok_or_else(|| Error::Solver {
         solver: "beam".into(),
         msg: "precedence has a cycle".into(),
     })?;
-    let g = CellGraph::new(m, &cl);
+    let Some(g) = CellGraph::new_until(m, &cl, deadline) else {
+        return Ok(None);
+    };
     let with_potentials = use_potentials && n <= POTENTIAL_MAX_CELLS;
-    let (sec, asg) = root_duals(m, &g, &cl, with_potentials, use_sec, upper);
+    let (sec, asg) = root_duals(m, &g, &cl, with_potentials, use_sec, upper, deadline);
+    if deadline.passed() {
+        return Ok(None);
+    }
     let (u, v) = match (&sec, &asg) {
         (Some(s), _) => (s.u.clone(), s.v.clone()),
         (None, Some(a)) => (a.u.clone(), a.v.clone()),
@@ -150,15 +159,20 @@ pub(super) fn tables(
         v: &v,
         mu_arc: &mu_arc,
     };
-    let pred_mask = pred_masks(m, &cl, twins, words);
-    let (node_out, node_in) = node_terms(m, &cl, &red);
+    let pred_mask = pred_masks(m, &cl, twins, words, deadline);
+    let Some((node_out, node_in)) = node_terms(m, &cl, &red, deadline) else {
+        return Ok(None);
+    };
     let (in_list, out_list) = arc_lists(&red);
     let first = |l: &Vec<(f64, u32)>| l.first().map(|e| e.0).unwrap_or(0.0);
     let clusters = if asg.is_some() || sec.is_some() {
-        choose_clusters(&g, &|i, j| red.r(i, j))
+        choose_clusters(&g, &|i, j| red.r(i, j), deadline)
     } else {
         Vec::new()
     };
+    if deadline.passed() {
+        return Ok(None);
+    }
     if crate::solvers::trace_enabled() {
         trace_root(m, sec.as_ref(), asg.as_ref(), &clusters);
     }
@@ -171,7 +185,7 @@ pub(super) fn tables(
     let cell_in: Vec<f64> = (0..n).map(|c| u[c] + v[c] + first(&in_list[c])).collect();
     let cell_out: Vec<f64> = (0..n).map(|c| u[c] + v[c] + first(&out_list[c])).collect();
     let r_home: Vec<f64> = (0..n).map(|i| red.r(i, n)).collect();
-    Ok(Tables {
+    Ok(Some(Tables {
         total_in: cell_in.iter().sum(),
         total_out: cell_out.iter().sum(),
         cell_in,
@@ -196,7 +210,7 @@ pub(super) fn tables(
         integral: g.integral() && m.constant().fract() == 0.0,
         cluster,
         clusters,
-    })
+    }))
 }
 
 /// The root relaxation whose duals give the potentials (`with_potentials`: wanted and
@@ -209,13 +223,14 @@ fn root_duals(
     with_potentials: bool,
     use_sec: bool,
     upper: Option<f64>,
+    deadline: Deadline,
 ) -> (Option<SecBound>, Option<Assignment>) {
     let n = m.n();
     let sec: Option<SecBound> = (with_potentials && use_sec)
         .then(|| {
             let iters = sec::affordable_iterations(n, SEC_WORK, 1000);
             let upper = upper.map(|x| x - m.constant());
-            sec::sec_bound(g, Some(cl), upper, iters, 4 * n + 16)
+            sec::sec_bound_until(g, Some(cl), upper, iters, 4 * n + 16, deadline)
         })
         .flatten()
         .filter(|s| s.u.iter().chain(&s.v).chain(&s.mu).all(|x| x.is_finite()));
@@ -223,7 +238,7 @@ fn root_duals(
         None
     } else {
         with_potentials
-            .then(|| assignment::hungarian_duals(g.size(), |i, j| g.c(i, j)))
+            .then(|| assignment::hungarian_duals_until(g.size(), |i, j| g.c(i, j), deadline))
             .flatten()
             .filter(|a| a.u.iter().chain(&a.v).all(|x| x.is_finite()))
     };
@@ -268,8 +283,15 @@ impl Reduced<'_> {
 }
 
 /// Per cell: its predecessors as a bitset of `words` words; with `twins`, each twin also
-/// waits for the twin that leads it (symmetry breaking, up to [`TWIN_MAX_CELLS`] cells).
-fn pred_masks(m: &CostModel, cl: &Closure, twins: bool, words: usize) -> Vec<Vec<u64>> {
+/// waits for the twin that leads it (symmetry breaking, up to [`TWIN_MAX_CELLS`] cells; the
+/// pairs found before `deadline`).
+fn pred_masks(
+    m: &CostModel,
+    cl: &Closure,
+    twins: bool,
+    words: usize,
+    deadline: Deadline,
+) -> Vec<Vec<u64>> {
     let n = m.n();
     let mut pred_mask: Vec<Vec<u64>> = (0..n)
         .map(|c| {
@@ -281,7 +303,7 @@ fn pred_masks(m: &CostModel, cl: &Closure, twins: bool, words: usize) -> Vec<Vec
         })
         .collect();
     if twins && n <= TWIN_MAX_CELLS {
-        for (a, b) in twin_order(m, cl) {
+        for (a, b) in twin_order(m, cl, deadline) {
             pred_mask[b][a / 64] |= 1 << (a % 64);
         }
     }
@@ -289,8 +311,13 @@ fn pred_masks(m: &CostModel, cl: &Closure, twins: bool, words: usize) -> Vec<Vec
 }
 
 /// Per node: `Tables::node_out` and `Tables::node_in` (the last node's terms of the
-/// incremental bound).
-fn node_terms(m: &CostModel, cl: &Closure, red: &Reduced) -> (Vec<f64>, Vec<f64>) {
+/// incremental bound); `None` once `deadline` passes (checked per node: O(nodes) work each).
+fn node_terms(
+    m: &CostModel,
+    cl: &Closure,
+    red: &Reduced,
+    deadline: Deadline,
+) -> Option<(Vec<f64>, Vec<f64>)> {
     let n = m.n();
     let (u, v) = (red.u, red.v);
     let fin = |x: f64| if x.is_finite() { x } else { 0.0 };
@@ -298,6 +325,9 @@ fn node_terms(m: &CostModel, cl: &Closure, red: &Reduced) -> (Vec<f64>, Vec<f64>
     let mut node_in = vec![0.0; m.nodes()];
     let home_in = fin((0..n).map(|i| red.r(i, n)).fold(f64::INFINITY, f64::min));
     for (nd, slot) in node_out.iter_mut().enumerate() {
+        if deadline.passed() {
+            return None;
+        }
         let (a, ma) = m.cell_mode(nd);
         let mut best = if cl.can_be_last(a) {
             m.finish(a, ma) - u[a] - v[n] - red.mu(a, n)
@@ -314,7 +344,7 @@ fn node_terms(m: &CostModel, cl: &Closure, red: &Reduced) -> (Vec<f64>, Vec<f64>
         *slot = u[a] + v[n] + fin(best);
         node_in[nd] = u[a] + v[n] + home_in;
     }
-    (node_out, node_in)
+    Some((node_out, node_in))
 }
 
 /// Per cell: the allowed predecessor cells, and the allowed successors (home = n when it

@@ -1,6 +1,7 @@
 //! Twin detection: cells that are copies of each other apart from the precedence, ordered by
 //! index (symmetry breaking that keeps an optimum).
 
+use crate::clock::Deadline;
 use crate::cost::CostModel;
 use crate::precedence::Closure;
 
@@ -70,14 +71,19 @@ fn may_lead(cl: &Closure, a: usize, b: usize) -> bool {
 #[cfg(any(test, feature = "internals"))]
 pub fn interchangeable_order(m: &CostModel) -> Vec<(usize, usize)> {
     Closure::new(&m.dag)
-        .map(|cl| twin_order(m, &cl))
+        .map(|cl| twin_order(m, &cl, Deadline::NONE))
         .unwrap_or_default()
 }
 
-pub(super) fn twin_order(m: &CostModel, cl: &Closure) -> Vec<(usize, usize)> {
+/// The pairs of [`interchangeable_order`] found before `deadline` (any subset of the pairs
+/// keeps an optimum too).
+pub(super) fn twin_order(m: &CostModel, cl: &Closure, deadline: Deadline) -> Vec<(usize, usize)> {
     let n = m.n();
     let mut out = Vec::new();
     for a in 0..n {
+        if deadline.passed() {
+            break;
+        }
         for b in a + 1..n {
             if !cost_twins(m, cl, a, b) {
                 continue;
