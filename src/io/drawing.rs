@@ -4,6 +4,7 @@
 
 use serde::Serialize;
 use std::collections::HashMap;
+use std::sync::Arc;
 
 /// A layer: an Inkscape layer, or (SVG) any other group that is a child of the root, which is
 /// how plotter tools such as vpype read a file's layers. Index 0 is the document root, outside
@@ -186,9 +187,109 @@ pub struct Kept {
     pub layer: usize,
     /// Source line of the element.
     pub line: usize,
-    /// Its source text, wrapped in one `<g>` per ancestor below the root carrying that
-    /// ancestor's attributes (transform, style), so that it renders as before.
+    /// Its source text.
     pub xml: String,
+    /// Its innermost ancestor below the root (`None` for a child of the root); the writer
+    /// wraps the element in one `<g>` per ancestor carrying that ancestor's attributes
+    /// (transform, style), so that it renders as before.
+    pub wrap: Option<Arc<Wrap>>,
+}
+
+impl Kept {
+    /// The element wrapped in one `<g>` per ancestor, outermost first (its text as written
+    /// on its own). Linear in the depth; the writer shares the wrappers of neighbouring
+    /// elements instead.
+    pub fn wrapped(&self) -> String {
+        let chain = Wrap::chain(self.wrap.as_ref());
+        let mut s = String::new();
+        for w in &chain {
+            s.push_str("<g");
+            s.push_str(&w.attrs);
+            s.push('>');
+        }
+        s.push_str(&self.xml);
+        for _ in &chain {
+            s.push_str("</g>");
+        }
+        s
+    }
+}
+
+/// An ancestor group of kept elements: its attributes as the source has them (`id`,
+/// namespace declarations and Inkscape attributes left out), its parent and its depth. Every
+/// kept element below one group shares that group's node, so elements deep in nested groups
+/// cost memory linear in the file, not in the depth times the number of elements.
+pub struct Wrap {
+    /// ` name="value"` for each attribute kept, in source order.
+    pub attrs: String,
+    /// The enclosing group below the root, if any.
+    pub parent: Option<Arc<Wrap>>,
+    /// 1 for a child of the root.
+    pub depth: usize,
+}
+
+impl Wrap {
+    /// A group below `parent` with attribute text `attrs`.
+    pub fn new(attrs: String, parent: Option<Arc<Wrap>>) -> Arc<Wrap> {
+        let depth = parent.as_ref().map_or(0, |p| p.depth) + 1;
+        Arc::new(Wrap {
+            attrs,
+            parent,
+            depth,
+        })
+    }
+    /// `w` and its ancestors, outermost first.
+    pub fn chain(w: Option<&Arc<Wrap>>) -> Vec<&Wrap> {
+        let mut v = Vec::new();
+        let mut at = w.map(|a| &**a);
+        while let Some(x) = at {
+            v.push(x);
+            at = x.parent.as_deref();
+        }
+        v.reverse();
+        v
+    }
+}
+
+impl PartialEq for Wrap {
+    /// Same attributes all the way up (compared without recursion).
+    fn eq(&self, other: &Wrap) -> bool {
+        let (mut a, mut b) = (self, other);
+        loop {
+            if std::ptr::eq(a, b) {
+                return true;
+            }
+            if a.depth != b.depth || a.attrs != b.attrs {
+                return false;
+            }
+            match (a.parent.as_deref(), b.parent.as_deref()) {
+                (Some(x), Some(y)) => (a, b) = (x, y),
+                (None, None) => return true,
+                _ => return false,
+            }
+        }
+    }
+}
+
+impl std::fmt::Debug for Wrap {
+    /// This group only (a chain can be thousands of groups deep).
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "Wrap(depth {}, \"{}\")", self.depth, self.attrs)
+    }
+}
+
+impl Drop for Wrap {
+    /// Drops a deep chain without recursion: each parent held only here is unlinked before
+    /// it is dropped.
+    fn drop(&mut self) {
+        let mut next = self.parent.take();
+        while let Some(p) = next {
+            match Arc::try_unwrap(p) {
+                Ok(mut w) => next = w.parent.take(),
+                Err(_) => break,
+            }
+        }
+    }
 }
 
 impl Drawing {
@@ -221,16 +322,6 @@ impl Drawing {
                 }
             })
             .or_insert(Some(arc));
-    }
-    /// The index of style `s`, added when new.
-    pub fn style_index(&mut self, s: Style) -> usize {
-        match self.styles.iter().position(|x| *x == s) {
-            Some(i) => i,
-            None => {
-                self.styles.push(s);
-                self.styles.len() - 1
-            }
-        }
     }
 }
 

@@ -10,9 +10,11 @@
 
 use super::{Drawing, Layer, Stroke, Style};
 use crate::error::{Error, Result};
-use crate::io::drawing::Kept;
+use crate::io::drawing::{Kept, Wrap};
 use kurbo::{Affine, BezPath, PathEl, Point, Shape};
 use roxmltree::{Document, Node, ParsingOptions};
+use std::collections::HashMap;
+use std::sync::Arc;
 use svgtypes::{SimplePathSegment, SimplifyingPathParser};
 
 const SVG_NS: &str = "http://www.w3.org/2000/svg";
@@ -56,6 +58,9 @@ struct Ctx<'a> {
     opts: ReadOptions,
     out: Drawing,
     points: usize,
+    /// Index of each distinct style in `out.styles` (colour, width bits): a file may have a
+    /// style per element, so the lookup is hashed, not a scan.
+    styles: HashMap<(String, u64), usize>,
 }
 
 /// Inherited presentation state.
@@ -67,6 +72,8 @@ struct Inherit {
     layer: usize,
     /// `stroke-linecap` is round or square: zero-length subpaths are drawn as dots.
     caps: bool,
+    /// The innermost group below the root, for elements kept as they are.
+    wrap: Option<Arc<Wrap>>,
 }
 
 /// Parses an SVG document into strokes.
@@ -123,6 +130,7 @@ pub fn read(file: &str, text: &str, opts: ReadOptions) -> Result<Drawing> {
         file,
         text,
         points: 0,
+        styles: HashMap::new(),
         doc: &lines,
         opts,
         out: Drawing {
@@ -150,6 +158,7 @@ pub fn read(file: &str, text: &str, opts: ReadOptions) -> Result<Drawing> {
         width: 1.0,
         layer: 0,
         caps: false,
+        wrap: None,
     };
     let inh = presentation(&ctx, root, &inh)?;
     walk(&mut ctx, root, inh)?;
@@ -187,10 +196,13 @@ fn mm_per_unit(root: Node) -> f64 {
             .filter(|s| !s.is_empty())
             .filter_map(|s| s.parse().ok())
             .collect();
-        (p.len() == 4 && p[2] > 0.0).then_some(p[2])
+        // `filter`, not `then_some(p[2])`: the index must not be evaluated on fewer numbers
+        Some(p)
+            .filter(|p| p.len() == 4 && p[2] > 0.0 && p[2].is_finite())
+            .map(|p| p[2])
     });
     match (width_mm, vb_w) {
-        (Some(w), Some(vb)) if w > 0.0 => w / vb,
+        (Some(w), Some(vb)) if w > 0.0 && (w / vb).is_normal() => w / vb,
         _ => 25.4 / 96.0,
     }
 }
@@ -334,6 +346,7 @@ fn visit(ctx: &mut Ctx, n: Node, inh: &Inherit) -> Result<Option<Inherit>> {
         }
         "g" | "a" => {
             let mut inh = presentation(ctx, n, inh)?;
+            inh.wrap = Some(Wrap::new(wrap_attrs(ctx, n), inh.wrap.take()));
             // an Inkscape layer, or any group that is a child of the root (the layers
             // plotter tools such as vpype read); the writer keeps them as they are
             let inkscape = n.attribute((INKSCAPE_NS, "groupmode")) == Some("layer");
@@ -370,42 +383,35 @@ fn visit(ctx: &mut Ctx, n: Node, inh: &Inherit) -> Result<Option<Inherit>> {
     }
 }
 
-/// Keeps an element that is not sequenced, verbatim, with its ancestors' attributes; or,
-/// with `skip_unsupported`, drops it and says so.
+/// Keeps an element that is not sequenced, verbatim, with its ancestors' attributes (shared
+/// with its siblings: [`Wrap`]); or, with `skip_unsupported`, drops it and says so.
 fn keep(ctx: &mut Ctx, n: Node, inh: &Inherit, what: &str) {
     let line = line_of(ctx.doc, n);
     if ctx.opts.skip_unsupported {
         ctx.out.skipped.push(format!("line {line}: {what}"));
         return;
     }
-    let mut chain: Vec<Node> = n
-        .ancestors()
-        .skip(1)
-        .filter(|a| a.is_element() && a.parent_element().is_some())
-        .collect();
-    chain.reverse();
-    let mut xml = String::new();
-    for a in &chain {
-        xml.push_str("<g");
-        for at in a.attributes() {
-            let qn = &ctx.text[at.range_qname()];
-            if qn == "id" || qn.starts_with("xmlns") || at.namespace() == Some(INKSCAPE_NS) {
-                continue;
-            }
-            xml.push(' ');
-            xml.push_str(&ctx.text[at.range()]);
-        }
-        xml.push('>');
-    }
-    xml.push_str(&ctx.text[n.range()]);
-    for _ in &chain {
-        xml.push_str("</g>");
-    }
     ctx.out.kept.push(Kept {
         layer: inh.layer,
         line,
-        xml,
+        xml: ctx.text[n.range()].to_string(),
+        wrap: inh.wrap.clone(),
     });
+}
+
+/// The attributes of a group that a kept element's wrapper carries: all but `id`, namespace
+/// declarations and Inkscape's own, as the source writes them.
+fn wrap_attrs(ctx: &Ctx, n: Node) -> String {
+    let mut s = String::new();
+    for at in n.attributes() {
+        let qn = &ctx.text[at.range_qname()];
+        if qn == "id" || qn.starts_with("xmlns") || at.namespace() == Some(INKSCAPE_NS) {
+            continue;
+        }
+        s.push(' ');
+        s.push_str(&ctx.text[at.range()]);
+    }
+    s
 }
 
 fn points_attr(ctx: &Ctx, n: Node) -> Result<Vec<Point>> {
@@ -563,6 +569,22 @@ fn shape(ctx: &Ctx, n: Node) -> Result<BezPath> {
     Ok(p)
 }
 
+/// The index of the style (`stroke`, `width`) in the drawing, added when new.
+fn style_index(ctx: &mut Ctx, stroke: &str, width: f64) -> usize {
+    // + 0.0: -0 and 0 are one width, as `==` has them
+    let key = (stroke.to_string(), (width + 0.0).to_bits());
+    if let Some(&i) = ctx.styles.get(&key) {
+        return i;
+    }
+    ctx.out.styles.push(Style {
+        stroke: key.0.clone(),
+        width,
+    });
+    let i = ctx.out.styles.len() - 1;
+    ctx.styles.insert(key, i);
+    i
+}
+
 /// Flattens a path (after the transform) and appends one stroke per subpath. Zero-length
 /// subpaths are drawn only with round or square caps; returns false when the element draws
 /// nothing at all (it is then kept as it is).
@@ -634,10 +656,7 @@ fn emit(ctx: &mut Ctx, path: &BezPath, inh: &Inherit, line: usize) -> Result<boo
             ),
         ));
     }
-    let style = ctx.out.style_index(Style {
-        stroke: inh.stroke.clone(),
-        width,
-    });
+    let style = style_index(ctx, &inh.stroke, width);
     let before = ctx.out.strokes.len();
     for (pts, closed) in strokes {
         let s = Stroke::new(pts, closed, inh.layer, style, line);
