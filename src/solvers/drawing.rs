@@ -20,6 +20,7 @@ use crate::engine::neighbours::Neighbours;
 use crate::error::Result;
 use crate::model::{Objective, Visit};
 use std::collections::VecDeque;
+use std::time::{Duration, Instant};
 
 /// Registry entry.
 pub static INFO: SolverInfo = SolverInfo {
@@ -63,7 +64,19 @@ impl Solver for Drawing {
         if !m.is_geometric() {
             return fallback(ctx);
         }
-        let start = crate::construct::greedy::geometric(m, &mut |k| ctx.count(k));
+        // a time limit holds in every phase: the construction and the candidate lists stop
+        // at it (an evaluation budget leaves them alone, so results stay as they were)
+        let deadline = ctx
+            .budget
+            .time_limit
+            .map(|t| Instant::now() + t.saturating_sub(Duration::from_secs_f64(ctx.elapsed())));
+        let out_of_time = || deadline.is_some_and(|d| Instant::now() >= d);
+        let start = crate::construct::greedy::geometric_until(m, &mut |k| ctx.count(k), deadline);
+        if out_of_time() {
+            let out = outcome_of(m, start);
+            ctx.report(out.cost);
+            return Ok(out);
+        }
         if !flat(m) || start.len() < 4 {
             let out = outcome_of(m, start);
             ctx.report(out.cost);
@@ -73,7 +86,9 @@ impl Solver for Drawing {
             return Ok(out);
         }
         ctx.report(m.evaluate(&start));
-        let nb = Neighbours::new(m, self.k);
+        let Some(nb) = Neighbours::new_until(m, self.k, deadline) else {
+            return Ok(outcome_of(m, start));
+        };
         let mut p = Path::new(m, start, nb.merged());
         let all: Vec<u32> = p.t.iter().map(|v| v.cell as u32).collect();
         p.descend(ctx, all);
@@ -83,7 +98,7 @@ impl Solver for Drawing {
         while limited && !ctx.exhausted() {
             p.kick(ctx, &mut rng, self.kick_len);
         }
-        p.polish(ctx);
+        p.polish(ctx, deadline);
         let out = outcome_of(m, p.t);
         ctx.report(out.cost);
         Ok(out)
@@ -490,15 +505,21 @@ impl<'m> Path<'m> {
     /// every place, in every mode) until a sweep finds nothing, on drawings of at most
     /// [`POLISH_MAX`] strokes, at most [`POLISH_SWEEPS`] sweeps. It runs after the budget (a
     /// sweep is O(n²) cheap evaluations, milliseconds at the cap) and depends on nothing but
-    /// the path, so results stay deterministic.
-    fn polish(&mut self, ctx: &mut Context) {
+    /// the path, so results stay deterministic; under a time limit it stops at `deadline`
+    /// (the clock read once per row of pairs).
+    fn polish(&mut self, ctx: &mut Context, deadline: Option<Instant>) {
         let n = self.t.len();
         if n > POLISH_MAX {
             return;
         }
+        let past = || deadline.is_some_and(|d| Instant::now() >= d);
         for _ in 0..POLISH_SWEEPS {
             let mut improved = false;
             for i in 0..n {
+                if past() {
+                    self.log.clear();
+                    return;
+                }
                 for j in i + 1..n {
                     if self.reverse_gain(i, j) > EPS {
                         self.reverse(i, j);
@@ -508,6 +529,10 @@ impl<'m> Path<'m> {
             }
             ctx.count((n * n / 2) as u64);
             for p in 0..n {
+                if past() {
+                    self.log.clear();
+                    return;
+                }
                 let v = self.t[p];
                 let (prev, next) = (
                     p.checked_sub(1).map(|k| self.t[k]),
