@@ -143,6 +143,10 @@ pub struct Drawing {
     pub warnings: Vec<String>,
     /// Coordinates are y-up (DXF): the SVG writer mirrors them with `scale(1,-1)`.
     pub flip_y: bool,
+    /// The program that wrote the file, when the file says so in a way the reader knows
+    /// (`boxes.py`, `Inkscape`); it tells which conventions its layers, colours and groups
+    /// follow (`pipeline::drawing::semantics`).
+    pub generator: Option<String>,
     /// Elements passed through unchanged (SVG text, images, `<use>`, definitions, metadata,
     /// foreign elements, invisible zero-length paths), in document order.
     pub kept: Vec<Kept>,
@@ -380,11 +384,36 @@ pub fn pen_up(
 /// A coordinate as the writers print it ([`num`]) and read it back, so that a drawing and
 /// its written copy hold the same numbers.
 pub fn round6(v: f64) -> f64 {
-    num(v).parse::<f64>().unwrap_or(v) + 0.0
+    match micros(v) {
+        // n / 10^6 correctly rounded: the number the printed decimal parses to
+        Some(n) => n as f64 / 1e6 + 0.0,
+        None => num_formatted(v).parse::<f64>().unwrap_or(v) + 0.0,
+    }
 }
 
 /// Formats a coordinate with 6 decimals, trailing zeros trimmed.
 pub fn num(v: f64) -> String {
+    let Some(n) = micros(v) else {
+        return num_formatted(v);
+    };
+    if n == 0 {
+        return "0".into();
+    }
+    let sign = if n < 0 { "-" } else { "" };
+    let a = n.unsigned_abs();
+    let (int, frac) = (a / 1_000_000, a % 1_000_000);
+    if frac == 0 {
+        return format!("{sign}{int}");
+    }
+    let mut f = format!("{frac:06}");
+    while f.ends_with('0') {
+        f.pop();
+    }
+    format!("{sign}{int}.{f}")
+}
+
+/// [`num`] through the standard formatting (any value).
+fn num_formatted(v: f64) -> String {
     let mut s = format!("{v:.6}");
     if s.contains('.') {
         while s.ends_with('0') {
@@ -395,4 +424,97 @@ pub fn num(v: f64) -> String {
         }
     }
     if s == "-0" { "0".into() } else { s }
+}
+
+/// `v` × 10^6 rounded to an integer as `format!("{v:.6}")` rounds it (half to even, on the
+/// exact binary value), computed exactly in integers; `None` for |v| ≥ 9·10^9 (where the
+/// result may pass 2^53) and for values that are not finite.
+fn micros(v: f64) -> Option<i64> {
+    if v.is_nan() || v.abs() >= 9.0e9 {
+        return None;
+    }
+    let bits = v.to_bits();
+    let exp = ((bits >> 52) & 0x7ff) as i32;
+    let frac = bits & ((1u64 << 52) - 1);
+    // v = ±m · 2^e exactly
+    let (m, e) = if exp == 0 {
+        (frac, -1074)
+    } else {
+        (frac | (1u64 << 52), exp - 1075)
+    };
+    let p = i128::from(m) * 1_000_000;
+    let n = if e >= 0 {
+        p << e
+    } else if -e >= 127 {
+        0
+    } else {
+        let k = (-e) as u32;
+        let (q, rem, half) = (p >> k, p & ((1i128 << k) - 1), 1i128 << (k - 1));
+        if rem > half || (rem == half && q & 1 == 1) {
+            q + 1
+        } else {
+            q
+        }
+    };
+    let n = n as i64;
+    Some(if bits >> 63 == 1 { -n } else { n })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn fast_six_decimals_equal_the_standard_formatting() {
+        let mut x: u64 = 0x9E37_79B9_7F4A_7C15;
+        let mut next = || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            x
+        };
+        let mut values = vec![
+            0.0,
+            -0.0,
+            0.0078125,
+            0.0234375,
+            -0.0078125,
+            0.25,
+            1e-7,
+            -1e-7,
+            5e-7,
+            4.9999999e-7,
+            0.5,
+            1.5,
+            2.5,
+            8.999_999_999e9,
+            -8.999_999_999e9,
+            9e9,
+            1e300,
+            f64::MIN_POSITIVE,
+            5e-324,
+            f64::NAN,
+            f64::INFINITY,
+            -f64::INFINITY,
+            123.456_789_5,
+            0.000_000_5,
+        ];
+        for _ in 0..200_000 {
+            let r = next();
+            // every magnitude from 1e-9 to 1e10, and ties k/2^j
+            let mag = 10f64.powi((r % 20) as i32 - 9);
+            let u = (next() >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0;
+            values.push(u * mag);
+            values.push((next() % 2_000_000) as f64 / f64::from(1u32 << (r % 24) as u32));
+        }
+        for v in values {
+            assert_eq!(num(v), num_formatted(v), "{v:e}");
+            let want = num_formatted(v).parse::<f64>().unwrap_or(v) + 0.0;
+            let got = round6(v);
+            assert!(
+                got.to_bits() == want.to_bits() || (got.is_nan() && want.is_nan()),
+                "{v:e}: {got} vs {want}"
+            );
+        }
+    }
 }

@@ -79,6 +79,31 @@ impl Lines {
     }
 }
 
+/// The first line at which an ASCII DXF names more than `max` distinct layers (group code 8)
+/// or line types (6), with which of the two; `None` within the limit or for a binary DXF.
+/// The `dxf` crate looks each entity's layer and line type up in a list, so its reading time
+/// grows with the entities times these names: this is checked before it reads.
+pub fn too_many_names(bytes: &[u8], max: usize) -> Option<(usize, &'static str)> {
+    use std::collections::HashSet;
+    if bytes.starts_with(b"AutoCAD Binary DXF") {
+        return None;
+    }
+    let text = String::from_utf8_lossy(bytes);
+    let mut lines = text.lines().enumerate();
+    let (mut layers, mut types) = (HashSet::new(), HashSet::new());
+    while let (Some((i, code)), Some((_, value))) = (lines.next(), lines.next()) {
+        let (set, what) = match code.trim() {
+            "8" => (&mut layers, "layer"),
+            "6" => (&mut types, "line type"),
+            _ => continue,
+        };
+        if set.len() < max + 1 && set.insert(value.trim()) && set.len() > max {
+            return Some((i + 2, what));
+        }
+    }
+    None
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -96,5 +121,12 @@ mod tests {
         // a place that does not hold that kind of entity gives no line
         assert_eq!(l.find("0", "ARC", 2), None);
         assert_eq!(l.find("0", "ARC", 9), None);
+    }
+
+    #[test]
+    fn too_many_layer_names_are_found_at_their_line() {
+        let t = "0\nLINE\n8\nA\n0\nLINE\n8\nB\n0\nLINE\n8\nA\n0\nLINE\n8\nC\n";
+        assert_eq!(too_many_names(t.as_bytes(), 3), None);
+        assert_eq!(too_many_names(t.as_bytes(), 2), Some((16, "layer")));
     }
 }

@@ -144,6 +144,9 @@ fn similarity(tf: Affine) -> Option<(f64, bool)> {
     (s > 0.0 && s.is_finite() && (rotation || mirror)).then_some((s, det < 0.0))
 }
 
+/// Most distinct layer names, and line type names, in a DXF ([`locate::too_many_names`]).
+pub const MAX_NAMES: usize = 10_000;
+
 /// Most points a drawing may expand to (inserts and flattening included).
 pub const MAX_POINTS: usize = 20_000_000;
 
@@ -172,6 +175,15 @@ fn load_guarded(file: &str, bytes: &[u8]) -> Result<dxf::Drawing> {
 pub fn read(file: &str, bytes: &[u8], opts: ReadOptions) -> Result<Drawing> {
     if !(opts.tolerance > 0.0 && opts.tolerance.is_finite() && opts.join >= 0.0) {
         return Err(Error::invalid(file, "tolerances must be positive"));
+    }
+    if let Some((line, what)) = locate::too_many_names(bytes, MAX_NAMES) {
+        return Err(Error::parse(
+            file,
+            line,
+            format!(
+                "more than {MAX_NAMES} {what} names (the DXF reader's time grows with the entities times the names)"
+            ),
+        ));
     }
     let dwg = load_guarded(file, bytes)?;
     let mut warnings = Vec::new();
@@ -252,6 +264,7 @@ pub fn read(file: &str, bytes: &[u8], opts: ReadOptions) -> Result<Drawing> {
         skipped,
         warnings,
         flip_y: true,
+        generator: None,
         kept: Vec::new(),
         namespaces: Vec::new(),
         arcs: Default::default(),
@@ -648,7 +661,7 @@ fn entity(
             add_piece(ctx, &src, p, true, &[run])
         }
         EntityType::Arc(a) => {
-            if !is_length(a.radius) || !(a.start_angle.is_finite() && a.end_angle.is_finite()) {
+            if !(is_length(a.radius) && a.start_angle.is_finite() && a.end_angle.is_finite()) {
                 let why = format!(
                     "radius {} or angles {}..{} are not numbers an arc can have",
                     a.radius, a.start_angle, a.end_angle

@@ -232,15 +232,19 @@ fn seg_keys(d: &Drawing, strokes: &[Stroke], intern: &mut Interner, round: bool)
         }
     };
     let mut v = Vec::new();
+    // the interned key of each (layer, style) met, so that each is built once
+    let mut ids: std::collections::HashMap<(usize, usize), u32> = Default::default();
     for s in strokes {
-        let st = &d.styles[s.style];
-        let k = (
-            d.layers[s.layer].label.clone(),
-            st.stroke.clone(),
-            num(st.width).parse::<f64>().unwrap_or(st.width).to_bits(),
-        );
-        let next = intern.len() as u32;
-        let id = *intern.entry(k).or_insert(next);
+        let id = *ids.entry((s.layer, s.style)).or_insert_with(|| {
+            let st = &d.styles[s.style];
+            let k = (
+                d.layers[s.layer].label.clone(),
+                st.stroke.clone(),
+                num(st.width).parse::<f64>().unwrap_or(st.width).to_bits(),
+            );
+            let next = intern.len() as u32;
+            *intern.entry(k).or_insert(next)
+        });
         for (a, b) in s.segments() {
             let (a, b) = ([r(a[0]), r(a[1])], [r(b[0]), r(b[1])]);
             let (a, b) = if (a[0], a[1]) <= (b[0], b[1]) {

@@ -78,6 +78,22 @@ struct Inherit {
 
 /// Parses an SVG document into strokes.
 pub fn read(file: &str, text: &str, opts: ReadOptions) -> Result<Drawing> {
+    read_with(file, text, opts, None)
+}
+
+/// [`read`] with the flattening tolerance given in millimetres (`opts.tolerance` is then
+/// ignored): the document is parsed once, its unit found on its root, and the tolerance
+/// converted to user units before any curve is flattened.
+pub fn read_mm(file: &str, text: &str, tolerance_mm: f64, opts: ReadOptions) -> Result<Drawing> {
+    read_with(file, text, opts, Some(tolerance_mm))
+}
+
+fn read_with(
+    file: &str,
+    text: &str,
+    mut opts: ReadOptions,
+    tolerance_mm: Option<f64>,
+) -> Result<Drawing> {
     if !(opts.tolerance > 0.0 && opts.tolerance.is_finite()) {
         return Err(Error::invalid(
             file,
@@ -122,6 +138,9 @@ pub fn read(file: &str, text: &str, opts: ReadOptions) -> Result<Drawing> {
         }
     }
     let mm_per_unit = mm_per_unit(root);
+    if let Some(t) = tolerance_mm {
+        opts.tolerance = t / mm_per_unit;
+    }
     let namespaces = root
         .namespaces()
         .filter_map(|ns| ns.name().map(|p| (p.to_string(), ns.uri().to_string())))
@@ -147,6 +166,7 @@ pub fn read(file: &str, text: &str, opts: ReadOptions) -> Result<Drawing> {
             skipped: Vec::new(),
             warnings: Vec::new(),
             flip_y: false,
+            generator: generator(text, root),
             kept: Vec::new(),
             namespaces,
             arcs: Default::default(),
@@ -175,6 +195,16 @@ pub fn read(file: &str, text: &str, opts: ReadOptions) -> Result<Drawing> {
         ));
     }
     Ok(ctx.out)
+}
+
+/// The program that wrote the file, from what it leaves in it: boxes.py's comment and
+/// metadata ("Created with Boxes.py"), Inkscape's `inkscape:version` on the root.
+fn generator(text: &str, root: Node) -> Option<String> {
+    if text.contains("Created with Boxes.py") || text.contains("boxes.hackerspace-bamberg.de") {
+        return Some("boxes.py".into());
+    }
+    root.attribute((INKSCAPE_NS, "version"))
+        .map(|_| "Inkscape".to_string())
 }
 
 /// Byte offsets of line starts, for line numbers in O(log n).
