@@ -237,10 +237,12 @@ fn json_semantics(out: &pipe::Optimized) -> serde_json::Value {
     serde_json::json!({
         "pens": out.reading.pens.name(),
         "blocks": out.reading.blocks.name(),
+        "inner_first": out.reading.inner_first,
         "why": out.semantics,
         "tried": out.tried.iter().map(|(r, up)| serde_json::json!({
             "pens": r.pens.name(),
             "blocks": r.blocks.name(),
+            "inner_first": r.inner_first,
             "pen_up_total_mm": up,
         })).collect::<Vec<_>>(),
     })

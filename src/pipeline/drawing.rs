@@ -96,10 +96,7 @@ pub fn scopes(d: &Drawing, by_scope: bool) -> Vec<Vec<usize>> {
     let r = if by_scope {
         Reading::STRICT
     } else {
-        Reading {
-            pens: Pens::None,
-            blocks: Blocks::None,
-        }
+        Reading::new(Pens::None, Blocks::None)
     };
     scopes_of(d, r)
 }
@@ -679,7 +676,13 @@ fn solve_reading(
 ) -> Result<(Pass, bool)> {
     let key = layer_label(d);
     let figures = |s: &[Stroke]| pen_up(s, d.mm_per_unit, &key);
-    let best = solve_pass(d, sc, opts, allowance, shares)?;
+    // inner first: the containment order inside each scope, as cut mode has it
+    let inner = Options {
+        cut: opts.cut || r.inner_first,
+        ..opts.clone()
+    };
+    let opts_in = &inner;
+    let best = solve_pass(d, sc, opts_in, allowance, shares)?;
     if !reorders(opts, r, sc) {
         return Ok((best, false));
     }
@@ -687,7 +690,7 @@ fn solve_reading(
         return Ok((best, false));
     };
     let sc2: Vec<Vec<usize>> = order.iter().map(|&k| sc[k].clone()).collect();
-    let p = solve_pass(d, &sc2, opts, allowance, shares)?;
+    let p = solve_pass(d, &sc2, opts_in, allowance, shares)?;
     let (a, b) = (figures(&best.strokes), figures(&p.strokes));
     Ok(if b.pen_up_total_mm < a.pen_up_total_mm {
         let solve_s = best.solve_s + p.solve_s;
@@ -717,7 +720,14 @@ pub fn optimize_within(d: &Drawing, opts: &Options, allowance: &Allowance) -> Re
     let mut plans: Vec<(Reading, Vec<Vec<usize>>)> = Vec::new();
     for r in readings {
         let sc = reading_scopes(d, opts, r);
-        if !plans.iter().any(|p| p.1 == sc) {
+        if r.inner_first {
+            let all: Vec<usize> = sc.iter().flatten().copied().collect();
+            let inside = containment(d, &all, opts.contain_tol);
+            if !semantics::parts_apart(&sc, &inside, d.strokes.len()) {
+                continue;
+            }
+        }
+        if !plans.iter().any(|p| p.1 == sc && !r.inner_first) {
             plans.push((r, sc));
         }
     }

@@ -16,6 +16,12 @@
 //! plain groups are grouping. When that reading differs from the strictest one (a colour is
 //! a pen inside each layer, groups are parts: what every other reading allows), both are
 //! solved and the one with less pen-up travel is kept ([`readings`]).
+//!
+//! boxes.py colours a part's strokes by operation (inner cuts, outer cut, etching) and draws
+//! them in that order so that nothing is cut after the part is free. A part read as one pen
+//! with its strokes *inner first* (every stroke inside a closed stroke before it, as
+//! `--cut` orders them) keeps that promise by geometry instead of by colour; `auto` also
+//! solves that reading for boxes.py files whose parts do not lie inside one another.
 
 use crate::io::drawing::Drawing;
 use std::collections::HashMap;
@@ -217,7 +223,7 @@ pub fn readings(d: &Drawing, pens: Pens, blocks: Blocks) -> (Vec<Reading>, Strin
         }
         given => given,
     };
-    let mut first = Reading { pens: p, blocks: b };
+    let mut first = Reading::new(p, b);
     if blocks == Blocks::Auto
         && first.blocks == Blocks::None
         && first.pens == Pens::Colour
@@ -226,17 +232,26 @@ pub fn readings(d: &Drawing, pens: Pens, blocks: Blocks) -> (Vec<Reading>, Strin
         why.push("groups order their colours differently: kept as parts");
         first.blocks = Blocks::Group;
     }
-    let strict = Reading {
-        pens: if pens == Pens::Auto { Pens::Colour } else { p },
-        blocks: if blocks == Blocks::Auto {
+    let strict = Reading::new(
+        if pens == Pens::Auto { Pens::Colour } else { p },
+        if blocks == Blocks::Auto {
             Blocks::Group
         } else {
             b
         },
-    };
+    );
     let mut out = vec![first];
     if strict != first && first.pens != Pens::None {
         out.push(strict);
+    }
+    if f.boxes_py && pens == Pens::Auto && f.plain_groups && first.blocks == Blocks::Group {
+        // a part as one pen, inner strokes first ([module docs](self)); the pipeline drops
+        // it when a part lies inside another ([`parts_apart`])
+        out.push(Reading {
+            pens: Pens::Layer,
+            blocks: Blocks::Group,
+            inner_first: true,
+        });
     }
     let why = if why.is_empty() {
         "as given".to_string()
@@ -244,4 +259,21 @@ pub fn readings(d: &Drawing, pens: Pens, blocks: Blocks) -> (Vec<Reading>, Strin
         why.join("; ")
     };
     (out, why)
+}
+
+/// True when no stroke of one scope lies inside a closed stroke of another: drawing a part
+/// inner first then frees nothing another part still needs. `containment` gives the
+/// (inner, outer) pairs of the strokes of all scopes, in the order of `all`.
+pub fn parts_apart(sc: &[Vec<usize>], containment: &[(usize, usize)], strokes: usize) -> bool {
+    let mut scope_of = vec![usize::MAX; strokes];
+    let mut all = Vec::new();
+    for (k, s) in sc.iter().enumerate() {
+        for &i in s {
+            scope_of[i] = k;
+            all.push(i);
+        }
+    }
+    containment
+        .iter()
+        .all(|&(a, b)| scope_of[all[a]] == scope_of[all[b]])
 }
