@@ -4,6 +4,7 @@
 
 use serde::Serialize;
 use std::collections::HashMap;
+use std::sync::Arc;
 
 /// A layer: an Inkscape layer, or (SVG) any other group that is a child of the root, which is
 /// how plotter tools such as vpype read a file's layers. Index 0 is the document root, outside
@@ -142,6 +143,10 @@ pub struct Drawing {
     pub warnings: Vec<String>,
     /// Coordinates are y-up (DXF): the SVG writer mirrors them with `scale(1,-1)`.
     pub flip_y: bool,
+    /// The program that wrote the file, when the file says so in a way the reader knows
+    /// (`boxes.py`, `Inkscape`); it tells which conventions its layers, colours and groups
+    /// follow (`pipeline::drawing::semantics`).
+    pub generator: Option<String>,
     /// Elements passed through unchanged (SVG text, images, `<use>`, definitions, metadata,
     /// foreign elements, invisible zero-length paths), in document order.
     pub kept: Vec<Kept>,
@@ -186,9 +191,109 @@ pub struct Kept {
     pub layer: usize,
     /// Source line of the element.
     pub line: usize,
-    /// Its source text, wrapped in one `<g>` per ancestor below the root carrying that
-    /// ancestor's attributes (transform, style), so that it renders as before.
+    /// Its source text.
     pub xml: String,
+    /// Its innermost ancestor below the root (`None` for a child of the root); the writer
+    /// wraps the element in one `<g>` per ancestor carrying that ancestor's attributes
+    /// (transform, style), so that it renders as before.
+    pub wrap: Option<Arc<Wrap>>,
+}
+
+impl Kept {
+    /// The element wrapped in one `<g>` per ancestor, outermost first (its text as written
+    /// on its own). Linear in the depth; the writer shares the wrappers of neighbouring
+    /// elements instead.
+    pub fn wrapped(&self) -> String {
+        let chain = Wrap::chain(self.wrap.as_ref());
+        let mut s = String::new();
+        for w in &chain {
+            s.push_str("<g");
+            s.push_str(&w.attrs);
+            s.push('>');
+        }
+        s.push_str(&self.xml);
+        for _ in &chain {
+            s.push_str("</g>");
+        }
+        s
+    }
+}
+
+/// An ancestor group of kept elements: its attributes as the source has them (`id`,
+/// namespace declarations and Inkscape attributes left out), its parent and its depth. Every
+/// kept element below one group shares that group's node, so elements deep in nested groups
+/// cost memory linear in the file, not in the depth times the number of elements.
+pub struct Wrap {
+    /// ` name="value"` for each attribute kept, in source order.
+    pub attrs: String,
+    /// The enclosing group below the root, if any.
+    pub parent: Option<Arc<Wrap>>,
+    /// 1 for a child of the root.
+    pub depth: usize,
+}
+
+impl Wrap {
+    /// A group below `parent` with attribute text `attrs`.
+    pub fn new(attrs: String, parent: Option<Arc<Wrap>>) -> Arc<Wrap> {
+        let depth = parent.as_ref().map_or(0, |p| p.depth) + 1;
+        Arc::new(Wrap {
+            attrs,
+            parent,
+            depth,
+        })
+    }
+    /// `w` and its ancestors, outermost first.
+    pub fn chain(w: Option<&Arc<Wrap>>) -> Vec<&Wrap> {
+        let mut v = Vec::new();
+        let mut at = w.map(|a| &**a);
+        while let Some(x) = at {
+            v.push(x);
+            at = x.parent.as_deref();
+        }
+        v.reverse();
+        v
+    }
+}
+
+impl PartialEq for Wrap {
+    /// Same attributes all the way up (compared without recursion).
+    fn eq(&self, other: &Wrap) -> bool {
+        let (mut a, mut b) = (self, other);
+        loop {
+            if std::ptr::eq(a, b) {
+                return true;
+            }
+            if a.depth != b.depth || a.attrs != b.attrs {
+                return false;
+            }
+            match (a.parent.as_deref(), b.parent.as_deref()) {
+                (Some(x), Some(y)) => (a, b) = (x, y),
+                (None, None) => return true,
+                _ => return false,
+            }
+        }
+    }
+}
+
+impl std::fmt::Debug for Wrap {
+    /// This group only (a chain can be thousands of groups deep).
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "Wrap(depth {}, \"{}\")", self.depth, self.attrs)
+    }
+}
+
+impl Drop for Wrap {
+    /// Drops a deep chain without recursion: each parent held only here is unlinked before
+    /// it is dropped.
+    fn drop(&mut self) {
+        let mut next = self.parent.take();
+        while let Some(p) = next {
+            match Arc::try_unwrap(p) {
+                Ok(mut w) => next = w.parent.take(),
+                Err(_) => break,
+            }
+        }
+    }
 }
 
 impl Drawing {
@@ -221,16 +326,6 @@ impl Drawing {
                 }
             })
             .or_insert(Some(arc));
-    }
-    /// The index of style `s`, added when new.
-    pub fn style_index(&mut self, s: Style) -> usize {
-        match self.styles.iter().position(|x| *x == s) {
-            Some(i) => i,
-            None => {
-                self.styles.push(s);
-                self.styles.len() - 1
-            }
-        }
     }
 }
 
@@ -289,11 +384,36 @@ pub fn pen_up(
 /// A coordinate as the writers print it ([`num`]) and read it back, so that a drawing and
 /// its written copy hold the same numbers.
 pub fn round6(v: f64) -> f64 {
-    num(v).parse::<f64>().unwrap_or(v) + 0.0
+    match micros(v) {
+        // n / 10^6 correctly rounded: the number the printed decimal parses to
+        Some(n) => n as f64 / 1e6 + 0.0,
+        None => num_formatted(v).parse::<f64>().unwrap_or(v) + 0.0,
+    }
 }
 
 /// Formats a coordinate with 6 decimals, trailing zeros trimmed.
 pub fn num(v: f64) -> String {
+    let Some(n) = micros(v) else {
+        return num_formatted(v);
+    };
+    if n == 0 {
+        return "0".into();
+    }
+    let sign = if n < 0 { "-" } else { "" };
+    let a = n.unsigned_abs();
+    let (int, frac) = (a / 1_000_000, a % 1_000_000);
+    if frac == 0 {
+        return format!("{sign}{int}");
+    }
+    let mut f = format!("{frac:06}");
+    while f.ends_with('0') {
+        f.pop();
+    }
+    format!("{sign}{int}.{f}")
+}
+
+/// [`num`] through the standard formatting (any value).
+fn num_formatted(v: f64) -> String {
     let mut s = format!("{v:.6}");
     if s.contains('.') {
         while s.ends_with('0') {
@@ -304,4 +424,97 @@ pub fn num(v: f64) -> String {
         }
     }
     if s == "-0" { "0".into() } else { s }
+}
+
+/// `v` × 10^6 rounded to an integer as `format!("{v:.6}")` rounds it (half to even, on the
+/// exact binary value), computed exactly in integers; `None` for |v| ≥ 9·10^9 (where the
+/// result may pass 2^53) and for values that are not finite.
+fn micros(v: f64) -> Option<i64> {
+    if v.is_nan() || v.abs() >= 9.0e9 {
+        return None;
+    }
+    let bits = v.to_bits();
+    let exp = ((bits >> 52) & 0x7ff) as i32;
+    let frac = bits & ((1u64 << 52) - 1);
+    // v = ±m · 2^e exactly
+    let (m, e) = if exp == 0 {
+        (frac, -1074)
+    } else {
+        (frac | (1u64 << 52), exp - 1075)
+    };
+    let p = i128::from(m) * 1_000_000;
+    let n = if e >= 0 {
+        p << e
+    } else if -e >= 127 {
+        0
+    } else {
+        let k = (-e) as u32;
+        let (q, rem, half) = (p >> k, p & ((1i128 << k) - 1), 1i128 << (k - 1));
+        if rem > half || (rem == half && q & 1 == 1) {
+            q + 1
+        } else {
+            q
+        }
+    };
+    let n = n as i64;
+    Some(if bits >> 63 == 1 { -n } else { n })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn fast_six_decimals_equal_the_standard_formatting() {
+        let mut x: u64 = 0x9E37_79B9_7F4A_7C15;
+        let mut next = || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            x
+        };
+        let mut values = vec![
+            0.0,
+            -0.0,
+            0.0078125,
+            0.0234375,
+            -0.0078125,
+            0.25,
+            1e-7,
+            -1e-7,
+            5e-7,
+            4.9999999e-7,
+            0.5,
+            1.5,
+            2.5,
+            8.999_999_999e9,
+            -8.999_999_999e9,
+            9e9,
+            1e300,
+            f64::MIN_POSITIVE,
+            5e-324,
+            f64::NAN,
+            f64::INFINITY,
+            -f64::INFINITY,
+            123.456_789_5,
+            0.000_000_5,
+        ];
+        for _ in 0..200_000 {
+            let r = next();
+            // every magnitude from 1e-9 to 1e10, and ties k/2^j
+            let mag = 10f64.powi((r % 20) as i32 - 9);
+            let u = (next() >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0;
+            values.push(u * mag);
+            values.push((next() % 2_000_000) as f64 / f64::from(1u32 << (r % 24) as u32));
+        }
+        for v in values {
+            assert_eq!(num(v), num_formatted(v), "{v:e}");
+            let want = num_formatted(v).parse::<f64>().unwrap_or(v) + 0.0;
+            let got = round6(v);
+            assert!(
+                got.to_bits() == want.to_bits() || (got.is_nan() && want.is_nan()),
+                "{v:e}: {got} vs {want}"
+            );
+        }
+    }
 }

@@ -17,9 +17,24 @@ pub struct DrawingArgs {
     /// Curve flattening tolerance (mm).
     #[arg(long, default_value_t = 0.01)]
     pub tolerance: f64,
-    /// Sequence the whole drawing at once instead of layer by layer / colour by colour.
+    /// Sequence the whole drawing at once instead of layer by layer / colour by colour (the
+    /// same as `--pens none`).
     #[arg(long)]
     pub no_scopes: bool,
+    /// What a pen is: the strokes of one pen are drawn together, pens in the file's order.
+    /// `layer`: a layer is a pen (AxiDraw, Inkscape); `colour`: a stroke colour is a pen
+    /// inside each layer (vpype --attr stroke, LightBurn); `none`: one pen, as --no-scopes;
+    /// `auto`: `layer` when the file has Inkscape layers (every DXF layer), else `colour`,
+    /// and the strictest reading too when it differs (the shorter is kept; see
+    /// docs/drawings.md).
+    #[arg(long, default_value = "auto", value_name = "layer|colour|none|auto", value_parser = parse_pens)]
+    pub pens: pipe::Pens,
+    /// What a plain group that is a child of the root (not an Inkscape layer) is. `group`: a
+    /// part, drawn as one block with its own pen order, the order of the blocks free;
+    /// `none`: only grouping, a run of such groups is ordered by pen alone; `auto`: `group`
+    /// for boxes.py files, else `none` and `group` both, the shorter kept.
+    #[arg(long, default_value = "auto", value_name = "group|none|auto", value_parser = parse_blocks)]
+    pub blocks: pipe::Blocks,
     /// Cut mode: strokes inside a closed stroke are drawn/cut before it.
     #[arg(long)]
     pub cut: bool,
@@ -75,6 +90,14 @@ pub struct DrawingArgs {
     pub units: Option<String>,
 }
 
+fn parse_pens(s: &str) -> Result<pipe::Pens, String> {
+    pipe::Pens::parse(s).ok_or_else(|| format!("'{s}': use layer, colour, none or auto"))
+}
+
+fn parse_blocks(s: &str) -> Result<pipe::Blocks, String> {
+    pipe::Blocks::parse(s).ok_or_else(|| format!("'{s}': use group, none or auto"))
+}
+
 /// `optimize` of a drawing (`fmt` is `svg` or `dxf`).
 pub fn optimize(a: &OptimizeArgs, fmt: &str) -> anyhow::Result<()> {
     match fmt {
@@ -102,7 +125,7 @@ pub fn import(a: &ImportArgs, fmt: &str) -> anyhow::Result<()> {
         SolverKind::Greedy,
         None,
         1,
-    );
+    )?;
     if fmt == "dxf" {
         opts.cut = !a.drawing.no_inner_first;
     }
@@ -123,21 +146,12 @@ fn read_svg(path: &Path, d: &DrawingArgs) -> anyhow::Result<svg::Drawing> {
     let file = path.display().to_string();
     let text = read_text(path)?;
     // the tolerance is given in mm; the reader works in user units
-    let probe = svg::read(
+    Ok(svg::read::read_mm(
         &file,
         &text,
+        d.tolerance,
         svg::ReadOptions {
-            tolerance: 1e9,
-            skip_unsupported: true,
-            max_points: d.max_points,
-        },
-    )?;
-    let tol = d.tolerance / probe.mm_per_unit;
-    Ok(svg::read(
-        &file,
-        &text,
-        svg::ReadOptions {
-            tolerance: tol,
+            tolerance: d.tolerance,
             skip_unsupported: d.skip_unsupported,
             max_points: d.max_points,
         },
@@ -151,8 +165,18 @@ fn svg_options(
     solver: SolverKind,
     time_limit: Option<f64>,
     seed: u64,
-) -> pipe::Options {
-    pipe::Options {
+) -> anyhow::Result<pipe::Options> {
+    use pipe::{Blocks, Pens};
+    if a.no_scopes && !matches!(a.pens, Pens::Auto | Pens::None) {
+        bail!(
+            "--no-scopes is --pens none: it cannot go with --pens {}",
+            a.pens.name()
+        );
+    }
+    if a.keep_group_order && a.blocks == Blocks::None {
+        bail!("--keep-group-order keeps plain groups as blocks: it cannot go with --blocks none");
+    }
+    Ok(pipe::Options {
         solver,
         time_limit,
         max_evals: None,
@@ -160,11 +184,13 @@ fn svg_options(
         seed,
         reversible,
         scopes: !a.no_scopes,
+        pens: a.pens,
+        blocks: a.blocks,
         cut: a.cut,
         free_groups: !a.keep_group_order,
         contain_tol: a.contain_tol / d.mm_per_unit,
         max_starts: a.max_starts,
-    }
+    })
 }
 
 /// The solver (default `drawing`), whether strokes may be reversed (by default yes) and the
@@ -178,9 +204,57 @@ fn optimize_options(
         Some(s) => s.parse()?,
         None => pipe::DRAWING_SOLVER,
     };
-    let mut opts = svg_options(d, &a.drawing, reversible, solver, a.time_limit, a.seed);
+    let mut opts = svg_options(d, &a.drawing, reversible, solver, a.time_limit, a.seed)?;
     opts.max_evals = a.max_evals;
     Ok((solver, reversible, opts))
+}
+
+/// The budget of the whole command, from its start (reading counts): `--time-limit` must be
+/// a positive number of seconds (at most [`MAX_TIME_LIMIT_S`]).
+fn allowance(a: &OptimizeArgs) -> anyhow::Result<cellseq_programs::optimize::Allowance> {
+    if let Some(t) = a.time_limit
+        && !(t.is_finite() && t > 0.0 && t <= MAX_TIME_LIMIT_S)
+    {
+        bail!(
+            "--time-limit must be a positive number of seconds, at most {MAX_TIME_LIMIT_S:e} (got {t})"
+        );
+    }
+    Ok(cellseq_programs::optimize::Allowance::new(a.time_limit, a.max_evals))
+}
+
+/// The longest `--time-limit` of a drawing (about three years).
+pub const MAX_TIME_LIMIT_S: f64 = 1e8;
+
+/// The semantics line of the report: the reading kept, why, and the others tried.
+fn say_semantics(out: &pipe::Optimized) {
+    let others: Vec<String> = out
+        .tried
+        .iter()
+        .filter(|(r, _)| *r != out.reading)
+        .map(|(r, up)| format!("{r}: {up:.1} mm"))
+        .collect();
+    let also = if others.is_empty() {
+        String::new()
+    } else {
+        format!("; also tried {}", others.join(", "))
+    };
+    say!("semantics: {} ({}){also}", out.reading, out.semantics);
+}
+
+/// The semantics of the JSON report.
+fn json_semantics(out: &pipe::Optimized) -> serde_json::Value {
+    serde_json::json!({
+        "pens": out.reading.pens.name(),
+        "blocks": out.reading.blocks.name(),
+        "inner_first": out.reading.inner_first,
+        "why": out.semantics,
+        "tried": out.tried.iter().map(|(r, up)| serde_json::json!({
+            "pens": r.pens.name(),
+            "blocks": r.blocks.name(),
+            "inner_first": r.inner_first,
+            "pen_up_total_mm": up,
+        })).collect::<Vec<_>>(),
+    })
 }
 
 /// The elements the reader skipped, and the note when the original order was kept.
@@ -195,11 +269,12 @@ fn say_skipped(d: &svg::Drawing, note: Option<&String>) {
 
 fn optimize_svg(a: &OptimizeArgs) -> anyhow::Result<()> {
     let file = a.input.display().to_string();
-    let t0 = std::time::Instant::now();
+    let allowance = allowance(a)?;
+    let t0 = allowance.started;
     let d = read_svg(&a.input, &a.drawing)?;
     let read_s = t0.elapsed().as_secs_f64();
     let (solver, reversible, opts) = optimize_options(a, &d)?;
-    let mut out = pipe::optimize(&d, &opts)?;
+    let mut out = pipe::optimize_within(&d, &opts, &allowance)?;
     let (text, segments) = pipe::render(&d, &mut out, pipe::Output::Svg)?;
     write_output(a.output.as_deref(), &text)?;
     let total_s = t0.elapsed().as_secs_f64();
@@ -219,6 +294,7 @@ fn optimize_svg(a: &OptimizeArgs) -> anyhow::Result<()> {
             "total_s": total_s,
             "kept_original_scopes": out.kept_original,
             "groups_reordered": out.groups_reordered,
+            "semantics": json_semantics(&out),
             "kept_note": out.note,
             "before": out.before,
             "after": out.after,
@@ -235,6 +311,7 @@ fn optimize_svg(a: &OptimizeArgs) -> anyhow::Result<()> {
             segments
         );
         say_skipped(&d, out.note.as_ref());
+        say_semantics(&out);
         if out.groups_reordered {
             say!(
                 "top-level groups drawn in a shorter order than the file's (--keep-group-order keeps it)"
@@ -279,14 +356,15 @@ fn read_dxf(path: &Path, d: &DrawingArgs) -> anyhow::Result<svg::Drawing> {
 fn optimize_dxf(a: &OptimizeArgs) -> anyhow::Result<()> {
     use cellseq_programs::dxf;
     let file = a.input.display().to_string();
-    let t0 = std::time::Instant::now();
+    let allowance = allowance(a)?;
+    let t0 = allowance.started;
     let d = read_dxf(&a.input, &a.drawing)?;
     for w in &d.warnings {
         eprintln!("warning: {file}: {w}");
     }
     let (solver, reversible, mut opts) = optimize_options(a, &d)?;
     opts.cut = !a.drawing.no_inner_first;
-    let mut out = pipe::optimize(&d, &opts)?;
+    let mut out = pipe::optimize_within(&d, &opts, &allowance)?;
     let post = dxf::Post {
         safe_height: a.drawing.safe_height,
         depth: a.drawing.cut_depth,
@@ -325,6 +403,7 @@ fn optimize_dxf(a: &OptimizeArgs) -> anyhow::Result<()> {
             "skipped": d.skipped,
             "warnings": d.warnings,
             "mm_per_unit": d.mm_per_unit,
+            "semantics": json_semantics(&out),
             "kept_note": out.note,
             "solve_s": out.solve_s,
             "total_s": total_s,
@@ -343,6 +422,7 @@ fn optimize_dxf(a: &OptimizeArgs) -> anyhow::Result<()> {
             segments
         );
         say_skipped(&d, out.note.as_ref());
+        say_semantics(&out);
         say!(
             "travel mm (file order -> optimized): {:.1} -> {:.1}; pierces {} -> {}",
             out.before.pen_up_total_mm,

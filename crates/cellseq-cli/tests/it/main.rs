@@ -20,6 +20,8 @@ mod cli;
 mod conformance;
 mod core;
 mod docs_solvers;
+mod drawing_scale;
+mod drawing_semantics;
 mod dxf;
 mod dxf_arcs;
 mod edge;

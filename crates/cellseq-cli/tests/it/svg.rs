@@ -119,7 +119,7 @@ fn elements_not_sequenced_are_kept_in_place_and_malformed_input_is_refused_with_
     assert_eq!(d.kept.len(), 1);
     assert_eq!(d.kept[0].line, 2);
     assert_eq!(
-        d.kept[0].xml,
+        d.kept[0].wrapped(),
         "<g transform=\"scale(2)\"><text>hi &amp; ho</text></g>"
     );
     let out = pipe::optimize(&d, &Options::default()).unwrap();

@@ -13,6 +13,7 @@ use dxf::entities::EntityType;
 use kurbo::Affine;
 use std::collections::HashMap;
 
+pub mod locate;
 pub mod post;
 
 pub use post::{Post, verify_gcode, write_gcode};
@@ -98,9 +99,19 @@ struct Piece {
 
 struct Ctx<'a> {
     file: &'a str,
+    /// The file's bytes, to find an entity's line for a message ([`locate::Lines`]).
+    bytes: &'a [u8],
+    lines: Option<locate::Lines>,
     opts: ReadOptions,
     blocks: HashMap<String, &'a dxf::Block>,
     layers: Vec<String>,
+    layer_ids: HashMap<String, usize>,
+    /// Entities and array cells of inserts visited so far (bounded like `points`: nested
+    /// arrays of empty blocks produce no points but can take forever).
+    visits: usize,
+    /// Spline evaluation work so far (samples × (degree + 1)²), bounded by
+    /// [`MAX_SPLINE_WORK`].
+    spline_work: f64,
     pieces: Vec<Piece>,
     skipped: Vec<String>,
     /// Points produced so far (bounded: nested arrays of inserts can explode).
@@ -133,6 +144,9 @@ fn similarity(tf: Affine) -> Option<(f64, bool)> {
     (s > 0.0 && s.is_finite() && (rotation || mirror)).then_some((s, det < 0.0))
 }
 
+/// Most distinct layer names, and line type names, in a DXF ([`locate::too_many_names`]).
+pub const MAX_NAMES: usize = 10_000;
+
 /// Most points a drawing may expand to (inserts and flattening included).
 pub const MAX_POINTS: usize = 20_000_000;
 
@@ -161,6 +175,15 @@ fn load_guarded(file: &str, bytes: &[u8]) -> Result<dxf::Drawing> {
 pub fn read(file: &str, bytes: &[u8], opts: ReadOptions) -> Result<Drawing> {
     if !(opts.tolerance > 0.0 && opts.tolerance.is_finite() && opts.join >= 0.0) {
         return Err(Error::invalid(file, "tolerances must be positive"));
+    }
+    if let Some((line, what)) = locate::too_many_names(bytes, MAX_NAMES) {
+        return Err(Error::parse(
+            file,
+            line,
+            format!(
+                "more than {MAX_NAMES} {what} names (the DXF reader's time grows with the entities times the names)"
+            ),
+        ));
     }
     let dwg = load_guarded(file, bytes)?;
     let mut warnings = Vec::new();
@@ -194,16 +217,22 @@ pub fn read(file: &str, bytes: &[u8], opts: ReadOptions) -> Result<Drawing> {
     };
     let mut ctx = Ctx {
         file,
+        bytes,
+        lines: None,
         opts,
         blocks: dwg.blocks().map(|b| (b.name.clone(), b)).collect(),
         layers: Vec::new(),
+        layer_ids: HashMap::new(),
+        visits: 0,
+        spline_work: 0.0,
         pieces: Vec::new(),
         skipped: Vec::new(),
         points: 0,
         arcs: Vec::new(),
     };
-    for e in dwg.entities() {
-        entity(&mut ctx, e, Affine::IDENTITY, None, 0)?;
+    for (top, e) in dwg.entities().enumerate() {
+        let at = At { top, block: None };
+        entity(&mut ctx, e, Affine::IDENTITY, None, 0, &at)?;
     }
     let Ctx {
         layers,
@@ -235,6 +264,7 @@ pub fn read(file: &str, bytes: &[u8], opts: ReadOptions) -> Result<Drawing> {
         skipped,
         warnings,
         flip_y: true,
+        generator: None,
         kept: Vec::new(),
         namespaces: Vec::new(),
         arcs: Default::default(),
@@ -242,9 +272,12 @@ pub fn read(file: &str, bytes: &[u8], opts: ReadOptions) -> Result<Drawing> {
     for (a, b, arc) in arcs {
         d.add_arc(a, b, arc);
     }
-    for (li, _) in layers.iter().enumerate() {
-        let mine: Vec<&Piece> = pieces.iter().filter(|p| p.layer == li).collect();
-        for s in chain(&mine, opts.join) {
+    let mut by_layer: Vec<Vec<&Piece>> = vec![Vec::new(); layers.len()];
+    for p in &pieces {
+        by_layer[p.layer].push(p);
+    }
+    for (li, mine) in by_layer.iter().enumerate() {
+        for s in chain(mine, opts.join) {
             d.strokes.push(Stroke::new(s.0, s.1, li + 1, 0, 0));
         }
     }
@@ -252,13 +285,12 @@ pub fn read(file: &str, bytes: &[u8], opts: ReadOptions) -> Result<Drawing> {
 }
 
 fn layer_index(ctx: &mut Ctx, name: &str) -> usize {
-    match ctx.layers.iter().position(|l| l == name) {
-        Some(i) => i,
-        None => {
-            ctx.layers.push(name.to_string());
-            ctx.layers.len() - 1
-        }
+    if let Some(&i) = ctx.layer_ids.get(name) {
+        return i;
     }
+    ctx.layers.push(name.to_string());
+    ctx.layer_ids.insert(name.to_string(), ctx.layers.len() - 1);
+    ctx.layers.len() - 1
 }
 
 /// Counter-clockwise sweep from angle `s` to `t` in (0, 2π] (2π when they coincide).
@@ -330,8 +362,13 @@ fn bulged(v: &[([f64; 2], f64)], closed: bool, tol: f64) -> (Vec<[f64; 2]>, Vec<
     (out, runs)
 }
 
-/// De Boor evaluation of a (rational) B-spline, sampled finely enough for `tol`.
-fn spline_points(s: &dxf::entities::Spline, tol: f64) -> Option<Vec<[f64; 2]>> {
+/// De Boor evaluation of a (rational) B-spline, sampled finely enough for `tol`; `allow` is
+/// asked with the number of samples before any is evaluated (false: nothing is evaluated).
+fn spline_points(
+    s: &dxf::entities::Spline,
+    tol: f64,
+    allow: impl FnOnce(usize) -> bool,
+) -> Option<Vec<[f64; 2]>> {
     let p = s.degree_of_curve.max(1) as usize;
     let cps: Vec<[f64; 2]> = s.control_points.iter().map(|c| [c.x, c.y]).collect();
     if cps.is_empty() {
@@ -390,6 +427,9 @@ fn spline_points(s: &dxf::entities::Spline, tol: f64) -> Option<Vec<[f64; 2]>> {
         .sum();
     let n = ((poly / tol.sqrt().max(1e-6)).ceil() as usize)
         .clamp((8 * cps.len()).min(200_000), 200_000);
+    if !allow(n + 1) {
+        return None;
+    }
     let pts: Vec<[f64; 2]> = (0..=n)
         .map(|i| eval(t0 + (t1 - t0) * i as f64 / n as f64))
         .collect();
@@ -402,6 +442,46 @@ struct Source<'a> {
     tf: Affine,
     layer: &'a str,
     handle: &'a str,
+    /// The entity's type (`LINE`, `LWPOLYLINE`, …).
+    kind: &'static str,
+    at: &'a At<'a>,
+}
+
+/// Where an entity was reached from, for messages: its top-level entity (the entity itself,
+/// or the INSERT whose block holds it) and that block's name.
+struct At<'a> {
+    top: usize,
+    block: Option<&'a str>,
+}
+
+/// Most entities and INSERT array cells a drawing may expand to (nested arrays of blocks
+/// that draw nothing produce no points, but visiting them takes time all the same).
+pub const MAX_VISITS: usize = 10_000_000;
+
+/// Highest SPLINE degree read (de Boor's evaluation costs (degree + 1)² per point; CAD
+/// programs write degree 1–11).
+pub const MAX_SPLINE_DEGREE: usize = 32;
+
+/// Most spline evaluation work in a drawing: points sampled × (degree + 1)², summed over its
+/// splines (about a second).
+pub const MAX_SPLINE_WORK: f64 = 2e9;
+
+/// The error for entity `src`: the file, the entity's line when it can be found (else none),
+/// its type and handle, and the block it was reached through.
+fn refuse(ctx: &mut Ctx, src: &Source, why: &str) -> Error {
+    let bytes = ctx.bytes;
+    let lines = ctx.lines.get_or_insert_with(|| locate::Lines::new(bytes));
+    let mut what = src.kind.to_string();
+    if lines.by_handle(src.handle, src.kind).is_some() {
+        what.push_str(&format!(" (handle {})", src.handle));
+    }
+    if let Some(b) = src.at.block {
+        what.push_str(&format!(" in block '{b}'"));
+    }
+    match lines.find(src.handle, src.kind, src.at.top) {
+        Some(l) => Error::parse(ctx.file, l, format!("{what}: {why}")),
+        None => Error::invalid(ctx.file, format!("{what}: {why}")),
+    }
 }
 
 /// Adds one piece of an entity (its own coordinates) in page coordinates, with the chords
@@ -419,13 +499,8 @@ fn add_piece(
     }
     ctx.points += pts.len();
     if ctx.points > MAX_POINTS {
-        return Err(Error::invalid(
-            ctx.file,
-            format!(
-                "the drawing expands to more than {MAX_POINTS} points (entity {})",
-                src.handle
-            ),
-        ));
+        let why = format!("the drawing expands to more than {MAX_POINTS} points");
+        return Err(refuse(ctx, src, &why));
     }
     let li = layer_index(ctx, src.layer);
     let tf = src.tf;
@@ -437,10 +512,7 @@ fn add_piece(
         })
         .collect();
     if !pts.iter().flatten().all(|v| v.is_finite()) {
-        return Err(Error::invalid(
-            ctx.file,
-            format!("entity {}: non-finite coordinate", src.handle),
-        ));
+        return Err(refuse(ctx, src, "non-finite coordinate"));
     }
     if let Some((scale, mirror)) = similarity(tf) {
         let n = pts.len();
@@ -521,13 +593,41 @@ fn ellipse(el: &dxf::entities::Ellipse, tol: f64) -> (Vec<[f64; 2]>, bool) {
     (p, full)
 }
 
-/// Reads one entity (a block's entities through [`insert`]) into pieces.
+/// The DXF name of an entity type this reader draws (`ENTITY` for any other).
+fn kind_of(e: &EntityType) -> &'static str {
+    match e {
+        EntityType::Line(_) => "LINE",
+        EntityType::Circle(_) => "CIRCLE",
+        EntityType::Arc(_) => "ARC",
+        EntityType::Ellipse(_) => "ELLIPSE",
+        EntityType::LwPolyline(_) => "LWPOLYLINE",
+        EntityType::Polyline(_) => "POLYLINE",
+        EntityType::Spline(_) => "SPLINE",
+        EntityType::Insert(_) => "INSERT",
+        _ => "ENTITY",
+    }
+}
+
+/// A radius that is a length: finite and not negative.
+fn is_length(r: f64) -> bool {
+    r.is_finite() && r >= 0.0
+}
+
+/// The first bulge of `bulges` that is not a finite number, with its vertex.
+fn bad_bulge(bulges: impl Iterator<Item = f64>) -> Option<(usize, f64)> {
+    bulges.enumerate().find(|(_, b)| !b.is_finite())
+}
+
+/// Reads one entity (a block's entities through [`insert`]) into pieces. Values no drawing
+/// has (a negative or non-finite radius, a bulge or angle that is not a number) are refused
+/// with the entity's line ([`refuse`]).
 fn entity(
     ctx: &mut Ctx,
     e: &dxf::entities::Entity,
     tf: Affine,
     block_layer: Option<&str>,
     depth: usize,
+    at: &At,
 ) -> Result<()> {
     let layer_name = match (e.common.layer.as_str(), block_layer) {
         ("0", Some(b)) => b.to_string(),
@@ -539,25 +639,54 @@ fn entity(
         tf,
         layer: &layer_name,
         handle: &handle,
+        kind: kind_of(&e.specific),
+        at,
     };
+    ctx.visits += 1;
+    if ctx.visits > MAX_VISITS {
+        let why = format!("the drawing expands to more than {MAX_VISITS} entities");
+        return Err(refuse(ctx, &src, &why));
+    }
     match &e.specific {
         EntityType::Line(l) => {
             let p = vec![[l.p1.x, l.p1.y], [l.p2.x, l.p2.y]];
             add_piece(ctx, &src, p, false, &[])
         }
         EntityType::Circle(c) => {
+            if !is_length(c.radius) {
+                let why = format!("radius {} is not a length", c.radius);
+                return Err(refuse(ctx, &src, &why));
+            }
             let (p, run) = circle(c, tol);
             add_piece(ctx, &src, p, true, &[run])
         }
         EntityType::Arc(a) => {
+            if !(is_length(a.radius) && a.start_angle.is_finite() && a.end_angle.is_finite()) {
+                let why = format!(
+                    "radius {} or angles {}..{} are not numbers an arc can have",
+                    a.radius, a.start_angle, a.end_angle
+                );
+                return Err(refuse(ctx, &src, &why));
+            }
             let (p, run) = arc(a, tol);
             add_piece(ctx, &src, p, false, &[run])
         }
         EntityType::Ellipse(el) => {
+            let nums = [el.minor_axis_ratio, el.start_parameter, el.end_parameter];
+            if !nums.iter().all(|v| v.is_finite()) || el.minor_axis_ratio < 0.0 {
+                let why = format!(
+                    "axis ratio {} or parameters {}..{} are not numbers an ellipse can have",
+                    nums[0], nums[1], nums[2]
+                );
+                return Err(refuse(ctx, &src, &why));
+            }
             let (p, full) = ellipse(el, tol);
             add_piece(ctx, &src, p, full, &[])
         }
         EntityType::LwPolyline(pl) => {
+            if let Some((k, b)) = bad_bulge(pl.vertices.iter().map(|v| v.bulge)) {
+                return Err(refuse(ctx, &src, &format!("bulge {b} at vertex {}", k + 1)));
+            }
             let v: Vec<([f64; 2], f64)> =
                 pl.vertices.iter().map(|v| ([v.x, v.y], v.bulge)).collect();
             let closed = pl.is_closed();
@@ -565,6 +694,9 @@ fn entity(
             add_piece(ctx, &src, p, closed, &runs)
         }
         EntityType::Polyline(pl) => {
+            if let Some((k, b)) = bad_bulge(pl.vertices().map(|v| v.bulge)) {
+                return Err(refuse(ctx, &src, &format!("bulge {b} at vertex {}", k + 1)));
+            }
             let v: Vec<([f64; 2], f64)> = pl
                 .vertices()
                 .map(|v| ([v.location.x, v.location.y], v.bulge))
@@ -573,14 +705,7 @@ fn entity(
             let (p, runs) = bulged(&v, closed, tol);
             add_piece(ctx, &src, p, closed, &runs)
         }
-        EntityType::Spline(s) => match spline_points(s, tol) {
-            Some(p) => add_piece(ctx, &src, p, s.is_closed(), &[]),
-            None => unsupported(
-                ctx,
-                &handle,
-                "SPLINE with inconsistent knots/control points",
-            ),
-        },
+        EntityType::Spline(s) => spline(ctx, s, &src),
         EntityType::Insert(ins) => insert(ctx, ins, &src, block_layer, depth),
         other => unsupported(
             ctx,
@@ -590,8 +715,46 @@ fn entity(
     }
 }
 
+/// A SPLINE, flattened, after checking its degree and that the work of evaluating it stays
+/// within [`MAX_SPLINE_WORK`] and the points within [`MAX_POINTS`].
+fn spline(ctx: &mut Ctx, s: &dxf::entities::Spline, src: &Source) -> Result<()> {
+    let degree = s.degree_of_curve.max(1) as usize;
+    if degree > MAX_SPLINE_DEGREE && !s.control_points.is_empty() {
+        let why = format!("degree {degree}: at most {MAX_SPLINE_DEGREE} is supported");
+        return Err(refuse(ctx, src, &why));
+    }
+    let tol = ctx.opts.tolerance;
+    let mut refusal = None;
+    let pts = spline_points(s, tol, |samples| {
+        let work = samples as f64 * ((degree + 1) * (degree + 1)) as f64;
+        if ctx.points + samples > MAX_POINTS {
+            refusal = Some(format!(
+                "the drawing expands to more than {MAX_POINTS} points"
+            ));
+        } else if ctx.spline_work + work > MAX_SPLINE_WORK {
+            refusal = Some(format!(
+                "its splines take more than {MAX_SPLINE_WORK:e} steps to flatten (degree {degree}, {samples} points here; raise --tolerance)"
+            ));
+        } else {
+            ctx.spline_work += work;
+        }
+        refusal.is_none()
+    });
+    if let Some(why) = refusal {
+        return Err(refuse(ctx, src, &why));
+    }
+    match pts {
+        Some(p) => add_piece(ctx, src, p, s.is_closed(), &[]),
+        None => unsupported(
+            ctx,
+            src.handle,
+            "SPLINE with inconsistent knots/control points",
+        ),
+    }
+}
+
 /// An INSERT: the block's entities under the insert's transform, once per array cell, on the
-/// insert's layer where they are on layer 0.
+/// insert's layer where they are on layer 0. Every array cell counts toward [`MAX_VISITS`].
 fn insert(
     ctx: &mut Ctx,
     ins: &dxf::entities::Insert,
@@ -599,37 +762,55 @@ fn insert(
     block_layer: Option<&str>,
     depth: usize,
 ) -> Result<()> {
-    let handle = src.handle;
     if depth > 16 {
-        return Err(Error::invalid(
-            ctx.file,
-            format!("INSERT (handle {handle}): blocks nested deeper than 16 (recursive?)"),
+        return Err(refuse(
+            ctx,
+            src,
+            "blocks nested deeper than 16 (recursive?)",
         ));
     }
     let Some(b) = ctx.blocks.get(&ins.name).copied() else {
-        return Err(Error::invalid(
-            ctx.file,
-            format!("INSERT (handle {handle}): unknown block '{}'", ins.name),
-        ));
+        let why = format!("unknown block '{}'", ins.name);
+        return Err(refuse(ctx, src, &why));
     };
+    let nums = [
+        ins.location.x,
+        ins.location.y,
+        ins.rotation,
+        ins.column_spacing,
+        ins.row_spacing,
+        ins.x_scale_factor,
+        ins.y_scale_factor,
+    ];
+    if !nums.iter().all(|v| v.is_finite()) {
+        return Err(refuse(ctx, src, "non-finite placement, scale or spacing"));
+    }
     let (cols, rows) = (
         ins.column_count.max(1) as usize,
         ins.row_count.max(1) as usize,
     );
     if cols * rows > 100_000 {
-        return Err(Error::invalid(
-            ctx.file,
-            format!("INSERT (handle {handle}): array too large"),
-        ));
+        return Err(refuse(ctx, src, "array too large"));
     }
     let bl = if src.layer == "0" {
         block_layer.map(str::to_string)
     } else {
         Some(src.layer.to_string())
     };
+    let at = At {
+        top: src.at.top,
+        block: Some(&b.name),
+    };
     let deg = std::f64::consts::PI / 180.0;
     for r in 0..rows {
         for c in 0..cols {
+            ctx.visits += 1;
+            if ctx.visits > MAX_VISITS {
+                let why = format!(
+                    "the drawing expands to more than {MAX_VISITS} entities (nested arrays of blocks)"
+                );
+                return Err(refuse(ctx, src, &why));
+            }
             let t = src.tf
                 * Affine::translate((ins.location.x, ins.location.y))
                 * Affine::rotate(ins.rotation * deg)
@@ -637,7 +818,7 @@ fn insert(
                 * Affine::scale_non_uniform(ins.x_scale_factor, ins.y_scale_factor)
                 * Affine::translate((-b.base_point.x, -b.base_point.y));
             for be in &b.entities {
-                entity(ctx, be, t, bl.as_deref(), depth + 1)?;
+                entity(ctx, be, t, bl.as_deref(), depth + 1, &at)?;
             }
         }
     }
@@ -664,53 +845,91 @@ fn unsupported(ctx: &mut Ctx, handle: &str, why: &str) -> Result<()> {
     }
 }
 
-/// Chains open pieces whose endpoints lie within `tol` (the joined vertex is the first
-/// piece's); closed pieces pass through. Deterministic: pieces in file order.
-fn chain(pieces: &[&Piece], tol: f64) -> Vec<(Vec<[f64; 2]>, bool)> {
-    let mut out = Vec::new();
-    let cell = tol.max(1e-12) * 2.0;
-    let key = |p: [f64; 2]| ((p[0] / cell).floor() as i64, (p[1] / cell).floor() as i64);
-    let mut index: HashMap<(i64, i64), Vec<(usize, bool)>> = HashMap::new();
-    let open: Vec<usize> = (0..pieces.len())
-        .filter(|&i| !pieces[i].closed && !pieces[i].pts.is_empty())
-        .collect();
-    for &i in &open {
-        let p = &pieces[i].pts;
-        index.entry(key(p[0])).or_default().push((i, false));
-        index
-            .entry(key(*p.last().expect("non-empty")))
-            .or_default()
-            .push((i, true));
+/// The distinct endpoints of open pieces, on a grid of cells of twice the join tolerance, each
+/// with its piece ends (piece, at its end) in piece order and a cursor past the used ones, so
+/// that many pieces ending at one point cost no rescans.
+struct Ends {
+    cell: f64,
+    points: Vec<[f64; 2]>,
+    ends: Vec<Vec<(usize, bool)>>,
+    next: Vec<usize>,
+    grid: HashMap<(i64, i64), Vec<usize>>,
+}
+
+impl Ends {
+    fn new(pieces: &[&Piece], tol: f64) -> Ends {
+        let mut e = Ends {
+            cell: tol.max(1e-12) * 2.0,
+            points: Vec::new(),
+            ends: Vec::new(),
+            next: Vec::new(),
+            grid: HashMap::new(),
+        };
+        let mut at: HashMap<[u64; 2], usize> = HashMap::new();
+        for (i, p) in pieces.iter().enumerate() {
+            if p.closed || p.pts.is_empty() {
+                continue;
+            }
+            for (q, at_end) in [(p.pts[0], false), (*p.pts.last().expect("non-empty"), true)] {
+                let id = *at
+                    .entry([q[0].to_bits(), q[1].to_bits()])
+                    .or_insert_with(|| {
+                        e.points.push(q);
+                        e.ends.push(Vec::new());
+                        e.next.push(0);
+                        let k = e.key(q);
+                        e.grid.entry(k).or_default().push(e.points.len() - 1);
+                        e.points.len() - 1
+                    });
+                e.ends[id].push((i, at_end));
+            }
+        }
+        e
     }
-    let mut used = vec![false; pieces.len()];
-    let near = |index: &HashMap<(i64, i64), Vec<(usize, bool)>>,
-                used: &[bool],
-                p: [f64; 2]|
-     -> Option<(usize, bool)> {
-        let (kx, ky) = key(p);
+    fn key(&self, p: [f64; 2]) -> (i64, i64) {
+        (
+            (p[0] / self.cell).floor() as i64,
+            (p[1] / self.cell).floor() as i64,
+        )
+    }
+    /// The unused piece end nearest `p` within `tol` (ties: the lower piece, its start
+    /// first).
+    fn near(&mut self, used: &[bool], p: [f64; 2], tol: f64) -> Option<(usize, bool)> {
+        let (kx, ky) = self.key(p);
         let mut best: Option<(f64, usize, bool)> = None;
         for dx in -1..=1 {
             for dy in -1..=1 {
-                if let Some(v) = index.get(&(kx + dx, ky + dy)) {
-                    for &(i, at_end) in v {
-                        if used[i] {
-                            continue;
-                        }
-                        let q = if at_end {
-                            *pieces[i].pts.last().expect("non-empty")
-                        } else {
-                            pieces[i].pts[0]
-                        };
-                        let d = ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2)).sqrt();
-                        if d <= tol && best.is_none_or(|b| (d, i) < (b.0, b.1)) {
-                            best = Some((d, i, at_end));
-                        }
+                let Some(sites) = self.grid.get(&(kx + dx, ky + dy)) else {
+                    continue;
+                };
+                for &s in sites {
+                    let list = &self.ends[s];
+                    let k = &mut self.next[s];
+                    while *k < list.len() && used[list[*k].0] {
+                        *k += 1;
+                    }
+                    let Some(&(i, at_end)) = list.get(*k) else {
+                        continue;
+                    };
+                    let q = self.points[s];
+                    let d = ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2)).sqrt();
+                    if d <= tol && best.is_none_or(|b| (d, i) < (b.0, b.1)) {
+                        best = Some((d, i, at_end));
                     }
                 }
             }
         }
         best.map(|b| (b.1, b.2))
-    };
+    }
+}
+
+/// Chains open pieces whose endpoints lie within `tol` (the joined vertex is the first
+/// piece's); closed pieces pass through. Deterministic: pieces in file order. Linear in the
+/// pieces (and the points) when many share an endpoint.
+fn chain(pieces: &[&Piece], tol: f64) -> Vec<(Vec<[f64; 2]>, bool)> {
+    let mut out = Vec::new();
+    let mut ends = Ends::new(pieces, tol);
+    let mut used = vec![false; pieces.len()];
     for (i, p) in pieces.iter().enumerate() {
         if p.closed {
             out.push((p.pts.clone(), true));
@@ -722,7 +941,7 @@ fn chain(pieces: &[&Piece], tol: f64) -> Vec<(Vec<[f64; 2]>, bool)> {
         used[i] = true;
         let mut pts = p.pts.clone();
         // forward
-        while let Some((j, at_end)) = near(&index, &used, *pts.last().expect("non-empty")) {
+        while let Some((j, at_end)) = ends.near(&used, *pts.last().expect("non-empty"), tol) {
             used[j] = true;
             let mut q = pieces[j].pts.clone();
             if at_end {
@@ -730,16 +949,26 @@ fn chain(pieces: &[&Piece], tol: f64) -> Vec<(Vec<[f64; 2]>, bool)> {
             }
             pts.extend(q.into_iter().skip(1));
         }
-        // backward
-        while let Some((j, at_end)) = near(&index, &used, pts[0]) {
+        // backward: the pieces found, put in front of the chain once at the end
+        let mut front: Vec<[f64; 2]> = Vec::new();
+        while let Some((j, at_end)) = ends.near(&used, front.last().copied().unwrap_or(pts[0]), tol)
+        {
             used[j] = true;
-            let mut q = pieces[j].pts.clone();
-            if !at_end {
-                q.reverse();
-            }
-            q.pop();
-            q.extend(pts);
-            pts = q;
+            let q = &pieces[j].pts;
+            // the piece drawn towards the chain, its last point (the joined vertex) dropped;
+            // `front` holds the chain's front reversed
+            let mut r: Vec<[f64; 2]> = if at_end {
+                q.iter().rev().copied().collect()
+            } else {
+                q.clone()
+            };
+            r.remove(0);
+            front.extend(r);
+        }
+        if !front.is_empty() {
+            front.reverse();
+            front.extend(pts);
+            pts = front;
         }
         let closed = pts.len() >= 3 && {
             let (a, b) = (pts[0], *pts.last().expect("non-empty"));

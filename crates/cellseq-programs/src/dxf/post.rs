@@ -227,7 +227,8 @@ fn trace_arc(
 /// the zero-length feed move after the plunge. Returns the number of segments.
 pub fn verify_gcode(d: &Drawing, name: &str, text: &str, post: &Post) -> Result<usize> {
     let prog = interp::interpret(text).map_err(|(l, m)| Error::parse(name, l, m))?;
-    let r = |v: f64| svg::num(v).parse::<f64>().unwrap_or(v);
+    // the writer's rounding (num, read back)
+    let r = crate::drawing::round6;
     let norm = |a: [f64; 2], b: [f64; 2]| {
         let (a, b) = if (a[0], a[1]) <= (b[0], b[1]) {
             (a, b)

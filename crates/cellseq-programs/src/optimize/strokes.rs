@@ -19,6 +19,11 @@ use rstar::RTree;
 use rstar::primitives::{GeomWithData, Rectangle};
 
 pub mod blocks;
+pub mod semantics;
+
+pub use semantics::{Blocks, Pens, Reading};
+use std::collections::HashMap;
+use std::time::{Duration, Instant};
 
 /// The registry solver drawings get by default (`drawing`: 2-opt and Or-opt with reversal,
 /// then iterated local search).
@@ -48,8 +53,12 @@ pub struct Options {
     pub seed: u64,
     /// Allow drawing strokes backwards / closed strokes from another vertex.
     pub reversible: bool,
-    /// Layers and stroke colours are ordering scopes.
+    /// Layers and stroke colours are ordering scopes (false: one scope, as [`Pens::None`]).
     pub scopes: bool,
+    /// What a pen is ([`semantics`]); default: read from the file.
+    pub pens: Pens,
+    /// What a plain top-level group is ([`semantics`]); default: read from the file.
+    pub blocks: Blocks,
     /// Cut mode: strokes inside a closed stroke come before it.
     pub cut: bool,
     /// Plain groups that are children of the root (not Inkscape layers) are blocks whose
@@ -73,6 +82,8 @@ impl Default for Options {
             seed: 1,
             reversible: true,
             scopes: true,
+            pens: Pens::Auto,
+            blocks: Blocks::Auto,
             cut: false,
             free_groups: true,
             contain_tol: 0.01,
@@ -81,25 +92,43 @@ impl Default for Options {
     }
 }
 
-/// Scopes in drawing order: each a list of stroke indices.
+/// Scopes in drawing order: each a list of stroke indices. With `by_scope`, one per layer
+/// and stroke colour ([`Reading::STRICT`]); without, one.
 pub fn scopes(d: &Drawing, by_scope: bool) -> Vec<Vec<usize>> {
-    if !by_scope {
+    let r = if by_scope {
+        Reading::STRICT
+    } else {
+        Reading::new(Pens::None, Blocks::None)
+    };
+    scopes_of(d, r)
+}
+
+/// Scopes in drawing order under a reading: one per unit ([`semantics::units`]) and pen
+/// (the stroke colour with [`Pens::Colour`]), units in the file's order, a unit's pens in the
+/// order they first appear; one scope with [`Pens::None`].
+pub fn scopes_of(d: &Drawing, r: Reading) -> Vec<Vec<usize>> {
+    if r.pens == Pens::None || r.pens == Pens::Auto {
         return vec![(0..d.strokes.len()).collect()];
     }
-    let mut keys: Vec<(usize, String)> = Vec::new();
+    let units = semantics::units(d, r.blocks);
+    let mut index: HashMap<(usize, &str), usize> = HashMap::new();
+    let mut keys: Vec<usize> = Vec::new();
     let mut out: Vec<Vec<usize>> = Vec::new();
     for (i, s) in d.strokes.iter().enumerate() {
-        let k = (s.layer, d.styles[s.style].stroke.clone());
-        match keys.iter().position(|x| *x == k) {
-            Some(g) => out[g].push(i),
-            None => {
-                keys.push(k);
-                out.push(vec![i]);
-            }
-        }
+        let pen = match r.pens {
+            Pens::Colour => d.styles[s.style].stroke.as_str(),
+            _ => "",
+        };
+        let unit = units[s.layer];
+        let g = *index.entry((unit, pen)).or_insert_with(|| {
+            keys.push(unit);
+            out.push(Vec::new());
+            out.len() - 1
+        });
+        out[g].push(i);
     }
     let mut idx: Vec<usize> = (0..out.len()).collect();
-    idx.sort_by_key(|&g| (keys[g].0, out[g][0]));
+    idx.sort_by_key(|&g| (keys[g], out[g][0]));
     idx.into_iter()
         .map(|g| std::mem::take(&mut out[g]))
         .collect()
@@ -200,9 +229,12 @@ pub fn containment(d: &Drawing, scope: &[usize], tol: f64) -> Vec<(usize, usize)
 }
 
 /// Cut mode: reorders scopes so that a scope whose closed strokes enclose strokes of another
-/// scope comes after it (stable topological order; file order kept where containment is
-/// cyclic or absent).
+/// scope comes after it (stable topological order: the first scope in file order whose
+/// predecessors are all placed; on a cycle, the first unplaced one). Linear in the scopes and
+/// their containment edges (a heap of ready scopes), not in the square of the scopes.
 pub fn inner_scopes_first(d: &Drawing, sc: Vec<Vec<usize>>, tol: f64) -> Vec<Vec<usize>> {
+    use std::cmp::Reverse;
+    use std::collections::BinaryHeap;
     let all: Vec<usize> = sc.iter().flatten().copied().collect();
     let mut scope_of = vec![0usize; d.strokes.len()];
     for (k, s) in sc.iter().enumerate() {
@@ -211,22 +243,47 @@ pub fn inner_scopes_first(d: &Drawing, sc: Vec<Vec<usize>>, tol: f64) -> Vec<Vec
         }
     }
     let m = sc.len();
-    let mut before = vec![vec![false; m]; m]; // before[a][b]: a must precede b
-    for (a, b) in containment(d, &all, tol) {
-        let (sa, sb) = (scope_of[all[a]], scope_of[all[b]]);
-        if sa != sb {
-            before[sa][sb] = true;
-        }
+    // before: a must precede b
+    let mut pairs: Vec<(usize, usize)> = containment(d, &all, tol)
+        .into_iter()
+        .map(|(a, b)| (scope_of[all[a]], scope_of[all[b]]))
+        .filter(|(a, b)| a != b)
+        .collect();
+    pairs.sort_unstable();
+    pairs.dedup();
+    let mut succs: Vec<Vec<usize>> = vec![Vec::new(); m];
+    let mut missing = vec![0usize; m];
+    for &(a, b) in &pairs {
+        succs[a].push(b);
+        missing[b] += 1;
     }
+    let mut ready: BinaryHeap<Reverse<usize>> =
+        (0..m).filter(|&b| missing[b] == 0).map(Reverse).collect();
     let mut placed = vec![false; m];
+    let mut first_unplaced = 0;
     let mut order = Vec::with_capacity(m);
     while order.len() < m {
-        // the first unplaced scope with no unplaced predecessor; file order on a cycle
-        let next = (0..m)
-            .find(|&b| !placed[b] && (0..m).all(|a| placed[a] || a == b || !before[a][b]))
-            .unwrap_or_else(|| (0..m).find(|&b| !placed[b]).expect("unplaced scope"));
+        let next = loop {
+            match ready.pop() {
+                Some(Reverse(b)) if placed[b] => continue,
+                Some(Reverse(b)) => break b,
+                None => {
+                    // a cycle: the first unplaced scope in file order
+                    while placed[first_unplaced] {
+                        first_unplaced += 1;
+                    }
+                    break first_unplaced;
+                }
+            }
+        };
         placed[next] = true;
         order.push(next);
+        for &b in &succs[next] {
+            missing[b] -= 1;
+            if missing[b] == 0 && !placed[b] {
+                ready.push(Reverse(b));
+            }
+        }
     }
     let mut sc = sc;
     order
@@ -313,11 +370,11 @@ pub fn scope_instance(
 }
 
 /// The whole drawing as one instance (scopes chained by precedence), for `cellseq import`.
+/// The reading is the one the file's conventions give ([`semantics::readings`]).
 pub fn import(d: &Drawing, opts: &Options) -> Result<Instance> {
-    let mut sc = scopes(d, opts.scopes);
-    if opts.cut && sc.len() > 1 {
-        sc = inner_scopes_first(d, sc, opts.contain_tol);
-    }
+    let (pens, blocks) = given(opts);
+    let reading = semantics::readings(d, pens, blocks).0[0];
+    let sc = reading_scopes(d, opts, reading);
     let all: Vec<usize> = sc.iter().flatten().copied().collect();
     let (mut inst, _) = scope_instance(
         d,
@@ -382,6 +439,36 @@ pub struct Optimized {
     /// Why the whole drawing was kept in the file's order, when it was (the new order failed
     /// the built-in check; see [`render`]).
     pub note: Option<String>,
+    /// The reading of pens and blocks kept ([`semantics`]).
+    pub reading: Reading,
+    /// Why that reading was considered (the file's conventions, or "as given").
+    pub semantics: String,
+    /// Every reading solved, in the order tried, with its pen-up travel in all (mm); the
+    /// kept one has the least (the first on a tie).
+    pub tried: Vec<(Reading, f64)>,
+}
+
+/// The pens and blocks the options ask for: `scopes` off is one pen; `free_groups` off
+/// keeps plain groups as parts in the file's order.
+fn given(opts: &Options) -> (Pens, Blocks) {
+    if !opts.scopes {
+        return (Pens::None, Blocks::None);
+    }
+    let blocks = match opts.blocks {
+        Blocks::Auto if !opts.free_groups => Blocks::Group,
+        b => b,
+    };
+    (opts.pens, blocks)
+}
+
+/// The scopes of a reading, in the order they are drawn (cut mode: inner scopes first).
+fn reading_scopes(d: &Drawing, opts: &Options, r: Reading) -> Vec<Vec<usize>> {
+    let sc = scopes_of(d, r);
+    if opts.cut && sc.len() > 1 {
+        inner_scopes_first(d, sc, opts.contain_tol)
+    } else {
+        sc
+    }
 }
 
 fn layer_label(d: &Drawing) -> impl Fn(&Stroke) -> String + '_ {
@@ -419,7 +506,8 @@ struct Shares {
 
 /// Solves the scopes `sc` in this order, each from the previous one's exit (the first from the
 /// origin) with its share of `allowance` ([`solve_group`]: the scope's file order kept unless
-/// the solver's is shorter).
+/// the solver's is shorter). A scope whose share of time is nothing keeps the file's order
+/// without running the solver.
 fn solve_pass(
     d: &Drawing,
     sc: &[Vec<usize>],
@@ -436,8 +524,6 @@ fn solve_pass(
         ends: Vec::with_capacity(sc.len()),
     };
     for s in sc {
-        let (inst, orient) = scope_instance(d, s, home, opts);
-        p.edges += inst.precedence.len();
         let budget = allowance.share_or(
             s.len(),
             shares.left,
@@ -446,6 +532,20 @@ fn solve_pass(
             default_evals(s.len()),
         );
         shares.left = shares.left.saturating_sub(s.len());
+        if budget.time_limit.is_some_and(|t| t.is_zero()) {
+            // no time left: the file's order, without building the scope's instance
+            let first = p.strokes.len();
+            p.strokes.extend(s.iter().map(|&i| d.strokes[i].clone()));
+            p.kept += usize::from(opts.solver != SolverKind::AsGiven);
+            let entry = p.strokes.get(first).map_or(home, |x| x.start());
+            if let Some(l) = p.strokes.last() {
+                home = l.end();
+            }
+            p.ends.push((entry, home));
+            continue;
+        }
+        let (inst, orient) = scope_instance(d, s, home, opts);
+        p.edges += inst.precedence.len();
         let r = solve_group(
             &inst,
             Objective::Air,
@@ -481,7 +581,7 @@ fn blocks_of(d: &Drawing, sc: &[Vec<usize>]) -> Vec<(usize, usize, bool)> {
             Some(b) if layer(b.0) == layer(k) => b.1 = k + 1,
             _ => {
                 let l = layer(k);
-                out.push((k, k + 1, l != 0 && !d.layers[l].inkscape));
+                out.push((k, k + 1, semantics::is_plain_group(d, l)));
             }
         }
     }
@@ -489,10 +589,15 @@ fn blocks_of(d: &Drawing, sc: &[Vec<usize>]) -> Vec<(usize, usize, bool)> {
 }
 
 /// The scopes in a new order in which every run of consecutive free blocks is put in the order
-/// of least travel between them ([`blocks::order`], on the entries and exits the blocks had in
-/// `pass`), from the exit of the block before the run (or the origin) to the entry of the block
-/// after it; `None` when no order changes.
-fn free_block_order(d: &Drawing, sc: &[Vec<usize>], pass: &Pass) -> Option<Vec<usize>> {
+/// of least travel between them ([`blocks::order_until`], on the entries and exits the blocks
+/// had in `pass`), from the exit of the block before the run (or the origin) to the entry of
+/// the block after it; `None` when no order changes.
+fn free_block_order(
+    d: &Drawing,
+    sc: &[Vec<usize>],
+    pass: &Pass,
+    deadline: Option<Instant>,
+) -> Option<Vec<usize>> {
     let bl = blocks_of(d, sc);
     let mut order: Vec<usize> = Vec::with_capacity(sc.len());
     let mut changed = false;
@@ -515,7 +620,7 @@ fn free_block_order(d: &Drawing, sc: &[Vec<usize>], pass: &Pass) -> Option<Vec<u
             .iter()
             .map(|b| (pass.ends[b.0].0, pass.ends[b.1 - 1].1))
             .collect();
-        let o = blocks::order(start, &ends, finish);
+        let o = blocks::order_until(start, &ends, finish, deadline);
         changed |= o.iter().enumerate().any(|(k, &b)| k != b);
         for b in o {
             order.extend(run[b].0..run[b].1);
@@ -525,65 +630,159 @@ fn free_block_order(d: &Drawing, sc: &[Vec<usize>], pass: &Pass) -> Option<Vec<u
     changed.then_some(order)
 }
 
+/// Plain top-level groups of reading `r` are blocks in a free order ([`Options::free_groups`];
+/// only with scopes in layers, not in cut mode, whose containment order crosses layers).
+fn reorders(opts: &Options, r: Reading, sc: &[Vec<usize>]) -> bool {
+    opts.free_groups
+        && r.blocks == Blocks::Group
+        && r.pens != Pens::None
+        && !opts.cut
+        && sc.len() > 1
+}
+
+/// The strokes of the free blocks of `sc` (they are solved twice).
+fn free_strokes(d: &Drawing, sc: &[Vec<usize>]) -> usize {
+    blocks_of(d, sc)
+        .iter()
+        .filter(|b| b.2)
+        .map(|b| sc[b.0..b.1].iter().map(Vec::len).sum::<usize>())
+        .sum()
+}
+
+/// Seconds of the time limit kept for writing and verifying: 2 % of the limit plus the larger
+/// of twice the time already spent (reading: the check reads the output again) and 6 µs per
+/// stroke and 0.5 µs per point (the output has one element per stroke, so it can take longer
+/// to read back than the input: one path of 300 000 sub-paths is 300 000 paths written).
+fn reserve_s(d: &Drawing, allowance: &Allowance) -> f64 {
+    let Some(t) = allowance.time_limit else {
+        return 0.0;
+    };
+    let spent = allowance.started.elapsed().as_secs_f64();
+    let points: usize = d.strokes.iter().map(|s| s.points.len()).sum();
+    let size = 6e-6 * d.strokes.len() as f64 + 0.5e-6 * points as f64;
+    0.02 * t + size.max(2.0 * spent)
+}
+
+/// One reading solved: its scopes in their order; with free blocks, again in the order of
+/// least travel between blocks, kept when shorter in all. Returns the pass and whether the
+/// blocks were reordered.
+fn solve_reading(
+    d: &Drawing,
+    opts: &Options,
+    r: Reading,
+    sc: &[Vec<usize>],
+    allowance: &Allowance,
+    shares: &mut Shares,
+    deadline: Option<Instant>,
+) -> Result<(Pass, bool)> {
+    let key = layer_label(d);
+    let figures = |s: &[Stroke]| pen_up(s, d.mm_per_unit, &key);
+    // inner first: the containment order inside each scope, as cut mode has it
+    let inner = Options {
+        cut: opts.cut || r.inner_first,
+        ..opts.clone()
+    };
+    let opts_in = &inner;
+    let best = solve_pass(d, sc, opts_in, allowance, shares)?;
+    if !reorders(opts, r, sc) {
+        return Ok((best, false));
+    }
+    let Some(order) = free_block_order(d, sc, &best, deadline) else {
+        return Ok((best, false));
+    };
+    let sc2: Vec<Vec<usize>> = order.iter().map(|&k| sc[k].clone()).collect();
+    let p = solve_pass(d, &sc2, opts_in, allowance, shares)?;
+    let (a, b) = (figures(&best.strokes), figures(&p.strokes));
+    Ok(if b.pen_up_total_mm < a.pen_up_total_mm {
+        let solve_s = best.solve_s + p.solve_s;
+        (Pass { solve_s, ..p }, true)
+    } else {
+        let solve_s = best.solve_s + p.solve_s;
+        (Pass { solve_s, ..best }, false)
+    })
+}
+
 /// Sequences each scope with a registry solver through the steps the G-code pipeline uses:
 /// the scope's share of the command's [`Allowance`], [`solve_group`] (air-travel objective,
 /// start at the previous scope's exit, the first at the origin; the file's order kept unless
 /// the solver's is shorter). With [`Options::free_groups`], plain top-level groups are then
 /// put in the order of least travel between them and solved again in that order; that result
-/// is kept only when its pen-up travel in all is shorter. [`render`] then writes and verifies
-/// the result.
+/// is kept only when its pen-up travel in all is shorter. Each reading of the pens and blocks
+/// ([`semantics::readings`]) is solved so, and the one with the least pen-up travel is kept.
+/// [`render`] then writes and verifies the result.
+///
+/// The allowance's time limit covers the whole command from `allowance.started`: a reserve
+/// ([`reserve_s`]) is kept for writing and verifying, the solver and block ordering stop at
+/// it, and a scope left without time keeps the file's order.
 pub fn optimize_within(d: &Drawing, opts: &Options, allowance: &Allowance) -> Result<Optimized> {
-    let mut sc = scopes(d, opts.scopes);
-    if opts.cut && sc.len() > 1 {
-        sc = inner_scopes_first(d, sc, opts.contain_tol);
+    let (pens, blocks) = given(opts);
+    let (readings, why) = semantics::readings(d, pens, blocks);
+    // readings with the same scopes as an earlier one are not solved again
+    let mut plans: Vec<(Reading, Vec<Vec<usize>>)> = Vec::new();
+    for r in readings {
+        let sc = reading_scopes(d, opts, r);
+        if r.inner_first {
+            let all: Vec<usize> = sc.iter().flatten().copied().collect();
+            let inside = containment(d, &all, opts.contain_tol);
+            if !semantics::parts_apart(&sc, &inside, d.strokes.len()) {
+                continue;
+            }
+        }
+        if !plans.iter().any(|p| p.1 == sc && !r.inner_first) {
+            plans.push((r, sc));
+        }
     }
-    // block order is free only with scopes (one layer's scopes contiguous) and without cut
-    // mode (whose containment order between scopes crosses layers)
-    let reorder = opts.free_groups && opts.scopes && !opts.cut && sc.len() > 1;
-    let free_strokes: usize = if reorder {
-        blocks_of(d, &sc)
-            .iter()
-            .filter(|b| b.2)
-            .map(|b| sc[b.0..b.1].iter().map(Vec::len).sum::<usize>())
-            .sum()
-    } else {
-        0
-    };
-    let total = d.strokes.len().max(1) + free_strokes;
-    // keep time for writing and verifying: both linear in the drawing
+    let total: usize = plans
+        .iter()
+        .map(|(r, sc)| {
+            let free = if reorders(opts, *r, sc) {
+                free_strokes(d, sc)
+            } else {
+                0
+            };
+            d.strokes.len().max(1) + free
+        })
+        .sum();
+    let reserve_s = reserve_s(d, allowance);
+    let deadline = allowance.time_limit.map(|t| {
+        let left = (t - reserve_s).max(0.0);
+        allowance.started + Duration::try_from_secs_f64(left).unwrap_or(Duration::MAX / 4)
+    });
     let mut shares = Shares {
         left: total,
         total,
-        reserve_s: 0.02 * allowance.time_limit.unwrap_or(0.0),
+        reserve_s,
     };
     let key = layer_label(d);
     let figures = |s: &[Stroke]| pen_up(s, d.mm_per_unit, &key);
-    let mut best = solve_pass(d, &sc, opts, allowance, &mut shares)?;
-    let mut groups_reordered = false;
-    if reorder && let Some(order) = free_block_order(d, &sc, &best) {
-        let sc2: Vec<Vec<usize>> = order.iter().map(|&k| sc[k].clone()).collect();
-        let p = solve_pass(d, &sc2, opts, allowance, &mut shares)?;
-        let (a, b) = (figures(&best.strokes), figures(&p.strokes));
-        if b.pen_up_total_mm < a.pen_up_total_mm {
-            best = Pass {
-                solve_s: best.solve_s + p.solve_s,
-                ..p
-            };
-            groups_reordered = true;
-        } else {
-            best.solve_s += p.solve_s;
+    // (reading, its scopes, its pass, blocks reordered, pen-up in all)
+    type Solved = (Reading, Vec<Vec<usize>>, Pass, bool, f64);
+    let mut best: Option<Solved> = None;
+    let mut tried = Vec::new();
+    let mut solve_s = 0.0;
+    for (r, sc) in plans {
+        let (pass, reordered) = solve_reading(d, opts, r, &sc, allowance, &mut shares, deadline)?;
+        solve_s += pass.solve_s;
+        let up = figures(&pass.strokes).pen_up_total_mm;
+        tried.push((r, up));
+        if best.as_ref().is_none_or(|b| up < b.4) {
+            best = Some((r, sc, pass, reordered, up));
         }
     }
+    let (reading, sc, best, groups_reordered, _) = best.expect("at least one reading");
     Ok(Optimized {
         before: figures(&d.strokes),
         after: figures(&best.strokes),
         strokes: best.strokes,
-        solve_s: best.solve_s,
+        solve_s,
         scopes: sc.len(),
         edges: best.edges,
         kept_original: best.kept,
         groups_reordered,
         note: None,
+        reading,
+        semantics: why,
+        tried,
     })
 }
 

@@ -13,7 +13,8 @@ pub mod read;
 use cellseq::error::{Error, Result};
 use std::fmt::Write as _;
 
-pub use crate::drawing::{Drawing, Layer, PenUp, Stroke, Style, dist, num, pen_up};
+pub use crate::drawing::{Drawing, Kept, Layer, PenUp, Stroke, Style, Wrap, dist, num, pen_up};
+use std::sync::Arc;
 
 pub use read::{ReadOptions, read};
 
@@ -69,18 +70,15 @@ pub fn write(d: &Drawing, strokes: &[Stroke]) -> String {
         o.push_str("<g transform=\"scale(1,-1)\">\n");
     }
     // kept elements go first into their layer's first group, in document order
-    let mut kept_of: Vec<Vec<&str>> = vec![Vec::new(); d.layers.len()];
+    let mut kept_of: Vec<Vec<&Kept>> = vec![Vec::new(); d.layers.len()];
     for k in &d.kept {
-        kept_of[k.layer.min(d.layers.len() - 1)].push(&k.xml);
+        kept_of[k.layer.min(d.layers.len() - 1)].push(k);
     }
     let mut opened = vec![false; d.layers.len()];
-    let mut open_layer = |o: &mut String, layer: usize, kept_of: &mut Vec<Vec<&str>>| {
+    let mut open_layer = |o: &mut String, layer: usize, kept_of: &mut Vec<Vec<&Kept>>| {
         open_group(o, &d.layers[layer], layer == 0, opened[layer]);
         opened[layer] = true;
-        for x in std::mem::take(&mut kept_of[layer]) {
-            o.push_str(x);
-            o.push('\n');
-        }
+        write_kept(o, &std::mem::take(&mut kept_of[layer]));
     };
     let mut cur: Option<usize> = None;
     for s in strokes {
@@ -133,6 +131,67 @@ pub fn write(d: &Drawing, strokes: &[Stroke]) -> String {
     o
 }
 
+/// Most wrapper groups a layer's kept elements get written in separately, each element in
+/// its own; beyond, neighbours share them.
+const SEPARATE_WRAPPERS_MAX: usize = 100_000;
+
+/// Writes kept elements in document order, each inside one `<g>` per ancestor carrying that
+/// ancestor's attributes. Up to [`SEPARATE_WRAPPERS_MAX`] wrappers in all, each element has
+/// its own; beyond, neighbours with common ancestors share their wrappers, so the text is
+/// linear in the file however deep the groups are nested.
+fn write_kept(o: &mut String, items: &[&Kept]) {
+    let wrappers: usize = items
+        .iter()
+        .map(|k| k.wrap.as_ref().map_or(0, |w| w.depth))
+        .sum();
+    if wrappers <= SEPARATE_WRAPPERS_MAX {
+        // each element on its own line in its own wrappers (the usual case)
+        for k in items {
+            o.push_str(&k.wrapped());
+            o.push('\n');
+        }
+        return;
+    }
+    // the wrappers open now, outermost first
+    let mut open: Vec<&Arc<Wrap>> = Vec::new();
+    for k in items {
+        // the element's ancestors not yet open, innermost first
+        let mut fresh: Vec<&Arc<Wrap>> = Vec::new();
+        let mut at = k.wrap.as_ref();
+        while let Some(w) = at.filter(|w| w.depth > open.len()) {
+            fresh.push(w);
+            at = w.parent.as_ref();
+        }
+        // close open wrappers until the top is the element's ancestor at that depth
+        while let Some(top) = open.last() {
+            match at {
+                Some(w) if Arc::ptr_eq(w, top) => break,
+                _ => {
+                    open.pop();
+                    o.push_str("</g>");
+                    if let Some(w) = at.filter(|w| w.depth > open.len()) {
+                        fresh.push(w);
+                        at = w.parent.as_ref();
+                    }
+                }
+            }
+        }
+        for w in fresh.into_iter().rev() {
+            o.push_str("<g");
+            o.push_str(&w.attrs);
+            o.push('>');
+            open.push(w);
+        }
+        o.push_str(&k.xml);
+    }
+    for _ in open {
+        o.push_str("</g>");
+    }
+    if !items.is_empty() {
+        o.push('\n');
+    }
+}
+
 /// Opens the group of a layer as the original has it: an Inkscape layer with its label, a
 /// plain group with its id (the root's own elements in an unnamed group). The id is written
 /// only on the layer's first group, so ids stay unique when a layer's strokes are split
@@ -173,15 +232,19 @@ fn seg_keys(d: &Drawing, strokes: &[Stroke], intern: &mut Interner, round: bool)
         }
     };
     let mut v = Vec::new();
+    // the interned key of each (layer, style) met, so that each is built once
+    let mut ids: std::collections::HashMap<(usize, usize), u32> = Default::default();
     for s in strokes {
-        let st = &d.styles[s.style];
-        let k = (
-            d.layers[s.layer].label.clone(),
-            st.stroke.clone(),
-            num(st.width).parse::<f64>().unwrap_or(st.width).to_bits(),
-        );
-        let next = intern.len() as u32;
-        let id = *intern.entry(k).or_insert(next);
+        let id = *ids.entry((s.layer, s.style)).or_insert_with(|| {
+            let st = &d.styles[s.style];
+            let k = (
+                d.layers[s.layer].label.clone(),
+                st.stroke.clone(),
+                num(st.width).parse::<f64>().unwrap_or(st.width).to_bits(),
+            );
+            let next = intern.len() as u32;
+            *intern.entry(k).or_insert(next)
+        });
         for (a, b) in s.segments() {
             let (a, b) = ([r(a[0]), r(a[1])], [r(b[0]), r(b[1])]);
             let (a, b) = if (a[0], a[1]) <= (b[0], b[1]) {
@@ -202,6 +265,42 @@ fn seg_keys(d: &Drawing, strokes: &[Stroke], intern: &mut Interner, round: bool)
     }
     v.sort_unstable();
     v
+}
+
+/// Chains of wrapper groups ([`Wrap`]) as numbers: two chains get the same number when they
+/// have the same attributes all the way up (0: no group). Each node is numbered once, so
+/// comparing the kept elements of two drawings is linear however deep their groups are.
+#[derive(Default)]
+struct Chains {
+    ids: std::collections::HashMap<(u32, String), u32>,
+    seen: std::collections::HashMap<usize, u32>,
+}
+
+impl Chains {
+    /// The number of a group with attributes `attrs` inside the chain numbered `parent`.
+    fn intern(&mut self, parent: u32, attrs: &str) -> u32 {
+        let next = self.ids.len() as u32 + 1;
+        *self.ids.entry((parent, attrs.to_string())).or_insert(next)
+    }
+    /// The number of the chain ending at `w`, inside the chain numbered `base`.
+    fn id(&mut self, w: Option<&Arc<Wrap>>, base: u32) -> u32 {
+        let mut todo: Vec<&Wrap> = Vec::new();
+        let mut at = w.map(|a| &**a);
+        let mut id = base;
+        while let Some(x) = at {
+            if let Some(&i) = self.seen.get(&(x as *const Wrap as usize)) {
+                id = i;
+                break;
+            }
+            todo.push(x);
+            at = x.parent.as_deref();
+        }
+        for x in todo.into_iter().rev() {
+            id = self.intern(id, &x.attrs);
+            self.seen.insert(x as *const Wrap as usize, id);
+        }
+        id
+    }
 }
 
 /// Checks that `written` (an SVG text) draws the same multiset of segments as `orig`
@@ -231,15 +330,26 @@ pub fn verify(orig: &Drawing, written_name: &str, written: &str) -> Result<usize
     fn label(d: &Drawing, l: usize) -> &str {
         d.layers.get(l).map_or("", |x| x.label.as_str())
     }
-    let mut ka: Vec<(&str, String)> = orig
+    let mut chains = Chains::default();
+    let layer_group = chains.intern(0, "");
+    let mut ka: Vec<(&str, u32, &str)> = orig
         .kept
         .iter()
-        .map(|k| (label(orig, k.layer), format!("<g>{}</g>", k.xml)))
+        .map(|k| {
+            let c = chains.id(k.wrap.as_ref(), layer_group);
+            (label(orig, k.layer), c, k.xml.as_str())
+        })
         .collect();
-    let mut kb: Vec<(&str, String)> = w
+    let mut kb: Vec<(&str, u32, &str)> = w
         .kept
         .iter()
-        .map(|k| (label(&w, k.layer), k.xml.clone()))
+        .map(|k| {
+            (
+                label(&w, k.layer),
+                chains.id(k.wrap.as_ref(), 0),
+                k.xml.as_str(),
+            )
+        })
         .collect();
     ka.sort_unstable();
     kb.sort_unstable();

@@ -9,10 +9,12 @@
 //! points is capped ([`ReadOptions::max_points`]).
 
 use super::{Drawing, Layer, Stroke, Style};
-use crate::drawing::Kept;
+use crate::drawing::{Kept, Wrap};
 use cellseq::error::{Error, Result};
 use kurbo::{Affine, BezPath, PathEl, Point, Shape};
 use roxmltree::{Document, Node, ParsingOptions};
+use std::collections::HashMap;
+use std::sync::Arc;
 use svgtypes::{SimplePathSegment, SimplifyingPathParser};
 
 const SVG_NS: &str = "http://www.w3.org/2000/svg";
@@ -56,6 +58,9 @@ struct Ctx<'a> {
     opts: ReadOptions,
     out: Drawing,
     points: usize,
+    /// Index of each distinct style in `out.styles` (colour, width bits): a file may have a
+    /// style per element, so the lookup is hashed, not a scan.
+    styles: HashMap<(String, u64), usize>,
 }
 
 /// Inherited presentation state.
@@ -67,10 +72,28 @@ struct Inherit {
     layer: usize,
     /// `stroke-linecap` is round or square: zero-length subpaths are drawn as dots.
     caps: bool,
+    /// The innermost group below the root, for elements kept as they are.
+    wrap: Option<Arc<Wrap>>,
 }
 
 /// Parses an SVG document into strokes.
 pub fn read(file: &str, text: &str, opts: ReadOptions) -> Result<Drawing> {
+    read_with(file, text, opts, None)
+}
+
+/// [`read`] with the flattening tolerance given in millimetres (`opts.tolerance` is then
+/// ignored): the document is parsed once, its unit found on its root, and the tolerance
+/// converted to user units before any curve is flattened.
+pub fn read_mm(file: &str, text: &str, tolerance_mm: f64, opts: ReadOptions) -> Result<Drawing> {
+    read_with(file, text, opts, Some(tolerance_mm))
+}
+
+fn read_with(
+    file: &str,
+    text: &str,
+    mut opts: ReadOptions,
+    tolerance_mm: Option<f64>,
+) -> Result<Drawing> {
     if !(opts.tolerance > 0.0 && opts.tolerance.is_finite()) {
         return Err(Error::invalid(
             file,
@@ -115,6 +138,9 @@ pub fn read(file: &str, text: &str, opts: ReadOptions) -> Result<Drawing> {
         }
     }
     let mm_per_unit = mm_per_unit(root);
+    if let Some(t) = tolerance_mm {
+        opts.tolerance = t / mm_per_unit;
+    }
     let namespaces = root
         .namespaces()
         .filter_map(|ns| ns.name().map(|p| (p.to_string(), ns.uri().to_string())))
@@ -123,6 +149,7 @@ pub fn read(file: &str, text: &str, opts: ReadOptions) -> Result<Drawing> {
         file,
         text,
         points: 0,
+        styles: HashMap::new(),
         doc: &lines,
         opts,
         out: Drawing {
@@ -139,6 +166,7 @@ pub fn read(file: &str, text: &str, opts: ReadOptions) -> Result<Drawing> {
             skipped: Vec::new(),
             warnings: Vec::new(),
             flip_y: false,
+            generator: generator(text, root),
             kept: Vec::new(),
             namespaces,
             arcs: Default::default(),
@@ -150,6 +178,7 @@ pub fn read(file: &str, text: &str, opts: ReadOptions) -> Result<Drawing> {
         width: 1.0,
         layer: 0,
         caps: false,
+        wrap: None,
     };
     let inh = presentation(&ctx, root, &inh)?;
     walk(&mut ctx, root, inh)?;
@@ -166,6 +195,16 @@ pub fn read(file: &str, text: &str, opts: ReadOptions) -> Result<Drawing> {
         ));
     }
     Ok(ctx.out)
+}
+
+/// The program that wrote the file, from what it leaves in it: boxes.py's comment and
+/// metadata ("Created with Boxes.py"), Inkscape's `inkscape:version` on the root.
+fn generator(text: &str, root: Node) -> Option<String> {
+    if text.contains("Created with Boxes.py") || text.contains("boxes.hackerspace-bamberg.de") {
+        return Some("boxes.py".into());
+    }
+    root.attribute((INKSCAPE_NS, "version"))
+        .map(|_| "Inkscape".to_string())
 }
 
 /// Byte offsets of line starts, for line numbers in O(log n).
@@ -187,10 +226,13 @@ fn mm_per_unit(root: Node) -> f64 {
             .filter(|s| !s.is_empty())
             .filter_map(|s| s.parse().ok())
             .collect();
-        (p.len() == 4 && p[2] > 0.0).then_some(p[2])
+        // `filter`, not `then_some(p[2])`: the index must not be evaluated on fewer numbers
+        Some(p)
+            .filter(|p| p.len() == 4 && p[2] > 0.0 && p[2].is_finite())
+            .map(|p| p[2])
     });
     match (width_mm, vb_w) {
-        (Some(w), Some(vb)) if w > 0.0 => w / vb,
+        (Some(w), Some(vb)) if w > 0.0 && (w / vb).is_normal() => w / vb,
         _ => 25.4 / 96.0,
     }
 }
@@ -334,6 +376,7 @@ fn visit(ctx: &mut Ctx, n: Node, inh: &Inherit) -> Result<Option<Inherit>> {
         }
         "g" | "a" => {
             let mut inh = presentation(ctx, n, inh)?;
+            inh.wrap = Some(Wrap::new(wrap_attrs(ctx, n), inh.wrap.take()));
             // an Inkscape layer, or any group that is a child of the root (the layers
             // plotter tools such as vpype read); the writer keeps them as they are
             let inkscape = n.attribute((INKSCAPE_NS, "groupmode")) == Some("layer");
@@ -370,42 +413,35 @@ fn visit(ctx: &mut Ctx, n: Node, inh: &Inherit) -> Result<Option<Inherit>> {
     }
 }
 
-/// Keeps an element that is not sequenced, verbatim, with its ancestors' attributes; or,
-/// with `skip_unsupported`, drops it and says so.
+/// Keeps an element that is not sequenced, verbatim, with its ancestors' attributes (shared
+/// with its siblings: [`Wrap`]); or, with `skip_unsupported`, drops it and says so.
 fn keep(ctx: &mut Ctx, n: Node, inh: &Inherit, what: &str) {
     let line = line_of(ctx.doc, n);
     if ctx.opts.skip_unsupported {
         ctx.out.skipped.push(format!("line {line}: {what}"));
         return;
     }
-    let mut chain: Vec<Node> = n
-        .ancestors()
-        .skip(1)
-        .filter(|a| a.is_element() && a.parent_element().is_some())
-        .collect();
-    chain.reverse();
-    let mut xml = String::new();
-    for a in &chain {
-        xml.push_str("<g");
-        for at in a.attributes() {
-            let qn = &ctx.text[at.range_qname()];
-            if qn == "id" || qn.starts_with("xmlns") || at.namespace() == Some(INKSCAPE_NS) {
-                continue;
-            }
-            xml.push(' ');
-            xml.push_str(&ctx.text[at.range()]);
-        }
-        xml.push('>');
-    }
-    xml.push_str(&ctx.text[n.range()]);
-    for _ in &chain {
-        xml.push_str("</g>");
-    }
     ctx.out.kept.push(Kept {
         layer: inh.layer,
         line,
-        xml,
+        xml: ctx.text[n.range()].to_string(),
+        wrap: inh.wrap.clone(),
     });
+}
+
+/// The attributes of a group that a kept element's wrapper carries: all but `id`, namespace
+/// declarations and Inkscape's own, as the source writes them.
+fn wrap_attrs(ctx: &Ctx, n: Node) -> String {
+    let mut s = String::new();
+    for at in n.attributes() {
+        let qn = &ctx.text[at.range_qname()];
+        if qn == "id" || qn.starts_with("xmlns") || at.namespace() == Some(INKSCAPE_NS) {
+            continue;
+        }
+        s.push(' ');
+        s.push_str(&ctx.text[at.range()]);
+    }
+    s
 }
 
 fn points_attr(ctx: &Ctx, n: Node) -> Result<Vec<Point>> {
@@ -563,6 +599,22 @@ fn shape(ctx: &Ctx, n: Node) -> Result<BezPath> {
     Ok(p)
 }
 
+/// The index of the style (`stroke`, `width`) in the drawing, added when new.
+fn style_index(ctx: &mut Ctx, stroke: &str, width: f64) -> usize {
+    // + 0.0: -0 and 0 are one width, as `==` has them
+    let key = (stroke.to_string(), (width + 0.0).to_bits());
+    if let Some(&i) = ctx.styles.get(&key) {
+        return i;
+    }
+    ctx.out.styles.push(Style {
+        stroke: key.0.clone(),
+        width,
+    });
+    let i = ctx.out.styles.len() - 1;
+    ctx.styles.insert(key, i);
+    i
+}
+
 /// Flattens a path (after the transform) and appends one stroke per subpath. Zero-length
 /// subpaths are drawn only with round or square caps; returns false when the element draws
 /// nothing at all (it is then kept as it is).
@@ -634,10 +686,7 @@ fn emit(ctx: &mut Ctx, path: &BezPath, inh: &Inherit, line: usize) -> Result<boo
             ),
         ));
     }
-    let style = ctx.out.style_index(Style {
-        stroke: inh.stroke.clone(),
-        width,
-    });
+    let style = style_index(ctx, &inh.stroke, width);
     let before = ctx.out.strokes.len();
     for (pts, closed) in strokes {
         let s = Stroke::new(pts, closed, inh.layer, style, line);

@@ -21,6 +21,7 @@ use crate::engine::neighbours::Neighbours;
 use crate::error::Result;
 use crate::model::{Objective, Visit};
 use std::collections::VecDeque;
+use std::time::{Duration, Instant};
 
 /// Registry entry.
 pub static INFO: SolverInfo = SolverInfo {
@@ -90,7 +91,7 @@ impl Solver for Drawing {
         while limited && !ctx.exhausted() {
             p.kick(ctx, &mut rng, self.kick_len);
         }
-        p.polish(ctx);
+        p.polish(ctx, deadline);
         let out = outcome_of(m, p.t);
         ctx.report(out.cost);
         Ok(out)
@@ -497,15 +498,21 @@ impl<'m> Path<'m> {
     /// every place, in every mode) until a sweep finds nothing, on drawings of at most
     /// [`POLISH_MAX`] strokes, at most [`POLISH_SWEEPS`] sweeps. It runs after the budget (a
     /// sweep is O(n²) cheap evaluations, milliseconds at the cap) and depends on nothing but
-    /// the path, so results stay deterministic.
-    fn polish(&mut self, ctx: &mut Context) {
+    /// the path, so results stay deterministic; under a time limit it stops at `deadline`
+    /// (the clock read once per row of pairs).
+    fn polish(&mut self, ctx: &mut Context, deadline: Option<Instant>) {
         let n = self.t.len();
         if n > POLISH_MAX {
             return;
         }
+        let past = || deadline.is_some_and(|d| Instant::now() >= d);
         for _ in 0..POLISH_SWEEPS {
             let mut improved = false;
             for i in 0..n {
+                if past() {
+                    self.log.clear();
+                    return;
+                }
                 for j in i + 1..n {
                     if self.reverse_gain(i, j) > EPS {
                         self.reverse(i, j);
@@ -515,6 +522,10 @@ impl<'m> Path<'m> {
             }
             ctx.count((n * n / 2) as u64);
             for p in 0..n {
+                if past() {
+                    self.log.clear();
+                    return;
+                }
                 let v = self.t[p];
                 let (prev, next) = (
                     p.checked_sub(1).map(|k| self.t[k]),
