@@ -8,7 +8,6 @@
 
 use cellseq::prelude::*;
 use std::path::Path;
-use std::time::Duration;
 
 fn main() -> Result<()> {
     let args: Vec<String> = std::env::args().skip(1).collect();

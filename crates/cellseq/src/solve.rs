@@ -38,9 +38,7 @@ pub use crate::context::{Budget, NoObserver, Observer, Progress, Trace};
 /// Largest instance (cells) for which [`Solve::lower_bound`] computes a bound after solving.
 pub const BOUND_MAX_CELLS: usize = 200_000;
 
-/// Longest time limit accepted, in seconds (about 11.5 days): longer ones are refused rather
-/// than overflowing a clock.
-pub const MAX_SECONDS: f64 = 1.0e6;
+pub use crate::params::MAX_SECONDS;
 
 impl Budget {
     /// A wall-clock budget of `seconds`; refused unless `0 < seconds ≤` [`MAX_SECONDS`].
