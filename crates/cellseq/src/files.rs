@@ -34,7 +34,7 @@
 use crate::error::{Error, Result};
 use std::fs::{File, OpenOptions};
 use std::io::{self, Write};
-use std::path::{Path, PathBuf};
+use std::path::{Component, Path, PathBuf};
 use std::sync::{Mutex, Once};
 
 /// Reads a whole file as UTF-8 text.
@@ -404,23 +404,54 @@ pub fn same_file(a: &Path, b: &Path) -> bool {
 
 /// Refuses an output directory whose own name is a symbolic link (its parents may be links):
 /// results appended to a directory a link leads to could land anywhere the link was pointed,
-/// so the directory must be named as it is.
+/// so the directory must be named as it is. Every spelling counts: `LINK`, `LINK/`, `LINK/.`,
+/// `LINK//`, `./LINK/.`, and a `..` that climbs out of a link (`LINK/..`, `LINK/sub/..`,
+/// whose directory is reached through the link). The path is read component by component,
+/// without following the last one (`symlink_metadata` follows a path that ends in `/`).
 pub fn ensure_not_link_dir(dir: &Path) -> Result<()> {
-    match std::fs::symlink_metadata(dir) {
-        Ok(m) if m.file_type().is_symlink() => {
-            let to = std::fs::read_link(dir)
-                .map(|t| t.display().to_string())
-                .unwrap_or_else(|_| "?".into());
-            Err(Error::invalid(
-                dir.display().to_string(),
-                format!(
-                    "is a symbolic link (to {to}); cellseq writes results only into a directory \
-                     named as it is: give the directory itself with --out, or remove the link"
-                ),
-            ))
+    let refuse = |link: &Path| {
+        let to = std::fs::read_link(link)
+            .map(|t| t.display().to_string())
+            .unwrap_or_else(|_| "?".into());
+        Err(Error::invalid(
+            dir.display().to_string(),
+            format!(
+                "{}is a symbolic link (to {to}); cellseq writes results only into a directory \
+                 named as it is: give the directory itself with --out, or remove the link",
+                if link == dir {
+                    String::new()
+                } else {
+                    format!("names a directory through {}, which ", link.display())
+                }
+            ),
+        ))
+    };
+    let is_link = |p: &Path| std::fs::symlink_metadata(p).is_ok_and(|m| m.file_type().is_symlink());
+    // `components` drops `.` and trailing slashes; `..` pops the component it climbs out of,
+    // and climbing out of a link is refused (the kernel would climb out of its target)
+    let mut named = PathBuf::new();
+    let mut depth = 0usize;
+    for c in dir.components() {
+        match c {
+            Component::ParentDir if depth > 0 => {
+                if is_link(&named) {
+                    return refuse(&named);
+                }
+                named.pop();
+                depth -= 1;
+            }
+            Component::ParentDir => named.push(".."),
+            Component::Normal(_) => {
+                named.push(c);
+                depth += 1;
+            }
+            other => named.push(other),
         }
-        _ => Ok(()),
     }
+    if depth > 0 && is_link(&named) {
+        return refuse(&named);
+    }
+    Ok(())
 }
 
 #[cfg(all(test, unix))]
@@ -708,5 +739,43 @@ mod tests {
         assert!(ensure_not_input(&a, &d.path().join("b.ngc"), false).is_ok());
         std::fs::write(d.path().join("c.ngc"), b"G0 X0\n").unwrap();
         assert!(ensure_not_input(&a, &d.path().join("c.ngc"), false).is_ok());
+    }
+
+    #[test]
+    fn a_link_directory_is_refused_in_every_spelling() {
+        let d = tempfile::tempdir().unwrap();
+        let target = d.path().join("target");
+        std::fs::create_dir_all(target.join("sub")).unwrap();
+        let link = d.path().join("link");
+        symlink(&target, &link).unwrap();
+        let l = link.display().to_string();
+        for form in [
+            l.clone(),
+            format!("{l}/"),
+            format!("{l}/."),
+            format!("{l}//"),
+            format!("{l}/./"),
+            format!("{l}/./."),
+            format!("{l}/sub/.."),
+            format!("{l}/.."),
+            format!("{l}/../target"),
+            format!("{}/./link/", d.path().display()),
+        ] {
+            let e = ensure_not_link_dir(Path::new(&form))
+                .map(|_| "accepted".to_string())
+                .unwrap_or_else(|e| e.to_string());
+            assert!(e.contains("symbolic link"), "{form}: {e}");
+        }
+        // the directory itself, links among the parents, a new name, `..` out of a real one
+        for ok in [
+            target.clone(),
+            link.join("sub"),
+            link.join("sub/"),
+            link.join("new"),
+            target.join("sub/.."),
+            d.path().join("nothing/here/."),
+        ] {
+            assert!(ensure_not_link_dir(&ok).is_ok(), "{}", ok.display());
+        }
     }
 }
