@@ -1,8 +1,8 @@
 //! `info`, `validate`, `solve`, `eval`, `solvers`, `generate`.
 
 use anyhow::{Context as _, Result, bail};
+use cellseq::formats;
 use cellseq::formats::json;
-use cellseq::formats::{self, best_known};
 use cellseq::model::{Instance, Objective};
 use cellseq::params::parse_kv;
 use cellseq::registry::{self, DEFAULT_SOLVER};
@@ -39,10 +39,10 @@ pub struct SolveArgs {
     /// Wall-clock limit of the solver in seconds. Reading the file and the lower bound after
     /// the solve are not counted, so solvers are compared at equal search time (`optimize`'s
     /// limit, by contrast, covers its whole command).
-    #[arg(long, value_name = "SECONDS")]
+    #[arg(long, value_name = "SECONDS", value_parser = super::ranges::time_limit)]
     pub time_limit: Option<f64>,
     /// Evaluation budget (deterministic runs): an integer, `200_000_000` or `2e8`.
-    #[arg(long, value_name = "N", value_parser = super::parse_count)]
+    #[arg(long, value_name = "N", value_parser = super::ranges::max_evals)]
     pub max_evals: Option<u64>,
     /// Objective: time (default), air, or matrix.
     #[arg(long)]
@@ -105,6 +105,15 @@ pub struct GenerateArgs {
 /// Loads an instance, with the file named in any error.
 pub fn load(path: &Path) -> Result<Instance> {
     Ok(formats::load_instance(path)?)
+}
+
+/// The best-known value and proof flag from a `bks.csv` beside `file`; a row whose value is
+/// not a finite number ≥ 0 is ignored with a warning naming `bks.csv` and its line.
+pub fn best_known(file: &Path) -> Option<(f64, bool)> {
+    formats::best_known_checked(file).unwrap_or_else(|e| {
+        eprintln!("warning: {e}; the best-known value is ignored");
+        None
+    })
 }
 
 /// Parses an objective name, or the instance's default.
@@ -191,14 +200,7 @@ pub fn solve(a: SolveArgs) -> Result<()> {
         .seed(a.seed)
         .lower_bound(!a.no_bound);
     if let Some(t) = a.time_limit {
-        solve = solve.time_limit(cellseq::solve::checked_seconds("--time-limit", t).map_err(
-            |_| {
-                anyhow::anyhow!(
-                    "--time-limit must be a positive number of seconds (at most {:e}), got {t}",
-                    cellseq::solve::MAX_SECONDS
-                )
-            },
-        )?);
+        solve = solve.time_limit(cellseq::solve::checked_seconds("--time-limit", t)?);
     }
     if let Some(n) = a.max_evals {
         solve = solve.max_evals(n);

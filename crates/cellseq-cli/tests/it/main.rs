@@ -37,6 +37,7 @@ mod pcgtsp;
 mod plot;
 mod portfolio;
 mod props;
+mod ranges;
 mod reader_regressions;
 mod records;
 mod report_outputs;
