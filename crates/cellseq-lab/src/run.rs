@@ -138,16 +138,19 @@ fn checked_best_known(p: &Path) -> Option<(f64, bool)> {
     })
 }
 
+/// How much less `x` is than `base`, in percent; none when not finite.
 fn pct_less(base: Option<f64>, x: Option<f64>) -> Option<f64> {
     match (base, x) {
-        (Some(b), Some(x)) if b.abs() > 0.0 => Some(100.0 * (b - x) / b),
+        (Some(b), Some(x)) if b.abs() > 0.0 => Some(100.0 * (b - x) / b).filter(|v| v.is_finite()),
         _ => None,
     }
 }
 
+/// The gap of `x` above `reference` in percent; none when not finite (a best-known value of
+/// 1e-320 would make it infinite).
 fn gap(x: Option<f64>, reference: Option<f64>) -> Option<f64> {
     match (x, reference) {
-        (Some(x), Some(r)) if r.abs() > 0.0 => Some(100.0 * (x - r) / r),
+        (Some(x), Some(r)) if r.abs() > 0.0 => Some(100.0 * (x - r) / r).filter(|v| v.is_finite()),
         _ => None,
     }
 }

@@ -37,16 +37,80 @@ use std::io::{self, Write};
 use std::path::{Component, Path, PathBuf};
 use std::sync::{Mutex, Once};
 
-/// Reads a whole file as UTF-8 text.
+/// Largest input file read: 4 GiB (a matrix file of the default 20 000-node limit holds about
+/// 2 GB of text). A longer input (an endless pipe, `/dev/zero`) is refused, naming the file,
+/// once this much has been read.
+pub const MAX_INPUT_BYTES: u64 = 1 << 32;
+
+/// Reads a whole file as UTF-8 text: refused, naming the file, when it is longer than
+/// [`MAX_INPUT_BYTES`], holds a NUL byte (no text format here has one; the line is named, and
+/// reading stops there, so `/dev/zero` is refused at once) or is not UTF-8.
 pub fn read_text(path: &Path) -> Result<String> {
     let file = path.display().to_string();
-    let bytes = std::fs::read(path).map_err(|e| Error::io(&file, e))?;
+    let bytes = read_capped(path, true)?;
     String::from_utf8(bytes).map_err(|e| {
         Error::invalid(
             &file,
             format!("not UTF-8 text (byte {})", e.utf8_error().valid_up_to()),
         )
     })
+}
+
+/// Reads a whole file as bytes (a DXF may be binary): refused, naming the file, when it is
+/// longer than [`MAX_INPUT_BYTES`].
+pub fn read_bytes(path: &Path) -> Result<Vec<u8>> {
+    read_capped(path, false)
+}
+
+/// Reads `path` in chunks up to [`MAX_INPUT_BYTES`] (a regular file longer than that is
+/// refused before reading); with `text`, stops at the first NUL byte; without, refuses an
+/// input that starts with one (no format read here does: a link to `/dev/zero`).
+fn read_capped(path: &Path, text: bool) -> Result<Vec<u8>> {
+    use std::io::Read;
+    let file = path.display().to_string();
+    let mut f = File::open(path).map_err(|e| Error::io(&file, e))?;
+    let too_long = || {
+        Error::invalid(
+            &file,
+            format!("longer than {MAX_INPUT_BYTES} bytes, the most an input may hold"),
+        )
+    };
+    let size = f.metadata().ok().filter(|m| m.is_file()).map(|m| m.len());
+    if size.is_some_and(|s| s > MAX_INPUT_BYTES) {
+        return Err(too_long());
+    }
+    let mut out = Vec::with_capacity(size.unwrap_or(0) as usize);
+    let mut chunk = vec![0u8; 1 << 20];
+    loop {
+        let n = match f.read(&mut chunk) {
+            Ok(0) => return Ok(out),
+            Ok(n) => n,
+            Err(e) if e.kind() == io::ErrorKind::Interrupted => continue,
+            Err(e) => return Err(Error::io(&file, e)),
+        };
+        if text && let Some(at) = chunk[..n].iter().position(|&b| b == 0) {
+            out.extend_from_slice(&chunk[..at]);
+            let line = out.iter().filter(|&&b| b == b'\n').count() + 1;
+            return Err(Error::parse(
+                &file,
+                line,
+                format!(
+                    "a NUL byte at byte {}: not a text file",
+                    out.len() as u64 + 1
+                ),
+            ));
+        }
+        if !text && out.is_empty() && chunk[0] == 0 {
+            return Err(Error::invalid(
+                &file,
+                "starts with a NUL byte: not a drawing or program",
+            ));
+        }
+        if out.len() as u64 + n as u64 > MAX_INPUT_BYTES {
+            return Err(too_long());
+        }
+        out.extend_from_slice(&chunk[..n]);
+    }
 }
 
 /// Writes a whole file safely: through an exclusively created temporary sibling with a random

@@ -238,8 +238,12 @@ pub fn solve(a: SolveArgs) -> Result<()> {
     Ok(())
 }
 
+/// The gap to the best-known value in percent; none without one, or when it is not finite
+/// (a best-known value of 1e-320 would make it infinite).
 fn gap(cost: f64, bk: Option<f64>) -> Option<f64> {
-    bk.filter(|&b| b > 0.0).map(|b| 100.0 * (cost - b) / b)
+    bk.filter(|&b| b > 0.0)
+        .map(|b| 100.0 * (cost - b) / b)
+        .filter(|g| g.is_finite())
 }
 
 fn print_report(inst: &Instance, r: &Solved, bk: Option<f64>) {
@@ -257,11 +261,7 @@ fn print_report(inst: &Instance, r: &Solved, bk: Option<f64>) {
         say!("machining time  {:.3} s", rep.machining_time);
     }
     if let Some(b) = bk {
-        say!(
-            "best known      {}  (gap {:.3} %)",
-            fmt_num(b),
-            gap(rep.cost, Some(b)).unwrap_or(0.0)
-        );
+        say_best_known(b, rep.cost);
     }
     if r.proven_optimal {
         say!("proven optimal  yes");
@@ -275,6 +275,14 @@ fn print_report(inst: &Instance, r: &Solved, bk: Option<f64>) {
     say!("feasible        yes (independent checker)");
     say!("evaluations     {}", r.evaluations);
     say!("elapsed         {:.3} s", r.elapsed_s);
+}
+
+/// The best-known line: the value, and the gap when it is defined (not for a best known of 0).
+fn say_best_known(b: f64, cost: f64) {
+    match gap(cost, Some(b)) {
+        Some(g) => say!("best known      {}  (gap {g:.3} %)", fmt_num(b)),
+        None => say!("best known      {}", fmt_num(b)),
+    }
 }
 
 fn fmt_num(x: f64) -> String {
@@ -311,11 +319,7 @@ pub fn eval(a: EvalArgs) -> Result<()> {
             say!("machining time  {:.3} s", rep.machining_time);
         }
         if let Some(b) = bk {
-            say!(
-                "best known      {}  (gap {:.3} %)",
-                fmt_num(b),
-                gap(rep.cost, Some(b)).unwrap_or(0.0)
-            );
+            say_best_known(b, rep.cost);
         }
     }
     Ok(())

@@ -253,7 +253,7 @@ fn optimize_svg(a: &OptimizeArgs) -> anyhow::Result<()> {
 
 fn read_dxf(path: &Path, d: &DrawingArgs) -> anyhow::Result<svg::Drawing> {
     let file = path.display().to_string();
-    let bytes = std::fs::read(path).with_context(|| format!("reading {file}"))?;
+    let bytes = cellseq::files::read_bytes(path)?;
     let units = match &d.units {
         Some(u) => Some(
             cellseq_programs::dxf::unit_mm(u)

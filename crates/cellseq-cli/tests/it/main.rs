@@ -31,6 +31,7 @@ mod generated_suite;
 mod generators;
 mod golden;
 mod harness;
+mod hostile;
 mod insertion;
 mod keep_out;
 mod pcgtsp;

@@ -110,6 +110,9 @@ pub fn best_known(path: &Path) -> Option<(f64, bool)> {
     best_known_checked(path).ok().flatten()
 }
 
+/// Largest `bks.csv` read (64 MiB; the shipped ones hold a few KB).
+pub const MAX_BKS_BYTES: u64 = 64 << 20;
+
 /// [`best_known`], with an error naming `bks.csv` and the line when the instance's row holds
 /// a value that is not a finite number ≥ 0 (`NaN`, `inf`, `-3`, `x`): such a value would
 /// print as a gap of NaN %. No file, no readable header or no row for the instance: `Ok(None)`.
@@ -118,6 +121,15 @@ pub fn best_known_checked(path: &Path) -> Result<Option<(f64, bool)>> {
         return Ok(None);
     };
     let bks = dir.join("bks.csv");
+    let Ok(meta) = std::fs::metadata(&bks) else {
+        return Ok(None);
+    };
+    if !meta.is_file() || meta.len() > MAX_BKS_BYTES {
+        return Err(Error::invalid(
+            bks.display().to_string(),
+            format!("not a regular file of at most {MAX_BKS_BYTES} bytes"),
+        ));
+    }
     let Ok(mut rdr) = csv::Reader::from_path(&bks) else {
         return Ok(None);
     };

@@ -284,7 +284,10 @@ pub fn check(p: &Params) -> Result<u64> {
     }
     let lib = ToolLibrary::load(p.word("tools"))?;
     if ngroups * nholes > 0 && lib.drills().next().is_none() {
-        return bad("hole groups need drills in the tool library".into());
+        return bad(format!(
+            "hole groups need drills in the tool library '{}'",
+            p.word("tools")
+        ));
     }
     Ok(cells)
 }

@@ -997,6 +997,7 @@ fn assemble(mut b: Builder, lib: &ToolLibrary, name: String, comment: String) ->
 /// Generates a panel: geometry (grid, outer contour, pockets, ribs and flange, holes), tool
 /// selection of pocket roughing, precedence, assembly.
 pub fn generate(p: &Params, seed: u64) -> Result<Instance> {
+    check(p)?;
     let s = Settings::read(p)?;
     let lib = ToolLibrary::load(p.word("tools"))?;
     build(s, lib, seed)
@@ -1006,7 +1007,14 @@ pub fn generate(p: &Params, seed: u64) -> Result<Instance> {
 /// library); about how many cells the panel will have, at most.
 pub fn check(p: &Params) -> Result<u64> {
     let s = Settings::read(p)?;
-    ToolLibrary::load(p.word("tools"))?;
+    let lib = ToolLibrary::load(p.word("tools"))?;
+    if s.holes > 0 && lib.drill_for(s.hole_diameter).is_none() {
+        return bad(format!(
+            "holes need a drill of at most hole_diameter = {} mm in the tool library '{}'",
+            s.hole_diameter,
+            p.word("tools")
+        ));
+    }
     let pockets = (s.rows * s.cols) as f64;
     let layers = s.dmax / s.ap + 6.0;
     let grid = 2.0 * ((s.rows + 1) * (s.cols + 1)) as f64;
