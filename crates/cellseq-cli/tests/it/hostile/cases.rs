@@ -5,7 +5,9 @@
 //! Categories: numbers at the type limits, NaN and infinities, truncation at a section (or a
 //! random byte), non-UTF-8 bytes, byte-order marks (UTF-8, UTF-16), NUL bytes, deep nesting
 //! (JSON and TOML 10⁵ deep, SVG groups), XML entity bombs and external entities, DXF INSERT
-//! cycles and huge INSERT arrays, seeded mutations (byte flips, duplicated, deleted and
+//! cycles and huge INSERT arrays, hostile values of the fields a reader computes with (a
+//! viewBox of fewer than four numbers, a NaN bulge, a negative radius, a spline of degree 400,
+//! G92 and incremental moves of 10^300), seeded mutations (byte flips, duplicated, deleted and
 //! swapped lines, repeated chunks), empty and blank files, one very long line or number, CR
 //! and CRLF line ends, and special files (a link to `/dev/zero`, a directory).
 
@@ -206,7 +208,104 @@ const LIMITS: &[&str] = &[
     "5e-324",
     "1e-320",
     "0.000000000000000000000000000001",
+    // 1e308 and -1e300 spelled out, for readers (G-code) where an exponent is a word of its own
+    concat!("1", "000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000"),
+    "-1000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
 ];
+
+/// Hostile values of the fields a reader interprets, per kind: a viewBox of fewer than four
+/// numbers, a zero scale, a NaN bulge, a negative radius, a spline of degree 400, a dwell of
+/// 10^300 s, a zero-radius arc, a peck of 0 (the places where a reader computes, not just
+/// parses). Each is inserted where the file has such a field, or appended in the file's
+/// syntax.
+fn fields(kind: Kind, b: &[u8], rng: &mut ChaCha8Rng) -> Vec<u8> {
+    let text = String::from_utf8_lossy(b).into_owned();
+    let pick = |v: &[&str], rng: &mut ChaCha8Rng| v[rng.random_range(0..v.len())].to_string();
+    match kind {
+        Kind::Svg => {
+            let attr = pick(
+                &[
+                    "viewBox=\"\"",
+                    "viewBox=\"none\"",
+                    "viewBox=\"0 0\"",
+                    "viewBox=\"0 0 0 0\"",
+                    "viewBox=\"0 0 -1 -1\"",
+                    "viewBox=\"nan nan nan nan\"",
+                    "width=\"0\" height=\"1e308mm\"",
+                    "transform=\"scale(1e308)\"",
+                    "transform=\"scale(0)\"",
+                    "transform=\"matrix(0 0 0 0 0 0)\"",
+                    "transform=\"rotate(nan)\"",
+                ],
+                rng,
+            );
+            let shape = pick(
+                &[
+                    "<path d=\"M0 0 A0 0 0 1 1 10 10\"/>",
+                    "<path d=\"M0 0 A1e308 1e308 0 1 1 10 10\"/>",
+                    "<circle cx=\"0\" cy=\"0\" r=\"-5\"/>",
+                    "<rect x=\"0\" y=\"0\" width=\"-1\" height=\"1e308\" rx=\"nan\"/>",
+                    "<polyline points=\"0,0 1e308,1e308 -1e308,0\"/>",
+                    "<path d=\"M0 0 C 1e308 0 0 1e308 1 1 Z\"/>",
+                ],
+                rng,
+            );
+            let with_attr = text.replacen("<svg", &format!("<svg {attr}"), 1);
+            match with_attr.rfind("</svg>") {
+                Some(i) if rng.random_bool(0.5) => {
+                    format!("{}{shape}{}", &with_attr[..i], &with_attr[i..]).into_bytes()
+                }
+                _ => with_attr.into_bytes(),
+            }
+        }
+        Kind::Dxf => {
+            let entity = pick(
+                &[
+                    "  0\nLWPOLYLINE\n  8\n0\n 90\n2\n 70\n0\n 10\n0\n 20\n0\n 42\nnan\n 10\n10\n 20\n0\n",
+                    "  0\nLWPOLYLINE\n  8\n0\n 90\n2\n 70\n1\n 10\n0\n 20\n0\n 42\n1e308\n 10\n10\n 20\n0\n",
+                    "  0\nCIRCLE\n  8\n0\n 10\n0\n 20\n0\n 40\n-5\n",
+                    "  0\nCIRCLE\n  8\n0\n 10\n0\n 20\n0\n 40\n1e300\n",
+                    "  0\nARC\n  8\n0\n 10\n0\n 20\n0\n 40\n5\n 50\nnan\n 51\n90\n",
+                    "  0\nELLIPSE\n  8\n0\n 10\n0\n 20\n0\n 11\n0\n 21\n0\n 40\n0\n 41\n0\n 42\n6.28\n",
+                    "  0\nSPLINE\n  8\n0\n 71\n400\n 72\n2\n 40\n0\n 40\n1\n 73\n2\n 10\n0\n 20\n0\n 10\n1\n 20\n1\n",
+                    "  0\nLWPOLYLINE\n  8\n0\n 90\n4000000000\n 70\n0\n 10\n0\n 20\n0\n",
+                ],
+                rng,
+            );
+            match text.find("ENTITIES\n") {
+                Some(i) => format!("{}{entity}{}", &text[..i + 9], &text[i + 9..]).into_bytes(),
+                None => format!("  0\nSECTION\n  2\nENTITIES\n{entity}  0\nENDSEC\n  0\nEOF\n")
+                    .into_bytes(),
+            }
+        }
+        Kind::Gcode => {
+            let line = pick(
+                &[
+                    "G92 X1000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000\n",
+                    "G91\nG1 X100000000000000000000000000000000000000000000000000 F100\nG1 X100000000000000000000000000000000000000000000000000\nG90\n",
+                    "G1 Z-1 F0\n",
+                    "G4 P1000000000000000000000000000000000000000000000000000000000000\n",
+                    "G2 X10 Y0 I0 J0 F100\n",
+                    "G2 X0 Y0 R0 F100\n",
+                    "G83 X5 Y5 Z-10 R2 Q0 F100\nG80\n",
+                    "G73 X5 Y5 Z-10 R2 Q-1 F100\nG80\n",
+                    "G81 X5 Y5 Z-1000000000000000000000000000000 R2 F100\nG80\n",
+                    "S100000000000000000000000000000000000000000000 M3\n",
+                    "G1 X0.000000000000000000000000000000000000000001 F100\n",
+                    "N99999999999999999999999 G0 X1\n",
+                ],
+                rng,
+            );
+            let lines: Vec<&str> = text.split_inclusive('\n').collect();
+            let at = rng.random_range(0..=lines.len());
+            let mut out = lines[..at].concat();
+            out.push_str(&line);
+            out.push_str(&lines[at..].concat());
+            out.into_bytes()
+        }
+        _ => replace_numbers(b, LIMITS, rng),
+    }
+}
 
 /// Non-finite spellings.
 const NON_FINITE: &[&str] = &[
@@ -531,6 +630,7 @@ fn apply(
 ) -> Option<(Vec<u8>, Option<&'static str>)> {
     let bytes = match category {
         "limits" => replace_numbers(b, LIMITS, rng),
+        "fields" => fields(kind, b, rng),
         "nonfinite" => replace_numbers(b, NON_FINITE, rng),
         "truncate" => truncate(b, kind, rng),
         "nonutf8" => {
