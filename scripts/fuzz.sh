@@ -13,7 +13,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 secs=${1:-120}
 shift || true
-all=(sop pcglns pcgtsp json_instance json_solution gcode svg dxf plan)
+all=(sop pcglns pcgtsp json_instance json_solution gcode svg dxf plan optimize_gcode optimize_drawing)
 targets=("$@")
 [ ${#targets[@]} -eq 0 ] && targets=("${all[@]}")
 parallel=${FUZZ_PARALLEL:-1}
@@ -37,6 +37,16 @@ seed gcode "tests/fixtures fuzz/seeds" '\.(ngc|nc|gcode|gco|tap)$'
 seed svg "tests/fixtures fuzz/seeds" '\.svg$'
 seed dxf "tests/fixtures fuzz/seeds" '\.dxf$'
 seed plan "experiments fuzz/seeds" '\.toml$'
+seed optimize_gcode "tests/fixtures fuzz/seeds" '\.(ngc|nc|gcode|gco|tap)$'
+# the drawing target's first byte chooses the reader: even SVG, odd DXF
+mkdir -p fuzz/corpus/optimize_drawing
+for f in tests/fixtures/svg/*.svg; do
+  { printf '\000'; cat "$f"; } >"fuzz/corpus/optimize_drawing/seed-svg-$(basename "$f")"
+done
+for f in fuzz/seeds/dxf/*.dxf; do
+  { printf '\001'; cat "$f"; } >"fuzz/corpus/optimize_drawing/seed-dxf-$(basename "$f")"
+  { printf '\003'; cat "$f"; } >"fuzz/corpus/optimize_drawing/seed-dxf-gcode-$(basename "$f")"
+done
 
 # Build through `fuzz run` itself: `fuzz build` passes other profile settings than `fuzz run`,
 # so building with it first made every run recompile the crate.

@@ -18,3 +18,17 @@ pub fn parse_validate_solve(data: &[u8], format: Format) {
         panic!("validated instance, but greedy fails: {e}");
     }
 }
+
+/// The time limit the pipeline targets give `optimize` (seconds).
+pub const LIMIT_S: f64 = 0.5;
+
+/// How far past [`LIMIT_S`] a pipeline target may end (libFuzzer's own `-timeout` is the
+/// hang guard; this catches a limit that is not kept).
+pub const MARGIN_S: f64 = 2.0;
+
+/// Occurrences of non-finite words (`NaN`, `inf`, `Infinity`) in `text`.
+pub fn non_finite(text: &str) -> usize {
+    text.split(|c: char| !(c.is_ascii_alphanumeric() || c == '_'))
+        .filter(|w| matches!(*w, "NaN" | "nan" | "inf" | "Inf" | "INF" | "Infinity" | "infinity"))
+        .count()
+}

@@ -41,11 +41,12 @@ pub fn estimate(
     let trials = usize::try_from(plan.trial_count()).unwrap_or(usize::MAX);
     let shards = shards.max(1);
     let b = &plan.file.budget;
-    let mut limit: Option<f64> = b.seconds;
-    if let Some(u) = b.calibration_units {
-        let s = u * calibration()?;
-        limit = Some(limit.map_or(s, |l| l.min(s)));
-    }
+    let calib = match b.calibration_units {
+        Some(_) => calibration()?,
+        None => 0.0,
+    };
+    let limit =
+        super::plan::trial_seconds(b, calib).map_err(|e| cellseq::Error::invalid(&plan.path, e))?;
     Ok(Estimate {
         trials,
         shards,
@@ -54,6 +55,12 @@ pub fn estimate(
         trial_seconds: limit,
     })
 }
+
+/// A year in seconds (365.25 days).
+const YEAR_S: f64 = 365.25 * 86400.0;
+
+/// Above this many seconds per shard the estimate gives years and no SLURM time: a year.
+const LONGEST_SHARD_S: f64 = YEAR_S;
 
 /// A SLURM `--time` (`D-HH:MM:SS` or `HH:MM:SS`) with room to spare: 1.5 × `seconds` plus
 /// 5 minutes for loading instances, checking the plan and writing results.
@@ -80,6 +87,14 @@ impl std::fmt::Display for Estimate {
             self.shards, self.per_shard, self.threads
         )?;
         match self.shard_seconds() {
+            Some(s) if s > LONGEST_SHARD_S => write!(
+                f,
+                "; each trial stops at its budget of {:.3} s, so a shard needs up to about {:.0} \
+                 years: more than a year, so split the plan into more shards, or shorten the \
+                 budget",
+                self.trial_seconds.unwrap_or(0.0),
+                s / YEAR_S
+            ),
             Some(s) => write!(
                 f,
                 "; each trial stops at its budget of {:.3} s, so a shard needs at most about \
@@ -135,6 +150,33 @@ name = "ils"
         let plan = Plan::parse("p.toml", &calib, std::path::Path::new(".")).unwrap();
         let e = estimate(&plan, 12, 1, || Ok(0.02)).unwrap();
         assert_eq!(e.shard_seconds(), Some(2.0));
+    }
+
+    #[test]
+    fn shards_longer_than_a_year_are_told_in_years() {
+        let long = PLAN
+            .replace("seconds = 10", "seconds = 1e6")
+            .replace("replicates = 2", "replicates = 200");
+        let plan = Plan::parse("p.toml", &long, std::path::Path::new(".")).unwrap();
+        let e = estimate(&plan, 1, 1, || unreachable!()).unwrap();
+        let text = e.to_string();
+        assert!(
+            text.contains("years") && !text.contains("suggested"),
+            "{text}"
+        );
+        // 1200 trials of 10^6 s on one thread: 1.2e9 s, about 38 years
+        assert!(text.contains("about 38 years"), "{text}");
+    }
+
+    #[test]
+    fn calibration_units_that_overflow_a_clock_are_refused() {
+        let calib = PLAN.replace("seconds = 10", "calibration_units = 1e9");
+        let plan = Plan::parse("p.toml", &calib, std::path::Path::new(".")).unwrap();
+        let e = estimate(&plan, 1, 1, || Ok(0.02)).unwrap_err().to_string();
+        assert!(
+            e.starts_with("p.toml") && e.contains("calibration_units"),
+            "{e}"
+        );
     }
 
     #[test]

@@ -18,7 +18,7 @@ use cellseq::SolverKind;
 use cellseq::error::{Error, Result};
 use cellseq::generate::KINDS;
 use cellseq::model::Objective;
-use cellseq::params::Params;
+use cellseq::params::{FloatRange, IntRange, ParamKind, ParamSpec, Params};
 use cellseq::registry as solvers;
 use serde::Deserialize;
 use std::collections::{BTreeMap, BTreeSet};
@@ -26,6 +26,94 @@ use std::path::{Path, PathBuf};
 
 /// Default cap on the trials of a plan (plan key `max_trials`, flag `--max-trials`).
 pub const DEFAULT_MAX_TRIALS: u64 = 100_000;
+
+/// What `max_trials` (and `--max-trials`, `--shards`) may be: a plan's trials are listed in
+/// memory, about 0.6 KB each with their result rows, so 10⁷ trials take about 6 GB.
+pub const MAX_TRIALS: IntRange = IntRange::new(1, 10_000_000);
+
+/// What `max_files` (and `--max-files`) may be: directory entries one pattern may visit.
+pub const MAX_FILES: IntRange = IntRange::new(1, 100_000_000);
+
+/// What `budget.seconds` may be: a time limit in seconds ([`cellseq::solve::MAX_SECONDS`]).
+pub const SECONDS: FloatRange = FloatRange::above(0.0, cellseq::solve::MAX_SECONDS);
+
+/// What `budget.calibration_units` may be; times the machine's calibration it must also be
+/// a time limit in [`SECONDS`].
+pub const CALIBRATION_UNITS: FloatRange = FloatRange::above(0.0, 1e9);
+
+/// What `budget.evaluations` may be.
+pub const EVALUATIONS: IntRange = IntRange::new(1, u64::MAX);
+
+/// What `replicates` may be (the trial cap bounds it too).
+pub const REPLICATES: IntRange = IntRange::new(1, u32::MAX as u64);
+
+/// What a `[max_cells]` entry may be: cells of the largest instance the solver runs on.
+pub const MAX_CELLS: IntRange = IntRange::new(1, u32::MAX as u64);
+
+/// The numbers a plan holds with their ranges (for `cellseq limits` and docs/bad-input.md);
+/// solver and generator parameters have their own declared ranges.
+pub static NUMBERS: &[ParamSpec] = &[
+    ParamSpec {
+        name: "budget.seconds",
+        default: "",
+        kind: ParamKind::Float(SECONDS),
+        help: "wall-clock seconds per trial; longer limits (over 11 days) are refused rather than overflowing a clock",
+    },
+    ParamSpec {
+        name: "budget.evaluations",
+        default: "",
+        kind: ParamKind::Int(EVALUATIONS),
+        help: "evaluations per trial (deterministic)",
+    },
+    ParamSpec {
+        name: "budget.calibration_units",
+        default: "",
+        kind: ParamKind::Float(CALIBRATION_UNITS),
+        help: "multiples of this machine's calibration kernel; the product must also lie in budget.seconds's range (checked by check and run on the machine)",
+    },
+    ParamSpec {
+        name: "replicates",
+        default: "1",
+        kind: ParamKind::Int(REPLICATES),
+        help: "runs per instance and solver configuration (the trial cap bounds it too)",
+    },
+    ParamSpec {
+        name: "seed",
+        default: "1",
+        kind: ParamKind::Int(IntRange::new(0, u64::MAX)),
+        help: "master seed of every trial seed",
+    },
+    ParamSpec {
+        name: "max_trials",
+        default: "100000",
+        kind: ParamKind::Int(MAX_TRIALS),
+        help: "trials the plan may have (also --max-trials); they are listed in memory, about 0.6 KB each",
+    },
+    ParamSpec {
+        name: "max_files",
+        default: "100000",
+        kind: ParamKind::Int(MAX_FILES),
+        help: "directory entries one file pattern may visit (also --max-files)",
+    },
+    ParamSpec {
+        name: "max_cells.SOLVER",
+        default: "",
+        kind: ParamKind::Int(MAX_CELLS),
+        help: "the solver runs only on instances of at most this many cells; its other trials are recorded as out of range",
+    },
+    ParamSpec {
+        name: "instances.seeds",
+        default: "1",
+        kind: ParamKind::Int(IntRange::new(0, u64::MAX)),
+        help: "generator seeds (a list; default [1])",
+    },
+    ParamSpec {
+        name: "paper.figures.value",
+        default: "",
+        kind: ParamKind::Text,
+        help: "a published figure printed beside ours: any finite number (NaN and inf are refused)",
+    },
+];
 
 /// Caps a plan must stay within. Each is taken from the command line when given there, else
 /// from the plan's own key, else the default.
@@ -71,6 +159,10 @@ pub struct PlanFile {
     /// Raises (or lowers) the cap on the directory entries one file pattern may visit.
     #[serde(default)]
     pub max_files: Option<u64>,
+    /// Per solver name: the largest instance (cells) it runs on; its trials on larger
+    /// instances are not run and are recorded as out of range (`[max_cells] exact = 16`).
+    #[serde(default)]
+    pub max_cells: BTreeMap<String, u64>,
 }
 
 fn one() -> u64 {
@@ -241,6 +333,8 @@ pub struct Trial {
 /// A validated, expanded plan.
 #[derive(Debug, Clone)]
 pub struct Plan {
+    /// The plan file as errors name it.
+    pub path: String,
     /// The file contents, parsed.
     pub file: PlanFile,
     /// The plan text (stored in the manifest).
@@ -352,22 +446,41 @@ fn params_suffix(p: &BTreeMap<String, String>) -> String {
         .join(",")
 }
 
-/// A budget sets at least one limit, and its limits in seconds are positive.
+/// A budget sets at least one limit, and each lies in its range ([`SECONDS`],
+/// [`CALIBRATION_UNITS`], [`EVALUATIONS`]).
 fn check_budget(b: &BudgetSpec) -> std::result::Result<(), String> {
     if b.seconds.is_none() && b.evaluations.is_none() && b.calibration_units.is_none() {
         return Err("budget: set seconds, evaluations or calibration_units".into());
     }
-    for (name, v) in [
-        ("seconds", b.seconds),
-        ("calibration_units", b.calibration_units),
-    ] {
-        if let Some(x) = v
-            && !(x.is_finite() && x > 0.0)
-        {
-            return Err(format!("budget.{name} must be a positive number, got {x}"));
-        }
+    if let Some(x) = b.seconds {
+        SECONDS.check("budget.seconds", x)?;
+    }
+    if let Some(x) = b.calibration_units {
+        CALIBRATION_UNITS.check("budget.calibration_units", x)?;
+    }
+    if let Some(x) = b.evaluations {
+        EVALUATIONS.check("budget.evaluations", x)?;
     }
     Ok(())
+}
+
+/// A trial's time limit in seconds under budget `b` on a machine whose calibration kernel
+/// takes `calib_s` seconds: `seconds`, or `calibration_units` × `calib_s`, whichever is
+/// shorter; an error when the product leaves (0, [`cellseq::solve::MAX_SECONDS`]].
+pub fn trial_seconds(b: &BudgetSpec, calib_s: f64) -> std::result::Result<Option<f64>, String> {
+    let mut limit = b.seconds;
+    if let Some(c) = b.calibration_units {
+        let s = SECONDS
+            .check(
+                &format!(
+                    "budget.calibration_units x this machine's calibration ({c} x {calib_s:.4} s)"
+                ),
+                c * calib_s,
+            )
+            .map_err(|e| format!("{e}; lower calibration_units"))?;
+        limit = Some(limit.map_or(s, |x: f64| x.min(s)));
+    }
+    Ok(limit)
 }
 
 /// The plan's instances in order (files matched by each pattern, or every generator parameter
@@ -446,6 +559,19 @@ fn file_instances(
     Ok(())
 }
 
+/// Generated instances of at most this many cells are generated and validated when the plan
+/// is read (by `check` as by `run`); larger ones have their parameters checked only.
+pub const BUILD_AT_CHECK: u64 = 1000;
+
+/// A grid point as errors name it: `n=60,tools=3`, or `default parameters`.
+pub fn grid_point(params: &BTreeMap<String, String>) -> String {
+    if params.is_empty() {
+        "default parameters".to_string()
+    } else {
+        params_suffix(params)
+    }
+}
+
 /// Generator `kind` at every parameter combination of the spec's grid × its seeds, appended to
 /// `out`.
 fn generated_instances(
@@ -468,7 +594,18 @@ fn generated_instances(
         return Err(bad(format!("{what}: empty seeds list")));
     }
     for params in expand_grid(file, what, &spec.grid, max_trials)? {
-        Params::new(kind, info.params, &params).map_err(|e| bad(format!("{what}: {e}")))?;
+        let point = format!("{what} (generator {kind}, {})", grid_point(&params));
+        Params::new(kind, info.params, &params).map_err(|e| bad(format!("{point}: {e}")))?;
+        // the parameters together, without generating; tiny instances are generated and
+        // validated too, so `check` refuses what `run` would fail on
+        let cells =
+            cellseq::generate::check(kind, &params).map_err(|e| bad(format!("{point}: {e}")))?;
+        if cells <= BUILD_AT_CHECK {
+            for &seed in &seeds {
+                cellseq::generate::generate(kind, &params, seed)
+                    .map_err(|e| bad(format!("{point}, seed {seed}: {e}")))?;
+            }
+        }
         for &seed in &seeds {
             let mut id = kind.clone();
             for (k, v) in &params {
@@ -550,9 +687,38 @@ fn plan_solvers(
     Ok(solvers_out)
 }
 
+/// Every `[max_cells]` entry names a solver of the plan and lies in [`MAX_CELLS`].
+fn check_max_cells(
+    m: &BTreeMap<String, u64>,
+    solvers: &[SolverRef],
+) -> std::result::Result<(), String> {
+    for (name, &v) in m {
+        if !solvers.iter().any(|s| &s.name == name) {
+            return Err(format!(
+                "max_cells.{name}: '{name}' is not a solver of the plan ({})",
+                solvers
+                    .iter()
+                    .map(|s| s.name.as_str())
+                    .collect::<BTreeSet<_>>()
+                    .into_iter()
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ));
+        }
+        MAX_CELLS.check(&format!("max_cells.{name}"), v)?;
+    }
+    Ok(())
+}
+
 /// Every paper figure names a known metric and, if any, a solver of the plan.
 fn check_paper(p: &Paper, solvers: &[SolverRef]) -> std::result::Result<(), String> {
     for f in &p.figures {
+        if !f.value.is_finite() {
+            return Err(format!(
+                "paper figure '{}': value must be a finite number, got {}",
+                f.label, f.value
+            ));
+        }
         if !FIGURE_METRICS.contains(&f.metric.as_str()) {
             return Err(format!(
                 "paper figure '{}': unknown metric '{}' (known: {})",
@@ -596,6 +762,22 @@ impl Plan {
         let pf: PlanFile = toml::from_str(text).map_err(|e| Error::invalid(file, e.to_string()))?;
         let bad = |m: String| Error::invalid(file, m);
         check_name(&pf.name).map_err(bad)?;
+        for (key, v) in [
+            ("max_trials", pf.max_trials),
+            ("--max-trials", limits.max_trials),
+        ] {
+            if let Some(v) = v {
+                MAX_TRIALS.check(key, v).map_err(bad)?;
+            }
+        }
+        for (key, v) in [
+            ("max_files", pf.max_files),
+            ("--max-files", limits.max_files),
+        ] {
+            if let Some(v) = v {
+                MAX_FILES.check(key, v).map_err(bad)?;
+            }
+        }
         let max_trials = limits
             .max_trials
             .or(pf.max_trials)
@@ -652,7 +834,9 @@ impl Plan {
                 trials.map_or_else(|| "too many".to_string(), |t| t.to_string()),
             )));
         }
+        check_max_cells(&pf.max_cells, &solvers_out).map_err(bad)?;
         Ok(Plan {
+            path: file.to_string(),
             hash: hex(stable_hash(&[text.as_bytes()])),
             text: text.to_string(),
             file: pf,
@@ -661,6 +845,12 @@ impl Plan {
             objective,
             reference,
         })
+    }
+
+    /// The largest instance (cells) solver `name` runs on, when the plan's `[max_cells]`
+    /// says.
+    pub fn max_cells(&self, name: &str) -> Option<u64> {
+        self.file.max_cells.get(name).copied()
     }
 
     /// The number of trials, counted without listing them (at most the plan's trial cap).

@@ -387,24 +387,35 @@ fn instances_section(md: &mut String, d: &Data) {
     let _ = writeln!(md);
 }
 
-/// Trials without a feasible result, once per (instance, solver).
+/// Trials without a feasible result, once per (instance, solver); trials not run because the
+/// instance lies beyond the solver's `[max_cells]` are listed apart, as out of range.
 fn failures_section(md: &mut String, d: &Data) {
-    let failed: Vec<&Row> = d.rows.iter().filter(|r| !r.feasible).collect();
-    if failed.is_empty() {
-        return;
-    }
-    let _ = writeln!(
-        md,
-        "## Trials without a feasible result ({})\n",
-        failed.len()
-    );
-    let mut seen = BTreeSet::new();
-    for r in &failed {
-        if seen.insert((r.instance.clone(), r.solver_id.clone())) {
-            let _ = writeln!(md, "- `{}` on `{}`: {}", r.solver_id, r.instance, r.error);
+    let beyond = |r: &&Row| r.error.starts_with(super::run::OUT_OF_RANGE);
+    let failed: Vec<&Row> = d
+        .rows
+        .iter()
+        .filter(|r| !r.feasible && !beyond(r))
+        .collect();
+    let skipped: Vec<&Row> = d.rows.iter().filter(|r| beyond(r)).collect();
+    for (rows, title) in [
+        (&failed, "Trials without a feasible result"),
+        (
+            &skipped,
+            "Trials not run: out of their solver's range (the plan's max_cells)",
+        ),
+    ] {
+        if rows.is_empty() {
+            continue;
         }
+        let _ = writeln!(md, "## {title} ({})\n", rows.len());
+        let mut seen = BTreeSet::new();
+        for r in rows {
+            if seen.insert((r.instance.clone(), r.solver_id.clone())) {
+                let _ = writeln!(md, "- `{}` on `{}`: {}", r.solver_id, r.instance, r.error);
+            }
+        }
+        let _ = writeln!(md);
     }
-    let _ = writeln!(md);
 }
 
 /// The table per instance and solver (`summary.csv`, `summary.tex`).

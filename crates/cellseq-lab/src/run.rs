@@ -7,7 +7,7 @@ use super::results::{
     Appender, InstanceRow, LayerRow, OutFiles, Row, TraceRow, read_lenient, write_table,
 };
 use cellseq::error::{Error, Result};
-use cellseq::formats::{best_known, load_instance};
+use cellseq::formats::load_instance;
 use cellseq::model::{Instance, Objective};
 use cellseq::{Budget, Solve, SolverKind, Trace};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -17,6 +17,14 @@ use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 use std::time::{Duration, Instant};
+
+/// Most worker threads a run may use: each holds a solver's memory, and more threads than
+/// cores only add memory (`--threads`).
+pub const MAX_THREADS: usize = 1024;
+
+/// The start of the `error` of a trial that was not run because the instance lies beyond the
+/// solver's `[max_cells]` (its row is not counted as a failure).
+pub const OUT_OF_RANGE: &str = "out of range:";
 
 /// How to run a plan.
 #[derive(Debug, Clone)]
@@ -47,6 +55,9 @@ pub struct RunSummary {
     pub ran: usize,
     /// Trials that ended infeasible or in an error.
     pub failed: usize,
+    /// Trials not run because the instance lies beyond the solver's `[max_cells]` (not
+    /// counted in `failed`).
+    pub out_of_range: usize,
     /// Files written.
     pub files: OutFiles,
 }
@@ -71,9 +82,19 @@ pub struct Prepared {
 pub fn prepare(plan: &Plan, idx: usize) -> Result<Prepared> {
     let r = &plan.instances[idx];
     let (instance, bks) = match &r.source {
-        Source::File(p) => (load_instance(p)?, best_known(p)),
+        Source::File(p) => (load_instance(p)?, checked_best_known(p)),
         Source::Generated { kind, params, seed } => {
-            (cellseq::generate::generate(kind, params, *seed)?, None)
+            let inst = cellseq::generate::generate(kind, params, *seed).map_err(|e| {
+                Error::invalid(
+                    &plan.path,
+                    format!(
+                        "instance {} (generator {kind}, {}, seed {seed}): {e}",
+                        r.id,
+                        super::plan::grid_point(params)
+                    ),
+                )
+            })?;
+            (inst, None)
         }
     };
     let objective = match plan.objective {
@@ -108,16 +129,28 @@ pub fn prepare(plan: &Plan, idx: usize) -> Result<Prepared> {
     })
 }
 
+/// The best-known value beside instance file `p`; a bad `bks.csv` row is ignored with a
+/// warning naming the file and line.
+fn checked_best_known(p: &Path) -> Option<(f64, bool)> {
+    cellseq::formats::best_known_checked(p).unwrap_or_else(|e| {
+        eprintln!("warning: {e}; the best-known value is ignored");
+        None
+    })
+}
+
+/// How much less `x` is than `base`, in percent; none when not finite.
 fn pct_less(base: Option<f64>, x: Option<f64>) -> Option<f64> {
     match (base, x) {
-        (Some(b), Some(x)) if b.abs() > 0.0 => Some(100.0 * (b - x) / b),
+        (Some(b), Some(x)) if b.abs() > 0.0 => Some(100.0 * (b - x) / b).filter(|v| v.is_finite()),
         _ => None,
     }
 }
 
+/// The gap of `x` above `reference` in percent; none when not finite (a best-known value of
+/// 1e-320 would make it infinite).
 fn gap(x: Option<f64>, reference: Option<f64>) -> Option<f64> {
     match (x, reference) {
-        (Some(x), Some(r)) if r.abs() > 0.0 => Some(100.0 * (x - r) / r),
+        (Some(x), Some(r)) if r.abs() > 0.0 => Some(100.0 * (x - r) / r).filter(|v| v.is_finite()),
         _ => None,
     }
 }
@@ -165,18 +198,23 @@ pub fn run_trial(plan: &Plan, prep: &Prepared, t: &Trial, calib_s: f64) -> Trial
     let sref = &plan.solvers[t.solver];
     let inst = &prep.instance;
     let b = &plan.file.budget;
-    let mut time_limit = b.seconds;
-    if let Some(c) = b.calibration_units {
-        let s = c * calib_s;
-        time_limit = Some(time_limit.map_or(s, |x: f64| x.min(s)));
-    }
+    // checked against the calibration when the run started (`run_plan`)
+    let time_limit = super::plan::trial_seconds(b, calib_s).unwrap_or(b.seconds);
     let budget = Budget {
         time_limit: time_limit.map(Duration::from_secs_f64),
         max_evals: b.evaluations,
     };
     let mut trace = Trace::default();
     let start = Instant::now();
+    let beyond = plan.max_cells(&sref.name).filter(|&m| inst.n() as u64 > m);
     let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        if let Some(m) = beyond {
+            return Err(cellseq::Error::Param(format!(
+                "{OUT_OF_RANGE} {} cells, more than the plan's max_cells.{} = {m}; not run",
+                inst.n(),
+                sref.name
+            )));
+        }
         sref.name.parse::<SolverKind>().and_then(|kind| {
             Solve::new(kind)
                 .params_text(&sref.params)
@@ -372,6 +410,7 @@ pub fn write_manifest(
         "trials_ran": summary.map(|s| s.ran),
         "trials_skipped": summary.map(|s| s.skipped),
         "trials_failed": summary.map(|s| s.failed),
+        "trials_out_of_range": summary.map(|s| s.out_of_range),
         "complete": summary.is_some(),
     });
     super::provenance::stamp(&mut m, &files.manifest, summary.is_some());
@@ -451,7 +490,8 @@ fn write_instance_table(
 }
 
 /// Runs `trials` in parallel (inside the caller's thread pool), appending each trial's traces,
-/// layer rows and result row as it completes. Returns the number of infeasible trials.
+/// layer rows and result row as it completes. Returns the numbers of infeasible trials and of
+/// trials out of their solver's range.
 fn run_trials(
     plan: &Plan,
     opts: &RunOptions,
@@ -459,7 +499,7 @@ fn run_trials(
     trials: &[Trial],
     prepared: &HashMap<usize, Prepared>,
     calib: f64,
-) -> Result<usize> {
+) -> Result<(usize, usize)> {
     let writer = Mutex::new((
         Appender::open::<Row>(&files.results)?,
         Appender::open::<TraceRow>(&files.traces)?,
@@ -477,10 +517,13 @@ fn run_trials(
         .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
     let failed = std::sync::atomic::AtomicUsize::new(0);
+    let out_of_range = std::sync::atomic::AtomicUsize::new(0);
     let res: Result<()> = trials.par_iter().try_for_each(|t| {
         let prep = &prepared[&t.instance];
         let (row, traces, layers) = run_trial(plan, prep, t, calib);
-        if !row.feasible {
+        if row.error.starts_with(OUT_OF_RANGE) {
+            out_of_range.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        } else if !row.feasible {
             failed.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
         }
         {
@@ -501,7 +544,7 @@ fn run_trials(
     bar.finish_and_clear();
     res?;
     drop(writer);
-    Ok(failed.into_inner())
+    Ok((failed.into_inner(), out_of_range.into_inner()))
 }
 
 /// Rewrites the tables in plan order (one row per trial), so that the files do not depend on
@@ -531,6 +574,13 @@ pub fn run_plan(plan: &Plan, opts: &RunOptions) -> Result<RunSummary> {
             "--shard {i}/{n}: expected I/N with 1 <= I <= N"
         )));
     }
+    if let Some(t) = opts.threads
+        && !(1..=MAX_THREADS).contains(&t)
+    {
+        return Err(Error::Param(format!(
+            "--threads must be a whole number in [1, {MAX_THREADS}], got {t}"
+        )));
+    }
     let out = &opts.out;
     cellseq::files::ensure_not_link_dir(out)?;
     std::fs::create_dir_all(out).map_err(|e| Error::io(out.display().to_string(), e))?;
@@ -539,8 +589,10 @@ pub fn run_plan(plan: &Plan, opts: &RunOptions) -> Result<RunSummary> {
     let threads = opts
         .threads
         .unwrap_or_else(rayon::current_num_threads)
-        .max(1);
+        .clamp(1, MAX_THREADS);
     let calib = calibrate()?;
+    super::plan::trial_seconds(&plan.file.budget, calib)
+        .map_err(|e| Error::invalid(&plan.path, e))?;
     write_manifest(plan, opts, &files, threads, calib, None)?;
 
     let mut trials = plan.trials();
@@ -567,13 +619,15 @@ pub fn run_plan(plan: &Plan, opts: &RunOptions) -> Result<RunSummary> {
             .collect::<Result<HashMap<_, _>>>()
     })?;
     write_instance_table(plan, &files, &prepared)?;
-    let failed = pool.install(|| run_trials(plan, opts, &files, &trials, &prepared, calib))?;
+    let (failed, out_of_range) =
+        pool.install(|| run_trials(plan, opts, &files, &trials, &prepared, calib))?;
     finalise(&files)?;
     let summary = RunSummary {
         planned,
         skipped,
         ran: trials.len(),
         failed,
+        out_of_range,
         files: files.clone(),
     };
     write_manifest(plan, opts, &files, threads, calib, Some(&summary))?;

@@ -34,19 +34,83 @@
 use crate::error::{Error, Result};
 use std::fs::{File, OpenOptions};
 use std::io::{self, Write};
-use std::path::{Path, PathBuf};
+use std::path::{Component, Path, PathBuf};
 use std::sync::{Mutex, Once};
 
-/// Reads a whole file as UTF-8 text.
+/// Largest input file read: 4 GiB (a matrix file of the default 20 000-node limit holds about
+/// 2 GB of text). A longer input (an endless pipe, `/dev/zero`) is refused, naming the file,
+/// once this much has been read.
+pub const MAX_INPUT_BYTES: u64 = 1 << 32;
+
+/// Reads a whole file as UTF-8 text: refused, naming the file, when it is longer than
+/// [`MAX_INPUT_BYTES`], holds a NUL byte (no text format here has one; the line is named, and
+/// reading stops there, so `/dev/zero` is refused at once) or is not UTF-8.
 pub fn read_text(path: &Path) -> Result<String> {
     let file = path.display().to_string();
-    let bytes = std::fs::read(path).map_err(|e| Error::io(&file, e))?;
+    let bytes = read_capped(path, true)?;
     String::from_utf8(bytes).map_err(|e| {
         Error::invalid(
             &file,
             format!("not UTF-8 text (byte {})", e.utf8_error().valid_up_to()),
         )
     })
+}
+
+/// Reads a whole file as bytes (a DXF may be binary): refused, naming the file, when it is
+/// longer than [`MAX_INPUT_BYTES`].
+pub fn read_bytes(path: &Path) -> Result<Vec<u8>> {
+    read_capped(path, false)
+}
+
+/// Reads `path` in chunks up to [`MAX_INPUT_BYTES`] (a regular file longer than that is
+/// refused before reading); with `text`, stops at the first NUL byte; without, refuses an
+/// input that starts with one (no format read here does: a link to `/dev/zero`).
+fn read_capped(path: &Path, text: bool) -> Result<Vec<u8>> {
+    use std::io::Read;
+    let file = path.display().to_string();
+    let mut f = File::open(path).map_err(|e| Error::io(&file, e))?;
+    let too_long = || {
+        Error::invalid(
+            &file,
+            format!("longer than {MAX_INPUT_BYTES} bytes, the most an input may hold"),
+        )
+    };
+    let size = f.metadata().ok().filter(|m| m.is_file()).map(|m| m.len());
+    if size.is_some_and(|s| s > MAX_INPUT_BYTES) {
+        return Err(too_long());
+    }
+    let mut out = Vec::with_capacity(size.unwrap_or(0) as usize);
+    let mut chunk = vec![0u8; 1 << 20];
+    loop {
+        let n = match f.read(&mut chunk) {
+            Ok(0) => return Ok(out),
+            Ok(n) => n,
+            Err(e) if e.kind() == io::ErrorKind::Interrupted => continue,
+            Err(e) => return Err(Error::io(&file, e)),
+        };
+        if text && let Some(at) = chunk[..n].iter().position(|&b| b == 0) {
+            out.extend_from_slice(&chunk[..at]);
+            let line = out.iter().filter(|&&b| b == b'\n').count() + 1;
+            return Err(Error::parse(
+                &file,
+                line,
+                format!(
+                    "a NUL byte at byte {}: not a text file",
+                    out.len() as u64 + 1
+                ),
+            ));
+        }
+        if !text && out.is_empty() && chunk[0] == 0 {
+            return Err(Error::invalid(
+                &file,
+                "starts with a NUL byte: not a drawing or program",
+            ));
+        }
+        if out.len() as u64 + n as u64 > MAX_INPUT_BYTES {
+            return Err(too_long());
+        }
+        out.extend_from_slice(&chunk[..n]);
+    }
 }
 
 /// Writes a whole file safely: through an exclusively created temporary sibling with a random
@@ -404,23 +468,54 @@ pub fn same_file(a: &Path, b: &Path) -> bool {
 
 /// Refuses an output directory whose own name is a symbolic link (its parents may be links):
 /// results appended to a directory a link leads to could land anywhere the link was pointed,
-/// so the directory must be named as it is.
+/// so the directory must be named as it is. Every spelling counts: `LINK`, `LINK/`, `LINK/.`,
+/// `LINK//`, `./LINK/.`, and a `..` that climbs out of a link (`LINK/..`, `LINK/sub/..`,
+/// whose directory is reached through the link). The path is read component by component,
+/// without following the last one (`symlink_metadata` follows a path that ends in `/`).
 pub fn ensure_not_link_dir(dir: &Path) -> Result<()> {
-    match std::fs::symlink_metadata(dir) {
-        Ok(m) if m.file_type().is_symlink() => {
-            let to = std::fs::read_link(dir)
-                .map(|t| t.display().to_string())
-                .unwrap_or_else(|_| "?".into());
-            Err(Error::invalid(
-                dir.display().to_string(),
-                format!(
-                    "is a symbolic link (to {to}); cellseq writes results only into a directory \
-                     named as it is: give the directory itself with --out, or remove the link"
-                ),
-            ))
+    let refuse = |link: &Path| {
+        let to = std::fs::read_link(link)
+            .map(|t| t.display().to_string())
+            .unwrap_or_else(|_| "?".into());
+        Err(Error::invalid(
+            dir.display().to_string(),
+            format!(
+                "{}is a symbolic link (to {to}); cellseq writes results only into a directory \
+                 named as it is: give the directory itself with --out, or remove the link",
+                if link == dir {
+                    String::new()
+                } else {
+                    format!("names a directory through {}, which ", link.display())
+                }
+            ),
+        ))
+    };
+    let is_link = |p: &Path| std::fs::symlink_metadata(p).is_ok_and(|m| m.file_type().is_symlink());
+    // `components` drops `.` and trailing slashes; `..` pops the component it climbs out of,
+    // and climbing out of a link is refused (the kernel would climb out of its target)
+    let mut named = PathBuf::new();
+    let mut depth = 0usize;
+    for c in dir.components() {
+        match c {
+            Component::ParentDir if depth > 0 => {
+                if is_link(&named) {
+                    return refuse(&named);
+                }
+                named.pop();
+                depth -= 1;
+            }
+            Component::ParentDir => named.push(".."),
+            Component::Normal(_) => {
+                named.push(c);
+                depth += 1;
+            }
+            other => named.push(other),
         }
-        _ => Ok(()),
     }
+    if depth > 0 && is_link(&named) {
+        return refuse(&named);
+    }
+    Ok(())
 }
 
 #[cfg(all(test, unix))]
@@ -708,5 +803,43 @@ mod tests {
         assert!(ensure_not_input(&a, &d.path().join("b.ngc"), false).is_ok());
         std::fs::write(d.path().join("c.ngc"), b"G0 X0\n").unwrap();
         assert!(ensure_not_input(&a, &d.path().join("c.ngc"), false).is_ok());
+    }
+
+    #[test]
+    fn a_link_directory_is_refused_in_every_spelling() {
+        let d = tempfile::tempdir().unwrap();
+        let target = d.path().join("target");
+        std::fs::create_dir_all(target.join("sub")).unwrap();
+        let link = d.path().join("link");
+        symlink(&target, &link).unwrap();
+        let l = link.display().to_string();
+        for form in [
+            l.clone(),
+            format!("{l}/"),
+            format!("{l}/."),
+            format!("{l}//"),
+            format!("{l}/./"),
+            format!("{l}/./."),
+            format!("{l}/sub/.."),
+            format!("{l}/.."),
+            format!("{l}/../target"),
+            format!("{}/./link/", d.path().display()),
+        ] {
+            let e = ensure_not_link_dir(Path::new(&form))
+                .map(|_| "accepted".to_string())
+                .unwrap_or_else(|e| e.to_string());
+            assert!(e.contains("symbolic link"), "{form}: {e}");
+        }
+        // the directory itself, links among the parents, a new name, `..` out of a real one
+        for ok in [
+            target.clone(),
+            link.join("sub"),
+            link.join("sub/"),
+            link.join("new"),
+            target.join("sub/.."),
+            d.path().join("nothing/here/."),
+        ] {
+            assert!(ensure_not_link_dir(&ok).is_ok(), "{}", ok.display());
+        }
     }
 }

@@ -96,6 +96,8 @@ pub mod registry {
         SolverKind, explain, find, is_portfolio_file, kind_label, markdown, registry as all,
         validate_portfolio,
     };
+    /// Largest portfolio file read, in bytes.
+    pub const PORTFOLIO_MAX_BYTES: u64 = crate::solvers::auto::portfolio::MAX_FILE_BYTES;
 }
 
 /// What most programs need, in one `use cellseq::prelude::*;`.

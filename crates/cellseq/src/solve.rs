@@ -44,9 +44,7 @@ pub const BOUND_SHARE: f64 = 0.05;
 /// Largest instance (cells) for which [`Solve::lower_bound`] computes a bound after solving.
 pub const BOUND_MAX_CELLS: usize = 200_000;
 
-/// Longest time limit accepted, in seconds (about 11.5 days): longer ones are refused rather
-/// than overflowing a clock.
-pub const MAX_SECONDS: f64 = 1.0e6;
+pub use crate::params::MAX_SECONDS;
 
 impl Budget {
     /// A wall-clock budget of `seconds`; refused unless `0 < seconds ≤` [`MAX_SECONDS`].
@@ -304,9 +302,12 @@ impl Solved {
         self.lower_bound
             .and_then(|lb| bound::certified_gap_percent(self.report.cost, lb))
     }
-    /// The gap to a best-known value, in percent of it.
+    /// The gap to a best-known value, in percent of it; none when it is 0 or the gap is not
+    /// finite.
     pub fn gap_percent(&self, best_known: f64) -> Option<f64> {
-        (best_known > 0.0).then(|| 100.0 * (self.report.cost - best_known) / best_known)
+        (best_known > 0.0)
+            .then(|| 100.0 * (self.report.cost - best_known) / best_known)
+            .filter(|g| g.is_finite())
     }
     /// Raises the lower bound with `bound::compute` at cheap settings (instances of up to
     /// [`BOUND_MAX_CELLS`] cells; nothing when the result is proven optimal).

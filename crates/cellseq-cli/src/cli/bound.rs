@@ -1,8 +1,7 @@
 //! `bound`: lower bounds on the optimum of an instance.
 
-use super::solve::{load, objective_of};
+use super::solve::{best_known, load, objective_of};
 use anyhow::Result;
-use cellseq::formats::best_known;
 use cellseq::{BoundOptions, Solve, SolverKind, certified_gap_percent, lower_bounds};
 use clap::Args;
 use serde_json::json;
@@ -17,7 +16,7 @@ pub struct BoundArgs {
     #[arg(long)]
     objective: Option<String>,
     /// Subgradient iterations of the Lagrangian arborescence bound (0 = skip it).
-    #[arg(long, default_value_t = 300)]
+    #[arg(long, default_value_t = 300, value_parser = super::ranges::iterations)]
     iterations: usize,
     /// Print one JSON object.
     #[arg(long)]

@@ -14,7 +14,7 @@ pub struct DemoArgs {
     #[arg(long, default_value = "results/demo")]
     out: PathBuf,
     /// Worker threads (default: all cores).
-    #[arg(long)]
+    #[arg(long, value_parser = super::ranges::threads)]
     threads: Option<usize>,
 }
 

@@ -28,11 +28,11 @@ pub struct OptimizeArgs {
     pub solver: Option<String>,
     /// Time limit in seconds for the whole command (reading, solving, checking, writing);
     /// the solver's part is shared among groups of cells by size.
-    #[arg(long, value_name = "S")]
+    #[arg(long, value_name = "S", value_parser = super::ranges::time_limit)]
     pub time_limit: Option<f64>,
     /// Evaluation budget of the solver, shared among groups by size (deterministic results);
     /// without this or a time limit, each group gets 20 000 evaluations per cell.
-    #[arg(long, value_name = "N")]
+    #[arg(long, value_name = "N", value_parser = super::ranges::max_evals)]
     pub max_evals: Option<u64>,
     /// Seed.
     #[arg(long, default_value_t = 1)]
@@ -58,7 +58,7 @@ pub struct OptimizeArgs {
     #[arg(long, value_name = "gcode|svg|dxf")]
     pub format: Option<String>,
     /// XY margin (mm) added to cell footprints for the overlap rule.
-    #[arg(long, default_value_t = 0.5)]
+    #[arg(long, default_value_t = 0.5, value_parser = super::ranges::margin)]
     pub margin: f64,
     #[command(flatten)]
     pub drawing: super::strokes::DrawingArgs,
@@ -79,7 +79,7 @@ pub struct ImportArgs {
     #[arg(long)]
     pub merge_tool_blocks: bool,
     /// XY margin (mm) added to cell footprints for the overlap rule.
-    #[arg(long, default_value_t = 0.5)]
+    #[arg(long, default_value_t = 0.5, value_parser = super::ranges::margin)]
     pub margin: f64,
     /// Input format (default: from the extension).
     #[arg(long, value_name = "gcode|svg|dxf")]
@@ -172,14 +172,9 @@ fn refuse_non_gcode_output(o: &Path) -> anyhow::Result<()> {
 }
 
 fn optimize_gcode(a: &OptimizeArgs) -> anyhow::Result<()> {
-    let allowance = Allowance::new(a.time_limit, a.max_evals);
+    let allowance = Allowance::new(a.time_limit, a.max_evals)?;
     if let Some(o) = &a.output {
         refuse_non_gcode_output(o)?;
-    }
-    if let Some(t) = a.time_limit
-        && !(t.is_finite() && t > 0.0)
-    {
-        bail!("--time-limit must be a positive number of seconds (got {t})");
     }
     let file = a.input.display().to_string();
     let t0 = std::time::Instant::now();

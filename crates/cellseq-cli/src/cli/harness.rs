@@ -11,11 +11,11 @@ use std::path::{Path, PathBuf};
 #[derive(Args, Debug, Clone, Copy)]
 pub struct LimitArgs {
     /// Refuse plans with more trials than this (default 100000, or the plan's `max_trials`).
-    #[arg(long, value_name = "N", value_parser = crate::cli::parse_count)]
+    #[arg(long, value_name = "N", value_parser = super::ranges::max_trials)]
     max_trials: Option<u64>,
     /// Stop a file pattern that looks at more directory entries than this (default 100000, or
     /// the plan's `max_files`).
-    #[arg(long, value_name = "N", value_parser = crate::cli::parse_count)]
+    #[arg(long, value_name = "N", value_parser = super::ranges::max_files)]
     max_files: Option<u64>,
 }
 
@@ -33,10 +33,10 @@ pub struct CheckArgs {
     /// Experiment plan (TOML), or a portfolio file of the `auto` solver (one with `[[rule]]`).
     plan: PathBuf,
     /// Shards the plan will run as (for the time-per-shard estimate).
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 1, value_parser = super::ranges::shards)]
     shards: usize,
     /// Threads per shard (for the estimate; default: all cores here).
-    #[arg(long)]
+    #[arg(long, value_parser = super::ranges::threads)]
     threads: Option<usize>,
     #[command(flatten)]
     limits: LimitArgs,
@@ -47,7 +47,7 @@ pub struct RunArgs {
     /// Experiment plan (TOML).
     plan: PathBuf,
     /// Worker threads (default: all cores).
-    #[arg(long)]
+    #[arg(long, value_parser = super::ranges::threads)]
     threads: Option<usize>,
     /// Run only shard I of N (1-based), e.g. `--shard 2/8`.
     #[arg(long, value_name = "I/N")]
@@ -56,7 +56,7 @@ pub struct RunArgs {
     #[arg(long)]
     out: Option<PathBuf>,
     /// Testing hook: sleep this many milliseconds after each trial.
-    #[arg(long, hide = true, default_value_t = 0)]
+    #[arg(long, hide = true, default_value_t = 0, value_parser = super::ranges::throttle_ms)]
     throttle_ms: u64,
     #[command(flatten)]
     limits: LimitArgs,
@@ -96,9 +96,6 @@ pub fn parse_shard(s: &str) -> Result<(usize, usize)> {
 }
 
 pub fn check(a: CheckArgs) -> Result<()> {
-    if a.shards == 0 || a.threads == Some(0) {
-        bail!("--shards and --threads must be at least 1");
-    }
     if cellseq::registry::is_portfolio_file(&a.plan) {
         return check_portfolio(&a.plan);
     }
@@ -136,8 +133,16 @@ fn check_portfolio(path: &Path) -> Result<()> {
 /// Runs a plan and prints a summary.
 pub fn execute(plan: &Plan, opts: &RunOptions) -> Result<()> {
     let s = run_plan(plan, opts)?;
+    let beyond = if s.out_of_range > 0 {
+        format!(
+            ", {} not run: out of their solver's range (the plan's max_cells)",
+            s.out_of_range
+        )
+    } else {
+        String::new()
+    };
     say!(
-        "{} trials: {} run now, {} already done, {} without a feasible result",
+        "{} trials: {} run now, {} already done, {} without a feasible result{beyond}",
         s.planned,
         s.ran,
         s.skipped,
@@ -152,9 +157,6 @@ pub fn execute(plan: &Plan, opts: &RunOptions) -> Result<()> {
 pub fn run(a: RunArgs) -> Result<()> {
     let plan = Plan::load_with(&a.plan, a.limits.limits())?;
     let shard = a.shard.as_deref().map(parse_shard).transpose()?;
-    if a.threads == Some(0) {
-        bail!("--threads must be at least 1");
-    }
     let out = a
         .out
         .unwrap_or_else(|| Path::new("results").join(&plan.file.name));

@@ -16,7 +16,9 @@ mod bound;
 mod demo;
 mod gcode;
 mod harness;
+mod limits;
 mod plot;
+mod ranges;
 mod rows;
 mod solve;
 mod strokes;
@@ -65,6 +67,9 @@ enum Command {
     Merge(harness::MergeArgs),
     /// Tables, tests and plots from a results directory.
     Report(harness::ReportArgs),
+    /// Every range and limit of a number cellseq takes: flags, plan keys, file values,
+    /// solver and generator parameters (`--markdown`: the list in docs/bad-input.md).
+    Limits(limits::LimitsArgs),
 }
 
 /// Parses a count given as an integer (`200000000`, `200_000_000`) or in exponent notation
@@ -116,6 +121,7 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<()> {
         Command::Run(a) => harness::run(a),
         Command::Merge(a) => harness::merge(a),
         Command::Report(a) => harness::report(a),
+        Command::Limits(a) => limits::limits(a),
     }
 }
 

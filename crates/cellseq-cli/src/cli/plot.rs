@@ -127,7 +127,7 @@ fn panels_of(
                     svg::ReadOptions::default(),
                 )?
             } else {
-                let bytes = std::fs::read(path).with_context(|| format!("reading {file}"))?;
+                let bytes = cellseq::files::read_bytes(path)?;
                 dxf::read(&file, &bytes, dxf::ReadOptions::default())?
             };
             out.push(cellseq_lab::plot::drawing_panel(title, &d, &d.strokes));

@@ -2,8 +2,8 @@
 
 use anyhow::{Context as _, Result, bail};
 use cellseq::clock::Deadline;
+use cellseq::formats;
 use cellseq::formats::json;
-use cellseq::formats::{self, best_known};
 use cellseq::model::{Instance, Objective};
 use cellseq::params::parse_kv;
 use cellseq::registry::{self, DEFAULT_SOLVER};
@@ -42,10 +42,10 @@ pub struct SolveArgs {
     /// bound after the solve (at most a twentieth of the time; `--no-bound` gives it to the
     /// solver) and the report end within it plus a small margin (docs/bad-input.md, "Time
     /// limits"). Experiments (`cellseq run`) give each solver its full budget instead.
-    #[arg(long, value_name = "SECONDS")]
+    #[arg(long, value_name = "SECONDS", value_parser = super::ranges::time_limit)]
     pub time_limit: Option<f64>,
     /// Evaluation budget (deterministic runs): an integer, `200_000_000` or `2e8`.
-    #[arg(long, value_name = "N", value_parser = super::parse_count)]
+    #[arg(long, value_name = "N", value_parser = super::ranges::max_evals)]
     pub max_evals: Option<u64>,
     /// Objective: time (default), air, or matrix.
     #[arg(long)]
@@ -108,6 +108,15 @@ pub struct GenerateArgs {
 /// Loads an instance, with the file named in any error.
 pub fn load(path: &Path) -> Result<Instance> {
     Ok(formats::load_instance(path)?)
+}
+
+/// The best-known value and proof flag from a `bks.csv` beside `file`; a row whose value is
+/// not a finite number ≥ 0 is ignored with a warning naming `bks.csv` and its line.
+pub fn best_known(file: &Path) -> Option<(f64, bool)> {
+    formats::best_known_checked(file).unwrap_or_else(|e| {
+        eprintln!("warning: {e}; the best-known value is ignored");
+        None
+    })
 }
 
 /// Parses an objective name, or the instance's default.
@@ -247,8 +256,12 @@ pub fn solve(a: SolveArgs) -> Result<()> {
     Ok(())
 }
 
+/// The gap to the best-known value in percent; none without one, or when it is not finite
+/// (a best-known value of 1e-320 would make it infinite).
 fn gap(cost: f64, bk: Option<f64>) -> Option<f64> {
-    bk.filter(|&b| b > 0.0).map(|b| 100.0 * (cost - b) / b)
+    bk.filter(|&b| b > 0.0)
+        .map(|b| 100.0 * (cost - b) / b)
+        .filter(|g| g.is_finite())
 }
 
 fn print_report(inst: &Instance, r: &Solved, bk: Option<f64>) {
@@ -266,11 +279,7 @@ fn print_report(inst: &Instance, r: &Solved, bk: Option<f64>) {
         say!("machining time  {:.3} s", rep.machining_time);
     }
     if let Some(b) = bk {
-        say!(
-            "best known      {}  (gap {:.3} %)",
-            fmt_num(b),
-            gap(rep.cost, Some(b)).unwrap_or(0.0)
-        );
+        say_best_known(b, rep.cost);
     }
     if r.proven_optimal {
         say!("proven optimal  yes");
@@ -284,6 +293,14 @@ fn print_report(inst: &Instance, r: &Solved, bk: Option<f64>) {
     say!("feasible        yes (independent checker)");
     say!("evaluations     {}", r.evaluations);
     say!("elapsed         {:.3} s", r.elapsed_s);
+}
+
+/// The best-known line: the value, and the gap when it is defined (not for a best known of 0).
+fn say_best_known(b: f64, cost: f64) {
+    match gap(cost, Some(b)) {
+        Some(g) => say!("best known      {}  (gap {g:.3} %)", fmt_num(b)),
+        None => say!("best known      {}", fmt_num(b)),
+    }
 }
 
 fn fmt_num(x: f64) -> String {
@@ -320,11 +337,7 @@ pub fn eval(a: EvalArgs) -> Result<()> {
             say!("machining time  {:.3} s", rep.machining_time);
         }
         if let Some(b) = bk {
-            say!(
-                "best known      {}  (gap {:.3} %)",
-                fmt_num(b),
-                gap(rep.cost, Some(b)).unwrap_or(0.0)
-            );
+            say_best_known(b, rep.cost);
         }
     }
     Ok(())

@@ -15,7 +15,7 @@ use std::path::Path;
 #[derive(Args, Debug, Clone)]
 pub struct DrawingArgs {
     /// Curve flattening tolerance (mm).
-    #[arg(long, default_value_t = 0.01)]
+    #[arg(long, default_value_t = 0.01, value_parser = super::ranges::tolerance)]
     pub tolerance: f64,
     /// Sequence the whole drawing at once instead of layer by layer / colour by colour (the
     /// same as `--pens none`).
@@ -45,10 +45,10 @@ pub struct DrawingArgs {
     #[arg(long)]
     pub keep_group_order: bool,
     /// Containment tolerance of cut mode (mm).
-    #[arg(long, default_value_t = 0.01)]
+    #[arg(long, default_value_t = 0.01, value_parser = super::ranges::contain_tol)]
     pub contain_tol: f64,
     /// Start-vertex candidates per closed stroke when reversible.
-    #[arg(long, default_value_t = 8)]
+    #[arg(long, default_value_t = 8, value_parser = super::ranges::max_starts)]
     pub max_starts: usize,
     /// SVG: drop the elements that are not sequenced (text, images, `<use>`, metadata, …)
     /// from the output instead of keeping them as they are; DXF: skip unsupported entities
@@ -57,32 +57,32 @@ pub struct DrawingArgs {
     pub skip_unsupported: bool,
     /// Most points a drawing may have after flattening its curves (a cap against hostile
     /// files; raise it for huge drawings).
-    #[arg(long, default_value_t = 10_000_000, value_name = "N")]
+    #[arg(long, default_value_t = 10_000_000, value_name = "N", value_parser = super::ranges::max_points)]
     pub max_points: usize,
     /// DXF: chain loose pieces whose endpoints are closer than this (mm).
-    #[arg(long, default_value_t = 0.001)]
+    #[arg(long, default_value_t = 0.001, value_parser = super::ranges::join_tol)]
     pub join_tol: f64,
     /// DXF: do not put inner contours first (cut mode is on by default for DXF).
     #[arg(long)]
     pub no_inner_first: bool,
     /// DXF G-code post: safe height (mm).
-    #[arg(long, default_value_t = 5.0)]
+    #[arg(long, default_value_t = 5.0, value_parser = super::ranges::safe_height)]
     pub safe_height: f64,
     /// DXF G-code post: cutting depth below Z0 (mm).
-    #[arg(long, default_value_t = 1.0)]
+    #[arg(long, default_value_t = 1.0, value_parser = super::ranges::cut_depth)]
     pub cut_depth: f64,
     /// DXF G-code post: cutting feed (mm/min).
-    #[arg(long, default_value_t = 1000.0)]
+    #[arg(long, default_value_t = 1000.0, value_parser = super::ranges::feed)]
     pub feed: f64,
     /// DXF G-code post: plunge / pierce feed (mm/min).
-    #[arg(long, default_value_t = 300.0)]
+    #[arg(long, default_value_t = 300.0, value_parser = super::ranges::plunge_feed)]
     pub plunge_feed: f64,
     /// DXF G-code post: spindle speed (M3 S… before the first cut, M5 at the end); 0 writes
     /// no spindle words (the operator's spindle state is left alone).
-    #[arg(long, default_value_t = 0.0, conflicts_with = "laser_power")]
+    #[arg(long, default_value_t = 0.0, conflicts_with = "laser_power", value_parser = super::ranges::spindle)]
     pub spindle: f64,
     /// DXF G-code post for a laser: power S (M4 S…, off on rapids; M5 at the end), no Z moves.
-    #[arg(long, default_value_t = 0.0, value_name = "S")]
+    #[arg(long, default_value_t = 0.0, value_name = "S", value_parser = super::ranges::laser_power)]
     pub laser_power: f64,
     /// DXF: the drawing unit when the file does not say (`$INSUNITS`): mm, cm, m, in, ft, mil
     /// or um (default mm, with a warning).
@@ -330,7 +330,7 @@ fn optimize_svg(a: &OptimizeArgs) -> anyhow::Result<()> {
 
 fn read_dxf(path: &Path, d: &DrawingArgs) -> anyhow::Result<svg::Drawing> {
     let file = path.display().to_string();
-    let bytes = std::fs::read(path).with_context(|| format!("reading {file}"))?;
+    let bytes = cellseq::files::read_bytes(path)?;
     let units = match &d.units {
         Some(u) => Some(
             cellseq_programs::dxf::unit_mm(u)

@@ -34,6 +34,17 @@ pub fn s(p: &Path) -> &str {
     p.to_str().unwrap()
 }
 
+/// True when `text` holds a non-finite number as a word: `NaN`, `inf`, `-inf`, `Infinity`.
+pub fn has_non_finite(text: &str) -> bool {
+    text.split(|c: char| !(c.is_ascii_alphanumeric() || c == '_'))
+        .any(|w| {
+            matches!(
+                w,
+                "NaN" | "nan" | "inf" | "Inf" | "INF" | "Infinity" | "infinity"
+            )
+        })
+}
+
 /// Writes `text` to `dir/name` and returns the path.
 pub fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
     let p = dir.join(name);

@@ -391,6 +391,21 @@ pub fn plot_panels(panels: &[Panel], y_down: bool, overlay: bool, out: &Path) ->
     if x0 > x1 {
         (x0, x1, y0, y1) = (0.0, 1.0, 0.0, 1.0);
     }
+    // the axes' ticks of a span beyond the coordinate limit never end (plotters loops)
+    let limit = cellseq::validate::MAX_COORD;
+    if let Some(v) = [x0, x1, y0, y1]
+        .into_iter()
+        .find(|v| !(v.is_finite() && v.abs() <= limit))
+    {
+        return Err(Error::invalid(
+            &file,
+            format!(
+                "the drawing reaches {} mm, beyond the coordinate limit of {} mm: nothing is drawn",
+                cellseq::params::float_text(v),
+                cellseq::params::float_text(limit)
+            ),
+        ));
+    }
     let pad = 0.04 * (x1 - x0).max(y1 - y0).max(1e-6);
     let bx = (x0 - pad, x1 + pad, y0 - pad, y1 + pad);
     let cols = if overlay { 1 } else { panels.len() as u32 };

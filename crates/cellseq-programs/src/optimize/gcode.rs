@@ -120,7 +120,7 @@ impl Optimized {
 
 /// [`optimize_within`] with an allowance starting now, from the options' budget.
 pub fn optimize(p: &Parsed, opts: &Options) -> Result<Optimized> {
-    optimize_within(p, opts, &Allowance::new(opts.time_limit, opts.max_evals))
+    optimize_within(p, opts, &Allowance::new(opts.time_limit, opts.max_evals)?)
 }
 
 /// Sequences the cells group by group with a registry solver, writes the program, verifies it

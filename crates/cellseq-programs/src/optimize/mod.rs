@@ -53,13 +53,21 @@ pub struct Allowance {
 }
 
 impl Allowance {
-    /// An allowance starting now.
-    pub fn new(time_limit: Option<f64>, max_evals: Option<u64>) -> Self {
-        Allowance {
+    /// An allowance starting now. The time limit must lie in (0, [`cellseq::solve::MAX_SECONDS`]]
+    /// seconds and the evaluation budget be at least 1; other values are refused, naming
+    /// `--time-limit` or `--max-evals`.
+    pub fn new(time_limit: Option<f64>, max_evals: Option<u64>) -> Result<Self> {
+        if let Some(t) = time_limit {
+            cellseq::solve::checked_seconds("--time-limit", t)?;
+        }
+        if max_evals == Some(0) {
+            return Err(Error::Param("--max-evals must be at least 1".into()));
+        }
+        Ok(Allowance {
             started: Instant::now(),
             time_limit,
             max_evals,
-        }
+        })
     }
 
     /// Seconds left of the time limit (none without one); never negative.
@@ -186,17 +194,17 @@ mod tests {
 
     #[test]
     fn evaluation_shares_follow_size_and_are_deterministic() {
-        let a = Allowance::new(None, Some(1000));
+        let a = Allowance::new(None, Some(1000)).unwrap();
         assert_eq!(a.share(250, 1000, 1000, 0.0).max_evals, Some(250));
         assert_eq!(a.share(250, 250, 1000, 0.0).max_evals, Some(250));
-        let b = Allowance::new(None, None);
+        let b = Allowance::new(None, None).unwrap();
         assert_eq!(b.share(10, 10, 10, 0.0).max_evals, Some(200_000));
         assert!(b.share(10, 10, 10, 0.0).time_limit.is_none());
     }
 
     #[test]
     fn time_shares_leave_the_reserve() {
-        let a = Allowance::new(Some(10.0), None);
+        let a = Allowance::new(Some(10.0), None).unwrap();
         let b = a.share(1, 2, 2, 2.0);
         let t = b.time_limit.unwrap().as_secs_f64();
         assert!(t <= 4.0 && t > 3.5, "{t}");

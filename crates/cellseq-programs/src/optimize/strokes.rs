@@ -483,7 +483,7 @@ pub fn default_evals(size: usize) -> u64 {
 
 /// [`optimize_within`] with an allowance starting now, from the options' budget.
 pub fn optimize(d: &Drawing, opts: &Options) -> Result<Optimized> {
-    optimize_within(d, opts, &Allowance::new(opts.time_limit, opts.max_evals))
+    optimize_within(d, opts, &Allowance::new(opts.time_limit, opts.max_evals)?)
 }
 
 /// The scopes solved in one order: the strokes, the figures of the report, and each scope's

@@ -203,5 +203,7 @@ fn dense_bounds(
 
 /// Certified gap of a solution cost against a lower bound, in percent of the bound.
 pub fn certified_gap_percent(cost: f64, lower: f64) -> Option<f64> {
-    (lower > 0.0).then(|| 100.0 * (cost - lower).max(0.0) / lower)
+    (lower > 0.0)
+        .then(|| 100.0 * (cost - lower).max(0.0) / lower)
+        .filter(|g| g.is_finite())
 }

@@ -103,26 +103,68 @@ pub fn stem_name(path: &Path) -> String {
     name.to_string()
 }
 
-/// Best-known value and whether it is proven optimal, from a `bks.csv` beside the file.
+/// Best-known value and whether it is proven optimal, from a `bks.csv` beside the file; none
+/// when there is no such file or row, or when the row's value is not a finite number ≥ 0
+/// ([`best_known_checked`] tells why).
 pub fn best_known(path: &Path) -> Option<(f64, bool)> {
-    let dir = path.parent()?;
+    best_known_checked(path).ok().flatten()
+}
+
+/// Largest `bks.csv` read (64 MiB; the shipped ones hold a few KB).
+pub const MAX_BKS_BYTES: u64 = 64 << 20;
+
+/// [`best_known`], with an error naming `bks.csv` and the line when the instance's row holds
+/// a value that is not a finite number ≥ 0 (`NaN`, `inf`, `-3`, `x`): such a value would
+/// print as a gap of NaN %. No file, no readable header or no row for the instance: `Ok(None)`.
+pub fn best_known_checked(path: &Path) -> Result<Option<(f64, bool)>> {
+    let Some(dir) = path.parent() else {
+        return Ok(None);
+    };
     let bks = dir.join("bks.csv");
-    let mut rdr = csv::Reader::from_path(bks).ok()?;
-    let headers = rdr.headers().ok()?.clone();
+    let Ok(meta) = std::fs::metadata(&bks) else {
+        return Ok(None);
+    };
+    if !meta.is_file() || meta.len() > MAX_BKS_BYTES {
+        return Err(Error::invalid(
+            bks.display().to_string(),
+            format!("not a regular file of at most {MAX_BKS_BYTES} bytes"),
+        ));
+    }
+    let Ok(mut rdr) = csv::Reader::from_path(&bks) else {
+        return Ok(None);
+    };
+    let Ok(headers) = rdr.headers().cloned() else {
+        return Ok(None);
+    };
     let col = |n: &str| headers.iter().position(|h| h == n);
-    let (name_c, best_c) = (col("name")?, col("best_known")?);
+    let (Some(name_c), Some(best_c)) = (col("name"), col("best_known")) else {
+        return Ok(None);
+    };
     let proven_c = col("proven_optimal");
     let stem = stem_name(path);
     for rec in rdr.records().flatten() {
-        if rec.get(name_c) == Some(stem.as_str()) {
-            let v: f64 = rec.get(best_c)?.trim().parse().ok()?;
-            let proven = proven_c
-                .and_then(|c| rec.get(c))
-                .is_some_and(|p| p.trim() == "true");
-            return Some((v, proven));
+        if rec.get(name_c) != Some(stem.as_str()) {
+            continue;
         }
+        let text = rec.get(best_c).unwrap_or("").trim();
+        let v = text
+            .parse::<f64>()
+            .ok()
+            .filter(|v| v.is_finite() && *v >= 0.0);
+        let Some(v) = v else {
+            let line = rec.position().map_or(0, |p| p.line() as usize);
+            return Err(Error::parse(
+                bks.display().to_string(),
+                line,
+                format!("best_known of '{stem}' is '{text}', not a finite number >= 0"),
+            ));
+        };
+        let proven = proven_c
+            .and_then(|c| rec.get(c))
+            .is_some_and(|p| p.trim() == "true");
+        return Ok(Some((v, proven)));
     }
-    None
+    Ok(None)
 }
 
 impl Instance {

@@ -1,7 +1,7 @@
 //! TSPLIB-style text split into its parts — header `KEY: VALUE` pairs and named sections of
 //! numbered lines — and the header checks the SOP, PCGLNS and PCGTSP readers share.
 
-use super::tsplib::{MAX_NODES_ENV, max_nodes};
+use super::tsplib::{MAX_NODES_ENV, max_nodes_checked};
 use crate::error::{Error, Result};
 
 /// Numbered lines (1-based line number, trimmed text).
@@ -149,7 +149,7 @@ pub(crate) fn check_explicit(file: &str, p: &Parts) -> Result<()> {
 
 /// Refuses a matrix dimension above [`max_nodes`], naming the memory it would take.
 pub(crate) fn check_dimension(file: &str, ln: usize, dim: usize) -> Result<()> {
-    let limit = max_nodes();
+    let limit = max_nodes_checked()?;
     if dim > limit {
         return Err(Error::parse(
             file,

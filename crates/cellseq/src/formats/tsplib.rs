@@ -16,13 +16,31 @@ pub const MAX_NODES: usize = 20_000;
 /// Environment variable that overrides [`MAX_NODES`].
 pub const MAX_NODES_ENV: &str = "CELLSEQ_MAX_MATRIX_NODES";
 
-/// The matrix dimension limit in force: [`MAX_NODES_ENV`] when set to a number, else
-/// [`MAX_NODES`].
+/// What [`MAX_NODES_ENV`] may be set to: a matrix of 10⁵ nodes takes 80 GB.
+pub const MAX_NODES_RANGE: crate::params::IntRange = crate::params::IntRange::new(1, 100_000);
+
+/// The matrix dimension limit in force: [`MAX_NODES_ENV`] when set to a whole number in
+/// [`MAX_NODES_RANGE`], else [`MAX_NODES`] ([`max_nodes_checked`] refuses a bad setting).
 pub fn max_nodes() -> usize {
-    std::env::var(MAX_NODES_ENV)
-        .ok()
-        .and_then(|v| v.trim().parse().ok())
-        .unwrap_or(MAX_NODES)
+    max_nodes_checked().unwrap_or(MAX_NODES)
+}
+
+/// The matrix dimension limit in force; an error naming [`MAX_NODES_ENV`] when it is set to
+/// anything but a whole number in [`MAX_NODES_RANGE`].
+pub fn max_nodes_checked() -> Result<usize> {
+    let Some(v) = std::env::var_os(MAX_NODES_ENV) else {
+        return Ok(MAX_NODES);
+    };
+    let text = v.to_string_lossy();
+    let n = text
+        .trim()
+        .parse::<u64>()
+        .map_err(|_| {
+            format!("{MAX_NODES_ENV} must be a whole number in {MAX_NODES_RANGE}, got '{text}'")
+        })
+        .and_then(|n| MAX_NODES_RANGE.check(MAX_NODES_ENV, n))
+        .map_err(Error::Param)?;
+    Ok(n as usize)
 }
 
 /// Whitespace tokens of numbered lines, read lazily, each with its 1-based line number.

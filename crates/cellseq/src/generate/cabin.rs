@@ -29,49 +29,49 @@ pub static SPECS: &[ParamSpec] = &[
     ParamSpec {
         name: "features",
         default: "6",
-        kind: ParamKind::Int,
+        kind: ParamKind::int(0, 1_000_000),
         help: "open + closed features (each gives a rough and a finish cell)",
     },
     ParamSpec {
         name: "open_fraction",
         default: "0.5",
-        kind: ParamKind::Float,
+        kind: ParamKind::float(0.0, 1.0),
         help: "fraction of open features (two contact points)",
     },
     ParamSpec {
         name: "faces",
         default: "2",
-        kind: ParamKind::Int,
+        kind: ParamKind::int(1, 10_000),
         help: "face-milling strips",
     },
     ParamSpec {
         name: "hole_groups",
         default: "2",
-        kind: ParamKind::Int,
+        kind: ParamKind::int(0, 10_000),
         help: "hole groups (bolt circles)",
     },
     ParamSpec {
         name: "holes",
         default: "3",
-        kind: ParamKind::Int,
+        kind: ParamKind::int(0, 10_000),
         help: "holes per group",
     },
     ParamSpec {
         name: "length",
         default: "2000",
-        kind: ParamKind::Float,
+        kind: ParamKind::float(200.0, 1e6),
         help: "part length (mm)",
     },
     ParamSpec {
         name: "width",
         default: "800",
-        kind: ParamKind::Float,
+        kind: ParamKind::float(200.0, 1e6),
         help: "part width (mm)",
     },
     ParamSpec {
         name: "levels",
         default: "3",
-        kind: ParamKind::Int,
+        kind: ParamKind::int(1, 1000),
         help: "distinct top-surface heights (50 mm apart)",
     },
     ParamSpec {
@@ -267,37 +267,46 @@ fn hole_group(
     }
 }
 
+/// Checks what the declared ranges cannot (limits on the parameters' combination, the tool
+/// library); about how many cells the part will have, at most.
+pub fn check(p: &Params) -> Result<u64> {
+    let (nf, nfaces) = (p.int("features"), p.int("faces"));
+    let (ngroups, nholes) = (p.int("hole_groups"), p.int("holes"));
+    let bad = |m: String| Err(Error::Param(format!("cabin: {m}")));
+    let cells = nf
+        .saturating_mul(2)
+        .saturating_add(ngroups.saturating_mul(nholes))
+        .saturating_add(nfaces);
+    if cells > 2_000_000 {
+        return bad(format!(
+            "2 x features + hole_groups x holes + faces = {cells} cells, more than 2000000"
+        ));
+    }
+    let lib = ToolLibrary::load(p.word("tools"))?;
+    if ngroups * nholes > 0 && lib.drills().next().is_none() {
+        return bad(format!(
+            "hole groups need drills in the tool library '{}'",
+            p.word("tools")
+        ));
+    }
+    Ok(cells)
+}
+
 /// Generates a cabin part.
 pub fn generate(p: &Params, seed: u64) -> Result<Instance> {
     let nf = p.int("features") as usize;
-    let nfaces = p.int("faces").max(1) as usize;
+    let nfaces = p.int("faces") as usize;
     let ngroups = p.int("hole_groups") as usize;
     let nholes = p.int("holes") as usize;
     let len = p.float("length");
     let wid = p.float("width");
-    let levels = p.int("levels").max(1) as usize;
+    let levels = p.int("levels") as usize;
     let of = p.float("open_fraction");
-    let bad = |m: String| Err(Error::Param(format!("cabin: {m}")));
-    if !(len >= 200.0 && wid >= 200.0) {
-        return bad("length and width must be at least 200 mm".into());
-    }
-    if !(0.0..=1.0).contains(&of) {
-        return bad("open_fraction must lie in [0, 1]".into());
-    }
-    if nf
-        .saturating_add(ngroups.saturating_mul(nholes))
-        .saturating_add(nfaces)
-        > 2_000_000
-    {
-        return bad("too many cells".into());
-    }
+    check(p)?;
     let lib = ToolLibrary::load(p.word("tools"))?;
     let face_tool = lib.end_mills().next().expect("end mill").clone();
     let rough_tool = lib.finishing_tool(16.0).clone();
     let drills: Vec<ToolSpec> = lib.drills().cloned().collect();
-    if ngroups * nholes > 0 && drills.is_empty() {
-        return bad("hole groups need drills in the tool library".into());
-    }
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let mut b = B {
         cells: Vec::new(),

@@ -46,73 +46,73 @@ pub static SPECS: &[ParamSpec] = &[
     ParamSpec {
         name: "regions",
         default: "3",
-        kind: ParamKind::Int,
+        kind: ParamKind::int(1, 10_000),
         help: "annular regions along the axis",
     },
     ParamSpec {
         name: "features",
         default: "6",
-        kind: ParamKind::Int,
+        kind: ParamKind::int(0, 10_000),
         help: "mean number of features per region",
     },
     ParamSpec {
         name: "diameter",
         default: "300",
-        kind: ParamKind::Float,
+        kind: ParamKind::float_above(0.0, 1e6),
         help: "casing diameter (mm); unrolled length π·D",
     },
     ParamSpec {
         name: "width",
         default: "60",
-        kind: ParamKind::Float,
+        kind: ParamKind::float_above(0.0, 1e4),
         help: "axial width of an annular region (mm)",
     },
     ParamSpec {
         name: "gap",
         default: "0",
-        kind: ParamKind::Float,
+        kind: ParamKind::float(0.0, 1e4),
         help: "axial gap between regions (mm)",
     },
     ParamSpec {
         name: "depth",
         default: "20",
-        kind: ParamKind::Float,
+        kind: ParamKind::float_above(0.0, 1e4),
         help: "radial allowance removed at w = 1 (mm)",
     },
     ParamSpec {
         name: "tool_diameter",
         default: "12",
-        kind: ParamKind::Float,
+        kind: ParamKind::float_above(0.0, 1000.0),
         help: "flat end mill diameter (mm)",
     },
     ParamSpec {
         name: "cut_feed",
         default: "500",
-        kind: ParamKind::Float,
+        kind: ParamKind::float(0.001, 1e6),
         help: "cutting feed (mm/min)",
     },
     ParamSpec {
         name: "rapid_feed",
         default: "2000",
-        kind: ParamKind::Float,
+        kind: ParamKind::float(0.001, 1e6),
         help: "rapid feed (mm/min)",
     },
     ParamSpec {
         name: "stepover",
         default: "0.6",
-        kind: ParamKind::Float,
+        kind: ParamKind::float_above(0.0, 1.0),
         help: "zig-zag step-over, fraction of the tool diameter",
     },
     ParamSpec {
         name: "link_distance",
         default: "60",
-        kind: ParamKind::Float,
+        kind: ParamKind::float(0.0, 1e9),
         help: "same-depth moves up to this long go around a block without a lift (mm)",
     },
     ParamSpec {
         name: "lift_time",
         default: "5",
-        kind: ParamKind::Float,
+        kind: ParamKind::float(0.0, 1e6),
         help: "overhead of one lift: retract, approach and plunge at reduced feed (s)",
     },
     ParamSpec {
@@ -241,8 +241,36 @@ fn layer(
     layer_regions
 }
 
+/// Checks what the declared ranges cannot (limits on the parameters' combination); about how
+/// many cells the casing will have, at most.
+pub fn check(p: &Params) -> Result<u64> {
+    let regions = p.int("regions");
+    let mean = p.int("features");
+    let td = p.float("tool_diameter");
+    let bad = |m: String| Err(Error::Param(format!("casing: {m}")));
+    if p.float("width") <= 2.0 * td {
+        return bad("width must be more than 2 tool diameters".into());
+    }
+    if regions.saturating_mul(mean) > 1_000_000 {
+        return bad(format!(
+            "regions x features = {} features, more than 1000000 (each makes about 5 cells)",
+            regions.saturating_mul(mean)
+        ));
+    }
+    let circ = std::f64::consts::PI * p.float("diameter");
+    let max_feats = mean.saturating_add(mean / 2);
+    if max_feats > 0 && circ / max_feats as f64 <= 50.0 + 3.0 * td {
+        return bad(format!(
+            "{mean} features per region do not fit on a circumference of {circ:.0} mm: raise diameter"
+        ));
+    }
+    // five layers of a region's features and the blocks between them
+    Ok(regions * (max_feats + 1) * 2 * LAYERS_W.len() as u64)
+}
+
 /// Generates a casing.
 pub fn generate(p: &Params, seed: u64) -> Result<Instance> {
+    check(p)?;
     let regions = p.int("regions") as usize;
     let mean = p.int("features") as usize;
     let d = p.float("diameter");
@@ -251,26 +279,8 @@ pub fn generate(p: &Params, seed: u64) -> Result<Instance> {
     let depth = p.float("depth");
     let td = p.float("tool_diameter");
     let stepover = p.float("stepover") * td;
-    let bad = |m: String| Err(Error::Param(format!("casing: {m}")));
-    if regions == 0 || regions > 10_000 {
-        return bad("regions must lie in 1..=10000".into());
-    }
-    if !(d > 0.0 && depth > 0.0 && td > 0.0 && width > 2.0 * td && gap >= 0.0 && stepover > 0.0) {
-        return bad(
-            "diameter, depth, tool_diameter, stepover must be positive, width > 2 tool diameters"
-                .into(),
-        );
-    }
-    if !(p.float("cut_feed") > 0.0 && p.float("rapid_feed") > 0.0) {
-        return bad("feeds must be positive".into());
-    }
     let circ = std::f64::consts::PI * d;
     let max_feats = mean.saturating_add(mean / 2);
-    if max_feats > 0 && circ / max_feats as f64 <= 50.0 + 3.0 * td {
-        return bad(format!(
-            "{mean} features per region do not fit on a circumference of {circ:.0} mm: raise diameter"
-        ));
-    }
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let feats = features(regions, (mean, max_feats), circ, td, &mut rng);
     let r = td / 2.0;

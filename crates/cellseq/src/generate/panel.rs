@@ -40,133 +40,133 @@ pub static SPECS: &[ParamSpec] = &[
     ParamSpec {
         name: "rows",
         default: "2",
-        kind: ParamKind::Int,
+        kind: ParamKind::int(1, 100_000),
         help: "pocket rows",
     },
     ParamSpec {
         name: "cols",
         default: "3",
-        kind: ParamKind::Int,
+        kind: ParamKind::int(1, 100_000),
         help: "pocket columns",
     },
     ParamSpec {
         name: "pitch",
         default: "150",
-        kind: ParamKind::Float,
+        kind: ParamKind::float_above(0.0, 1e4),
         help: "grid spacing (mm)",
     },
     ParamSpec {
         name: "pitch_var",
         default: "0.3",
-        kind: ParamKind::Float,
+        kind: ParamKind::float_below(0.0, 0.5),
         help: "column widths and row heights vary by ± this fraction of the pitch (< 0.5)",
     },
     ParamSpec {
         name: "skew",
         default: "0",
-        kind: ParamKind::Float,
+        kind: ParamKind::float(-1.0, 1.0),
         help: "x shift per row, as a fraction of the pitch",
     },
     ParamSpec {
         name: "jitter",
         default: "0",
-        kind: ParamKind::Float,
+        kind: ParamKind::float_below(0.0, 0.2),
         help: "random shift of inner grid nodes, fraction of the pitch (< 0.2)",
     },
     ParamSpec {
         name: "rib",
         default: "6",
-        kind: ParamKind::Float,
+        kind: ParamKind::float_above(0.0, 1e4),
         help: "rib width (mm)",
     },
     ParamSpec {
         name: "flange",
         default: "25",
-        kind: ParamKind::Float,
+        kind: ParamKind::float_above(0.0, 1e4),
         help: "flange width around the pockets (mm)",
     },
     ParamSpec {
         name: "thickness",
         default: "45",
-        kind: ParamKind::Float,
+        kind: ParamKind::float_above(0.0, 1e4),
         help: "plate thickness (mm)",
     },
     ParamSpec {
         name: "depth_min",
         default: "15",
-        kind: ParamKind::Float,
+        kind: ParamKind::float_above(0.0, 1e4),
         help: "smallest pocket depth H (mm)",
     },
     ParamSpec {
         name: "depth_max",
         default: "40",
-        kind: ParamKind::Float,
+        kind: ParamKind::float_above(0.0, 1e4),
         help: "largest pocket depth H (mm)",
     },
     ParamSpec {
         name: "radius_min",
         default: "4",
-        kind: ParamKind::Float,
+        kind: ParamKind::float_above(0.0, 1e4),
         help: "smallest pocket corner radius (mm)",
     },
     ParamSpec {
         name: "radius_max",
         default: "16",
-        kind: ParamKind::Float,
+        kind: ParamKind::float_above(0.0, 1e4),
         help: "largest pocket corner radius (mm)",
     },
     ParamSpec {
         name: "ap",
         default: "6",
-        kind: ParamKind::Float,
+        kind: ParamKind::float(0.01, 1e4),
         help: "roughing step-down a_p (mm)",
     },
     ParamSpec {
         name: "delta",
         default: "1",
-        kind: ParamKind::Float,
+        kind: ParamKind::float(0.0, 1e4),
         help: "finishing allowance δ (mm)",
     },
     ParamSpec {
         name: "islands",
         default: "0.2",
-        kind: ParamKind::Float,
+        kind: ParamKind::float(0.0, 1.0),
         help: "probability that a pocket has an island",
     },
     ParamSpec {
         name: "open",
         default: "0.1",
-        kind: ParamKind::Float,
+        kind: ParamKind::float(0.0, 1.0),
         help: "probability that a pocket is open (through)",
     },
     ParamSpec {
         name: "grooves",
         default: "0.2",
-        kind: ParamKind::Float,
+        kind: ParamKind::float(0.0, 1.0),
         help: "probability that a pocket has a wall groove",
     },
     ParamSpec {
         name: "holes",
         default: "4",
-        kind: ParamKind::Int,
+        kind: ParamKind::int(0, 100_000),
         help: "holes in the flange",
     },
     ParamSpec {
         name: "hole_diameter",
         default: "6.8",
-        kind: ParamKind::Float,
+        kind: ParamKind::float_above(0.0, 1e4),
         help: "hole diameter (mm); the largest drill not above it",
     },
     ParamSpec {
         name: "eta_min",
         default: "0.9",
-        kind: ParamKind::Float,
+        kind: ParamKind::float(0.0, 1.0),
         help: "minimum machinable ratio of the roughing tool",
     },
     ParamSpec {
         name: "mu",
         default: "0.7",
-        kind: ParamKind::Float,
+        kind: ParamKind::float(0.0, 100.0),
         help: "merge two roughing tool groups when μ exceeds this",
     },
     ParamSpec {
@@ -297,6 +297,9 @@ struct Settings {
     min_pitch: f64,
 }
 
+/// Most roughing layers of one pocket (depth_max / ap): each layer is a cell.
+const MAX_LAYERS: f64 = 1000.0;
+
 /// A refused parameter combination.
 fn bad<T>(m: String) -> Result<T> {
     Err(Error::Param(format!("panel: {m}")))
@@ -339,26 +342,20 @@ impl Settings {
     }
 
     fn check(&self) -> Result<()> {
-        let (rows, cols, pitch, rib, ap) = (self.rows, self.cols, self.pitch, self.rib, self.ap);
-        if rows == 0 || cols == 0 || rows.saturating_mul(cols) > 100_000 {
-            return bad("rows and cols must be at least 1 (at most 100000 pockets)".into());
+        let (rows, cols, rib, ap) = (self.rows, self.cols, self.rib, self.ap);
+        // each parameter lies in its declared range (checked by `Params`); what is left are
+        // limits on their combination
+        if rows.saturating_mul(cols) > 100_000 {
+            return bad("rows x cols must be at most 100000 pockets".into());
         }
-        if !(pitch > 0.0
-            && rib > 0.0
-            && self.flange > 0.0
-            && self.thickness > 0.0
-            && ap > 0.0
-            && self.delta >= 0.0)
-        {
-            return bad(
-                "pitch, rib, flange, thickness and ap must be positive, delta non-negative".into(),
-            );
+        if !(self.dmin <= self.dmax && self.dmax < self.thickness) {
+            return bad("need depth_min <= depth_max < thickness".into());
         }
-        if !(0.0 < self.dmin && self.dmin <= self.dmax && self.dmax < self.thickness) {
-            return bad("need 0 < depth_min <= depth_max < thickness".into());
-        }
-        if !(0.0..0.5).contains(&self.pitch_var) {
-            return bad("pitch_var must lie in [0, 0.5)".into());
+        if self.dmax / ap > MAX_LAYERS {
+            return bad(format!(
+                "depth_max / ap = {:.0} roughing layers per pocket, more than {MAX_LAYERS}: raise ap",
+                self.dmax / ap
+            ));
         }
         if !(0.0 < self.rmin
             && self.rmin <= self.rmax
@@ -368,18 +365,6 @@ impl Settings {
                 "need 0 < radius_min <= radius_max and 2 radius_max + rib < 0.6 pitch (1 - pitch_var)"
                     .into(),
             );
-        }
-        if !(0.0..0.2).contains(&self.jitter) || !(-1.0..=1.0).contains(&self.skew) {
-            return bad("jitter must lie in [0, 0.2) and skew in [-1, 1]".into());
-        }
-        for (k, v) in [
-            ("islands", self.islands),
-            ("open", self.open),
-            ("grooves", self.grooves),
-        ] {
-            if !(0.0..=1.0).contains(&v) {
-                return bad(format!("{k} must lie in [0, 1]"));
-            }
         }
         Ok(())
     }
@@ -1012,8 +997,32 @@ fn assemble(mut b: Builder, lib: &ToolLibrary, name: String, comment: String) ->
 /// Generates a panel: geometry (grid, outer contour, pockets, ribs and flange, holes), tool
 /// selection of pocket roughing, precedence, assembly.
 pub fn generate(p: &Params, seed: u64) -> Result<Instance> {
+    check(p)?;
     let s = Settings::read(p)?;
     let lib = ToolLibrary::load(p.word("tools"))?;
+    build(s, lib, seed)
+}
+
+/// Checks what the declared ranges cannot (limits on the parameters' combination, the tool
+/// library); about how many cells the panel will have, at most.
+pub fn check(p: &Params) -> Result<u64> {
+    let s = Settings::read(p)?;
+    let lib = ToolLibrary::load(p.word("tools"))?;
+    if s.holes > 0 && lib.drill_for(s.hole_diameter).is_none() {
+        return bad(format!(
+            "holes need a drill of at most hole_diameter = {} mm in the tool library '{}'",
+            s.hole_diameter,
+            p.word("tools")
+        ));
+    }
+    let pockets = (s.rows * s.cols) as f64;
+    let layers = s.dmax / s.ap + 6.0;
+    let grid = 2.0 * ((s.rows + 1) * (s.cols + 1)) as f64;
+    Ok((pockets * layers + grid + s.holes as f64 + s.thickness / s.ap + 2.0) as u64)
+}
+
+/// The panel of checked settings `s` with tools from `lib`.
+fn build(s: Settings, lib: ToolLibrary, seed: u64) -> Result<Instance> {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let g = Grid::new(&s, &mut rng);
     let mut b = Builder {

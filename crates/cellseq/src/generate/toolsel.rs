@@ -9,6 +9,7 @@
 //! - roughing layer count N: nn = ⌊H / a_p⌋, N = nn if H − a_p·nn < δ, else nn + 1.
 
 use crate::error::{Error, Result};
+use crate::params::FloatRange;
 use geo::{Area, Buffer, MultiPolygon, Polygon};
 use serde::Deserialize;
 use std::path::Path;
@@ -73,6 +74,13 @@ impl ToolSpec {
     }
 }
 
+/// Diameters and widths of cut a library may give (mm): (0, 10⁴].
+pub const TOOL_SIZE: FloatRange = FloatRange::above(0.0, 1e4);
+/// Feeds per revolution a library may give (mm/rev): (0, 10³].
+pub const FEED_PER_REV: FloatRange = FloatRange::above(0.0, 1e3);
+/// Spindle speeds a library may give (rev/min): (0, 10⁶].
+pub const SPINDLE: FloatRange = FloatRange::above(0.0, 1e6);
+
 /// A tool library: end mills and drills, sorted by decreasing diameter.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ToolLibrary {
@@ -101,15 +109,24 @@ impl ToolLibrary {
             return Err(Error::invalid(file, "the tool library has no end mill"));
         }
         for (i, t) in tools.iter().enumerate() {
-            let ok = [t.diameter, t.cutting_width, t.feed, t.spindle]
-                .iter()
-                .all(|v| v.is_finite() && *v > 0.0);
-            if !ok {
+            for (key, v, range) in [
+                ("diameter", t.diameter, TOOL_SIZE),
+                ("cutting_width", t.cutting_width, TOOL_SIZE),
+                ("feed", t.feed, FEED_PER_REV),
+                ("spindle", t.spindle, SPINDLE),
+            ] {
+                range
+                    .check(&format!("tool '{}': {key}", t.id), v)
+                    .map_err(|m| Error::invalid(file, m))?;
+            }
+            if t.feed_rate() < crate::validate::MIN_FEED {
                 return Err(Error::invalid(
                     file,
                     format!(
-                        "tool '{}': diameter, cutting_width, feed and spindle must be positive",
-                        t.id
+                        "tool '{}': feed x spindle = {} mm/min, below the least feed {} mm/min",
+                        t.id,
+                        t.feed_rate(),
+                        crate::validate::MIN_FEED
                     ),
                 ));
             }
@@ -435,6 +452,29 @@ mod tests {
             "[[tool]]\nid=\"A\"\ndiameter=-1.0\ncutting_width=1.0\nfeed=1.0\nspindle=1.0\n",
         )
         .unwrap_err();
-        assert!(e.to_string().contains("positive"), "{e}");
+        assert!(
+            e.to_string()
+                .contains("tool 'A': diameter must be a finite number in (0, 10000]"),
+            "{e}"
+        );
+        for (key, v) in [
+            ("diameter", "1e300"),
+            ("cutting_width", "nan"),
+            ("feed", "inf"),
+            ("spindle", "1e7"),
+            ("spindle", "1e-9"),
+        ] {
+            let text =
+                "[[tool]]\nid=\"A\"\ndiameter=10.0\ncutting_width=1.0\nfeed=0.1\nspindle=1000.0\n"
+                    .replace(&format!("{key}="), &format!("{key}={v}\nx_"));
+            let text = text.replace("x_", "# ");
+            let e = ToolLibrary::parse("lib.toml", &text)
+                .unwrap_err()
+                .to_string();
+            assert!(
+                e.starts_with("lib.toml") && e.contains(key),
+                "{key}={v}: {e}"
+            );
+        }
     }
 }

@@ -17,25 +17,25 @@ pub static SPECS: &[ParamSpec] = &[
     ParamSpec {
         name: "n",
         default: "100",
-        kind: ParamKind::Int,
-        help: "number of cells",
+        kind: ParamKind::int(1, crate::params::MAX_CELLS),
+        help: "number of cells (about 1.5 KB of memory each once generated and saved)",
     },
     ParamSpec {
         name: "size",
         default: "1000",
-        kind: ParamKind::Float,
+        kind: ParamKind::float_above(0.0, 1e8),
         help: "side of the square box (mm)",
     },
     ParamSpec {
         name: "modes",
         default: "1",
-        kind: ParamKind::Int,
+        kind: ParamKind::int(1, 1000),
         help: "start points per closed cell",
     },
     ParamSpec {
         name: "closed",
         default: "0",
-        kind: ParamKind::Float,
+        kind: ParamKind::float(0.0, 1.0),
         help: "fraction of closed contours",
     },
     ParamSpec {
@@ -47,70 +47,85 @@ pub static SPECS: &[ParamSpec] = &[
     ParamSpec {
         name: "length",
         default: "20",
-        kind: ParamKind::Float,
+        kind: ParamKind::float(0.0, 1e6),
         help: "mean stroke length / contour radius (mm)",
     },
     ParamSpec {
         name: "tools",
         default: "1",
-        kind: ParamKind::Int,
+        kind: ParamKind::int(1, 10_000),
         help: "number of tools",
     },
     ParamSpec {
         name: "layers",
         default: "1",
-        kind: ParamKind::Int,
+        kind: ParamKind::int(1, 1_000_000),
         help: "number of depth layers",
     },
     ParamSpec {
         name: "density",
         default: "0",
-        kind: ParamKind::Float,
+        kind: ParamKind::float(0.0, 1.0),
         help: "probability of a precedence pair (n <= 5000)",
     },
     ParamSpec {
         name: "lift",
         default: "7",
-        kind: ParamKind::Float,
+        kind: ParamKind::float(0.0, 1e6),
         help: "height of the retract plane above the top layer (mm); 0 = plotter/laser-like travel with no vertical moves on the top layer",
     },
     ParamSpec {
         name: "preds",
         default: "0",
-        kind: ParamKind::Int,
+        kind: ParamKind::int(0, 1000),
         help: "random predecessors per cell (sparse precedence)",
     },
 ];
 
+/// Most modes a uniform instance may have in all (n × modes, open cells have 2): 10⁸.
+const MAX_MODES: u64 = 100_000_000;
+
+/// Most precedence pairs `preds` may draw in all (n × preds): 10⁸, 1.6 GB of pairs.
+const MAX_PAIRS: u64 = 100_000_000;
+
+/// Checks what the declared ranges cannot (limits on the parameters' combination); the
+/// number of cells the instance will have.
+pub fn check(p: &Params) -> Result<u64> {
+    let n = p.int("n");
+    let (modes, preds) = (p.int("modes"), p.int("preds"));
+    let bad = |m: String| Err(Error::Param(format!("uniform: {m}")));
+    if n.saturating_mul(modes.max(2)) > MAX_MODES {
+        return bad(format!(
+            "n x modes = {} modes, more than {MAX_MODES}: lower n or modes",
+            n.saturating_mul(modes.max(2))
+        ));
+    }
+    if n.saturating_mul(preds) > MAX_PAIRS {
+        return bad(format!(
+            "n x preds = {} precedence pairs, more than {MAX_PAIRS}: lower n or preds",
+            n.saturating_mul(preds)
+        ));
+    }
+    if p.float("density") > 0.0 && n > 5000 {
+        return bad("density is O(n^2): use preds=K for more than 5000 cells".into());
+    }
+    Ok(n)
+}
+
 /// Generates a uniform instance.
 pub fn generate(p: &Params, seed: u64) -> Result<Instance> {
+    check(p)?;
     let n = p.int("n") as usize;
     let size = p.float("size");
-    let modes = p.int("modes").max(1) as usize;
+    let modes = p.int("modes") as usize;
     let closed = p.float("closed");
     let reversible = p.bool("reversible");
     let len = p.float("length");
-    let ntools = p.int("tools").max(1) as usize;
-    let layers = p.int("layers").max(1) as u32;
+    let ntools = p.int("tools") as usize;
+    let layers = p.int("layers") as u32;
     let density = p.float("density");
     let preds = p.int("preds") as usize;
     let lift = p.float("lift");
-    let bad = |m: String| Err(Error::Param(format!("uniform: {m}")));
-    if n == 0 {
-        return bad("n must be at least 1".into());
-    }
-    if size.is_nan() || size <= 0.0 || len.is_nan() || len < 0.0 {
-        return bad("size must be positive and length non-negative".into());
-    }
-    if lift.is_nan() || lift < 0.0 {
-        return bad("lift must be non-negative".into());
-    }
-    if !(0.0..=1.0).contains(&closed) || !(0.0..=1.0).contains(&density) {
-        return bad("closed and density must lie in [0, 1]".into());
-    }
-    if density > 0.0 && n > 5000 {
-        return bad("density is O(n^2): use preds=K for more than 5000 cells".into());
-    }
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let step = 2.0;
     let tools: Vec<Tool> = (0..ntools)

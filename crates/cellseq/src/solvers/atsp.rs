@@ -38,7 +38,7 @@ start and end) is at most 0.001; notes/atsp.md has the measurements.",
         ParamSpec {
             name: "k",
             default: "8",
-            kind: ParamKind::Int,
+            kind: ParamKind::int(1, crate::params::MAX_NEIGHBOURS),
             help: "candidate successors and predecessors per cell",
         },
         ParamSpec {
@@ -50,7 +50,7 @@ start and end) is at most 0.001; notes/atsp.md has the measurements.",
         ParamSpec {
             name: "kick-len",
             default: "10",
-            kind: ParamKind::Int,
+            kind: ParamKind::int(1, crate::params::MAX_CELLS),
             help: "longest block of a kick (two adjacent blocks of 1..kick-len cells swap places)",
         },
         ParamSpec {
@@ -68,20 +68,20 @@ start and end) is at most 0.001; notes/atsp.md has the measurements.",
         ParamSpec {
             name: "ap-max-cells",
             default: "3000",
-            kind: ParamKind::Int,
+            kind: ParamKind::int(0, 20_000),
             help: "above this many cells no assignment is solved (O(n^3)): greedy start and nearest-cost candidates",
         },
     ],
     caps: Caps { ..Caps::NONE },
     build: Build::Fresh(|p: &Params| {
         Ok(Box::new(Atsp {
-            k: p.int("k").max(1) as usize,
+            k: p.int("k") as usize,
             rank: if p.word("cand") == "raw" {
                 Rank::Raw
             } else {
                 Rank::Reduced
             },
-            kick_len: p.int("kick-len").max(1) as usize,
+            kick_len: p.int("kick-len") as usize,
             ap_max_cells: p.int("ap-max-cells") as usize,
             far: p.word("kick") == "far",
             greedy_patch: p.word("patch") == "greedy",

@@ -5,13 +5,12 @@
 use super::{DEFAULT_SOLVER, SolverInfo, registry};
 use crate::params::ParamKind;
 
-
-/// A parameter kind as the listings show it: `int`, `float`, `bool`, `text`, or the choices
-/// joined by `|`.
+/// A parameter kind as the listings show it: `int` or `float` with the range it accepts
+/// (`int [1, 1000]`, `float (0, 1]`), `bool`, `text`, or the choices joined by `|`.
 pub fn kind_label(kind: &ParamKind) -> String {
     match kind {
-        ParamKind::Int => "int".to_string(),
-        ParamKind::Float => "float".to_string(),
+        ParamKind::Int(r) => format!("int {r}"),
+        ParamKind::Float(r) => format!("float {r}"),
         ParamKind::Bool => "bool".to_string(),
         ParamKind::Choice(c) => c.join("|"),
         ParamKind::Text => "text".to_string(),

@@ -37,21 +37,21 @@ search until the budget. Other instances get `local-search`. Details: \
         ParamSpec {
             name: "k",
             default: "10",
-            kind: ParamKind::Int,
+            kind: ParamKind::int(1, crate::params::MAX_NEIGHBOURS),
             help: "candidate neighbours per stroke",
         },
         ParamSpec {
             name: "kick-len",
             default: "30",
-            kind: ParamKind::Int,
+            kind: ParamKind::int(2, crate::params::MAX_CELLS),
             help: "longest block moved by an iterated-local-search kick",
         },
     ],
     caps: Caps { ..Caps::NONE },
     build: Build::Fresh(|p: &Params| {
         Ok(Box::new(Drawing {
-            k: p.int("k").max(1) as usize,
-            kick_len: p.int("kick-len").max(2) as usize,
+            k: p.int("k") as usize,
+            kick_len: p.int("kick-len") as usize,
         }))
     }),
 };

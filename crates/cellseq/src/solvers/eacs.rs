@@ -57,19 +57,19 @@ solution. Each ant's local optimum is recombined with the best by partition cros
         ParamSpec {
             name: "ls-band",
             default: "10",
-            kind: ParamKind::Float,
+            kind: ParamKind::float(0.0, 1000.0),
             help: "local search on ants whose constructed cost is within this relative band above the best",
         },
         ParamSpec {
             name: "reset",
             default: "0",
-            kind: ParamKind::Int,
+            kind: ParamKind::int(0, crate::params::MAX_ITERATIONS),
             help: "reset the pheromone after this many iterations without a new best (0 = never)",
         },
         ParamSpec {
             name: "stall",
             default: "2000",
-            kind: ParamKind::Int,
+            kind: ParamKind::int(1, crate::params::MAX_ITERATIONS),
             help: "stop after this many iterations without a new best when no budget is set",
         },
         ParamSpec {
@@ -87,7 +87,7 @@ solution. Each ant's local optimum is recombined with the best by partition cros
         ParamSpec {
             name: "k",
             default: "12",
-            kind: ParamKind::Int,
+            kind: ParamKind::int(1, crate::params::MAX_NEIGHBOURS),
             help: "candidate neighbours per cell (Or-opt)",
         },
         ParamSpec {
@@ -113,15 +113,15 @@ solution. Each ant's local optimum is recombined with the best by partition cros
 /// Builds the solver from validated parameters.
 pub fn from_params(p: &Params) -> Eacs {
     Eacs {
-        ants: p.int("ants").max(1) as usize,
+        ants: p.int("ants") as usize,
         beta: p.float("beta"),
-        s: p.float("s").max(0.0),
-        rho: p.float("rho").clamp(0.0, 1.0),
-        phi: p.float("phi").clamp(0.0, 1.0),
-        ls_band: p.float("ls-band").max(0.0),
+        s: p.float("s"),
+        rho: p.float("rho"),
+        phi: p.float("phi"),
+        ls_band: p.float("ls-band"),
         reset: p.int("reset"),
-        stall: p.int("stall").max(1),
-        k: p.int("k").max(1) as usize,
+        stall: p.int("stall"),
+        k: p.int("k") as usize,
         two_opt: p.bool("two-opt"),
         two_way: p.bool("two-way"),
         lk: p.switch("lk"),

@@ -18,13 +18,13 @@ else gets `greedy`. On uniform strokes it reaches 0.91–0.93 × greedy's air le
     params: &[ParamSpec {
         name: "k",
         default: "8",
-        kind: ParamKind::Int,
+        kind: ParamKind::int(1, crate::params::MAX_NEIGHBOURS),
         help: "candidate successors per cell",
     }],
     caps: Caps { ..Caps::NONE },
     build: Build::Fresh(|p: &Params| {
         Ok(Box::new(GreedyEdge {
-            k: p.int("k").max(1) as usize,
+            k: p.int("k") as usize,
         }))
     }),
 };

@@ -28,13 +28,13 @@ error rather than started.",
         ParamSpec {
             name: "memory_mb",
             default: "4096",
-            kind: ParamKind::Int,
+            kind: ParamKind::int(1, crate::params::MAX_MEMORY_MB),
             help: "refuse when the DP tables would need more than this many MiB",
         },
         ParamSpec {
             name: "max_cells",
             default: "128",
-            kind: ParamKind::Int,
+            kind: ParamKind::int(1, 128),
             help: "refuse instances with more cells (the subset bitset holds at most 128)",
         },
     ],
@@ -45,7 +45,7 @@ error rather than started.",
     build: Build::Fresh(|p: &Params| {
         Ok(Box::new(Exact {
             memory_mb: p.int("memory_mb"),
-            max_cells: p.int("max_cells").min(128) as usize,
+            max_cells: p.int("max_cells") as usize,
         }))
     }),
 };

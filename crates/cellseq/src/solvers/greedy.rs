@@ -18,7 +18,7 @@ multi-start solvers.",
     params: &[ParamSpec {
         name: "randomize",
         default: "0",
-        kind: ParamKind::Float,
+        kind: ParamKind::float(0.0, 1.0),
         help: "probability of taking the second-best candidate at a step (0 = pure greedy)",
     }],
     caps: Caps { ..Caps::NONE },

@@ -21,13 +21,13 @@ it is what `local-search` starts from on geometric instances with precedence.",
     params: &[ParamSpec {
         name: "k",
         default: "8",
-        kind: ParamKind::Int,
+        kind: ParamKind::int(1, crate::params::MAX_NEIGHBOURS),
         help: "feasible places next to nearby inserted cells to try per cell (geometric instances)",
     }],
     caps: Caps { ..Caps::NONE },
     build: Build::Fresh(|p: &Params| {
         Ok(Box::new(Insertion {
-            k: p.int("k").max(1) as usize,
+            k: p.int("k") as usize,
         }))
     }),
 };

@@ -46,19 +46,19 @@ reaches 0.78 × greedy's air in 10 s; with sparse precedence, from the insertion
         ParamSpec {
             name: "k",
             default: "10",
-            kind: ParamKind::Int,
+            kind: ParamKind::int(1, crate::params::MAX_NEIGHBOURS),
             help: "candidate neighbours per cell",
         },
         ParamSpec {
             name: "kicks",
             default: "30",
-            kind: ParamKind::Int,
+            kind: ParamKind::int(0, crate::params::MAX_ITERATIONS),
             help: "iterated VND: stop after this many non-improving kicks (runs until the budget when one is set; 0 = plain VND)",
         },
         ParamSpec {
             name: "strength",
             default: "3",
-            kind: ParamKind::Int,
+            kind: ParamKind::int(1, 100_000),
             help: "random feasible Or-opt moves per kick",
         },
         ParamSpec {
@@ -76,13 +76,13 @@ reaches 0.78 × greedy's air in 10 s; with sparse precedence, from the insertion
         ParamSpec {
             name: "kick-block",
             default: "30",
-            kind: ParamKind::Int,
+            kind: ParamKind::int(1, crate::params::MAX_CELLS),
             help: "two-level search: longest block of a local double-bridge kick",
         },
         ParamSpec {
             name: "walk-kicks",
             default: "0",
-            kind: ParamKind::Float,
+            kind: ParamKind::float(0.0, 1.0),
             help: "two-level search without precedence: share of the kicks that are random-walk double bridges (cut points a few candidate-list hops apart in the plane, far apart along the path), the rest local ones",
         },
         ParamSpec {
@@ -94,7 +94,7 @@ reaches 0.78 × greedy's air in 10 s; with sparse precedence, from the insertion
         ParamSpec {
             name: "max-block",
             default: "0",
-            kind: ParamKind::Int,
+            kind: ParamKind::int(0, crate::params::MAX_CELLS),
             help: "longest block of SOP-3-exchange (0 = n up to 120 cells, 64 up to 5000, else 8)",
         },
     ],
@@ -104,16 +104,16 @@ reaches 0.78 × greedy's air in 10 s; with sparse precedence, from the insertion
     },
     build: Build::Fresh(|p: &Params| {
         let kicks = p.int("kicks");
-        let strength = p.int("strength").max(1) as usize;
+        let strength = p.int("strength") as usize;
         Ok(Box::new(LocalSearch {
             kicks,
             strength,
-            k: p.int("k").max(1) as usize,
-            max_block: p.int("max-block").min(u32::MAX as u64) as usize,
+            k: p.int("k") as usize,
+            max_block: p.int("max-block") as usize,
             vnd: p.bool("vnd"),
             two_level: p.switch("two-level"),
-            kick_block: p.int("kick-block").max(1) as usize,
-            walk_kicks: p.float("walk-kicks").clamp(0.0, 1.0),
+            kick_block: p.int("kick-block") as usize,
+            walk_kicks: p.float("walk-kicks"),
             three_opt: p.bool("three-opt"),
         }))
     }),

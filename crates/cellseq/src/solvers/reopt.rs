@@ -41,6 +41,10 @@ use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::time::Duration;
 
+/// Largest window: a window with the fixed cells either side is an instance `beam` takes
+/// ([`super::beam::MAX_CELLS`] cells).
+const MAX_WINDOW: u64 = super::beam::MAX_CELLS as u64 - 2;
+
 /// Registry entry.
 pub static INFO: SolverInfo = SolverInfo {
     name: "reopt",
@@ -56,31 +60,31 @@ the built-in portfolio's `sparse` rule, from the best so far. On rbg323a it turn
         ParamSpec {
             name: "window",
             default: "40",
-            kind: ParamKind::Int,
+            kind: ParamKind::int(2, MAX_WINDOW),
             help: "cells per window at the first sweep (windows grow by a quarter after a sweep without a gain)",
         },
         ParamSpec {
             name: "step",
             default: "0",
-            kind: ParamKind::Int,
+            kind: ParamKind::int(0, crate::params::MAX_CELLS),
             help: "positions between the starts of two windows of a sweep (0: a quarter of a window)",
         },
         ParamSpec {
             name: "window-share",
             default: "0.1",
-            kind: ParamKind::Float,
+            kind: ParamKind::float_above(0.0, 1.0),
             help: "most of the budget that one window's search may use",
         },
         ParamSpec {
             name: "max-window",
             default: "200",
-            kind: ParamKind::Int,
+            kind: ParamKind::int(2, MAX_WINDOW),
             help: "windows grow up to this many cells; a sweep at this size without a gain ends the run",
         },
         ParamSpec {
             name: "k",
             default: "12",
-            kind: ParamKind::Int,
+            kind: ParamKind::int(1, crate::params::MAX_NEIGHBOURS),
             help: "candidate neighbours per cell of the VND that polishes a gain",
         },
     ],
@@ -94,11 +98,11 @@ the built-in portfolio's `sparse` rule, from the best so far. On rbg323a it turn
 /// Builds the solver from validated parameters.
 pub fn from_params(p: &Params) -> Reopt {
     Reopt {
-        window: p.int("window").max(2) as usize,
+        window: p.int("window") as usize,
         step: p.int("step") as usize,
-        window_share: p.float("window-share").clamp(1e-6, 1.0),
-        max_window: (p.int("max-window") as usize).clamp(2, super::beam::MAX_CELLS - 2),
-        k: p.int("k").max(1) as usize,
+        window_share: p.float("window-share"),
+        max_window: p.int("max-window") as usize,
+        k: p.int("k") as usize,
     }
 }
 

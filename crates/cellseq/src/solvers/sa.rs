@@ -47,37 +47,37 @@ pub static SPECS: &[ParamSpec] = &[
     ParamSpec {
         name: "chain",
         default: "20",
-        kind: ParamKind::Float,
+        kind: ParamKind::float(0.01, 1e6),
         help: "Markov chain length L per temperature, times n",
     },
     ParamSpec {
         name: "alpha",
         default: "0.97",
-        kind: ParamKind::Float,
+        kind: ParamKind::float_open(0.0, 1.0),
         help: "geometric cooling factor per chain",
     },
     ParamSpec {
         name: "accept0",
         default: "0.3",
-        kind: ParamKind::Float,
+        kind: ParamKind::float_open(0.0, 1.0),
         help: "initial acceptance probability of an average worsening move",
     },
     ParamSpec {
         name: "stall",
         default: "40",
-        kind: ParamKind::Int,
+        kind: ParamKind::int(1, crate::params::MAX_ITERATIONS),
         help: "stop a run after this many chains without a new best",
     },
     ParamSpec {
         name: "max-chains",
         default: "2000",
-        kind: ParamKind::Int,
+        kind: ParamKind::int(1, crate::params::MAX_ITERATIONS),
         help: "chains per run at most",
     },
     ParamSpec {
         name: "reheats",
         default: "3",
-        kind: ParamKind::Int,
+        kind: ParamKind::int(0, crate::params::MAX_ITERATIONS),
         help: "re-annealing runs from the best after a run stops (unlimited while a budget is set)",
     },
     ParamSpec {
@@ -125,11 +125,11 @@ impl Anneal {
     /// Reads the [`SPECS`] parameters.
     pub fn from_params(p: &Params) -> Self {
         Anneal {
-            chain: p.float("chain").max(0.01),
-            alpha: p.float("alpha").clamp(0.0, 0.9999),
-            accept0: p.float("accept0").clamp(1e-6, 0.999),
-            stall: p.int("stall").max(1),
-            max_chains: p.int("max-chains").max(1),
+            chain: p.float("chain"),
+            alpha: p.float("alpha"),
+            accept0: p.float("accept0"),
+            stall: p.int("stall"),
+            max_chains: p.int("max-chains"),
             reheats: p.int("reheats"),
             closed: p.word("eval") == "closed",
         }

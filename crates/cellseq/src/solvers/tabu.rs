@@ -30,31 +30,31 @@ moved cell stays tabu for `tenure` iterations. Starts: every ready start cell an
         ParamSpec {
             name: "tenure",
             default: "0",
-            kind: ParamKind::Int,
+            kind: ParamKind::int(0, crate::params::MAX_CELLS),
             help: "iterations a moved cell stays tabu (0 = 5 + n/20)",
         },
         ParamSpec {
             name: "iters",
             default: "3000",
-            kind: ParamKind::Int,
+            kind: ParamKind::int(1, crate::params::MAX_ITERATIONS),
             help: "iterations per start at most",
         },
         ParamSpec {
             name: "stall",
             default: "400",
-            kind: ParamKind::Int,
+            kind: ParamKind::int(1, crate::params::MAX_ITERATIONS),
             help: "stop a start after this many iterations without a new best",
         },
         ParamSpec {
             name: "starts",
             default: "8",
-            kind: ParamKind::Int,
+            kind: ParamKind::int(1, 1_000_000),
             help: "starts at most (every ready start cell/mode first, then randomized greedy)",
         },
         ParamSpec {
             name: "k",
             default: "10",
-            kind: ParamKind::Int,
+            kind: ParamKind::int(1, crate::params::MAX_NEIGHBOURS),
             help: "candidate neighbours per cell",
         },
     ],
@@ -66,9 +66,9 @@ moved cell stays tabu for `tenure` iterations. Starts: every ready start cell an
         Ok(Box::new(Tabu {
             tenure: p.int("tenure") as usize,
             iters: p.int("iters"),
-            stall: p.int("stall").max(1),
-            starts: p.int("starts").max(1) as usize,
-            k: p.int("k").max(1) as usize,
+            stall: p.int("stall"),
+            starts: p.int("starts") as usize,
+            k: p.int("k") as usize,
         }))
     }),
 };

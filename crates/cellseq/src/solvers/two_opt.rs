@@ -17,7 +17,7 @@ change mode).",
     params: &[ParamSpec {
         name: "k",
         default: "10",
-        kind: ParamKind::Int,
+        kind: ParamKind::int(1, crate::params::MAX_NEIGHBOURS),
         help: "candidate neighbours per cell",
     }],
     caps: Caps {
@@ -26,7 +26,7 @@ change mode).",
     },
     build: Build::Fresh(|p: &Params| {
         Ok(Box::new(TwoOpt {
-            k: p.int("k").max(1) as usize,
+            k: p.int("k") as usize,
         }))
     }),
 };

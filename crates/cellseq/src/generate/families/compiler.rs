@@ -10,7 +10,7 @@
 //! after write on registers, the condition flags and memory. The dependence graph is sparse
 //! and not transitively closed; costs are integers in 0..=32 and symmetric.
 
-use super::{check_matrix_n, n_spec, sop_shaped};
+use super::{n_spec, sop_shaped};
 use crate::error::{Error, Result};
 use crate::model::Instance;
 use crate::params::{ParamKind, ParamSpec, Params};
@@ -20,23 +20,23 @@ use std::collections::BTreeSet;
 
 /// Parameters.
 pub static SPECS: &[ParamSpec] = &[
-    n_spec("200"),
+    n_spec("200", super::MAX_N),
     ParamSpec {
         name: "regs",
         default: "13",
-        kind: ParamKind::Int,
+        kind: ParamKind::int(2, 16),
         help: "general registers the block uses (2..=16)",
     },
     ParamSpec {
         name: "chains",
         default: "3",
-        kind: ParamKind::Int,
+        kind: ParamKind::int(1, 16),
         help: "independent computations interleaved in the block, each with its own registers (1..=regs)",
     },
     ParamSpec {
         name: "mem",
         default: "0.3",
-        kind: ParamKind::Float,
+        kind: ParamKind::float(0.0, 1.0),
         help: "share of loads and stores (a third of them stores)",
     },
 ];
@@ -209,28 +209,24 @@ fn dependences(block: &[Insn]) -> Vec<(usize, usize)> {
     edges.into_iter().collect()
 }
 
-/// Generates a `compiler-dag` instance.
-pub fn generate(p: &Params, seed: u64) -> Result<Instance> {
-    let n = p.int("n") as usize;
-    check_matrix_n("compiler-dag", n, 1)?;
-    let regs = p.int("regs");
-    let mem = p.float("mem");
-    if !(2..=16).contains(&regs) {
-        return Err(Error::Param(format!(
-            "compiler-dag: regs must lie in 2..=16, got {regs}"
-        )));
-    }
-    if !(0.0..=1.0).contains(&mem) {
-        return Err(Error::Param(format!(
-            "compiler-dag: mem must lie in [0, 1], got {mem}"
-        )));
-    }
-    let chains = p.int("chains");
-    if chains == 0 || chains > regs {
+/// Checks the parameters together (`chains` ≤ `regs`); the number of cells.
+pub fn check(p: &Params) -> Result<u64> {
+    let (regs, chains) = (p.int("regs"), p.int("chains"));
+    if chains > regs {
         return Err(Error::Param(format!(
             "compiler-dag: chains must lie in 1..=regs ({regs}), got {chains}"
         )));
     }
+    Ok(p.int("n") + 2)
+}
+
+/// Generates a `compiler-dag` instance.
+pub fn generate(p: &Params, seed: u64) -> Result<Instance> {
+    check(p)?;
+    let n = p.int("n") as usize;
+    let regs = p.int("regs");
+    let mem = p.float("mem");
+    let chains = p.int("chains");
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let mut g = Gen {
         rng: &mut rng,

@@ -2,8 +2,8 @@
 //! with sparse precedence, 10³–10⁵ cells) and `generalized` (a matrix instance whose cells
 //! have several modes).
 
-use super::{check_matrix_n, check_p, dag::random_dag, n_spec, p_spec, sop_shaped};
-use crate::error::{Error, Result};
+use super::{check_matrix_n, dag::random_dag, n_spec, p_spec, sop_shaped};
+use crate::error::Result;
 use crate::generate::common::{programmed_order, pt};
 use crate::model::{Cell, Instance, Machine, Mode, StepKind, Tool};
 use crate::params::{ParamKind, ParamSpec, Params};
@@ -13,59 +13,59 @@ use std::f64::consts::TAU;
 
 /// `geometric-sparse` parameters.
 pub static GEOMETRIC_SPECS: &[ParamSpec] = &[
-    n_spec("1000"),
+    n_spec("1000", 1_000_000),
     ParamSpec {
         name: "size",
         default: "1000",
-        kind: ParamKind::Float,
+        kind: ParamKind::float(100.0, 1e8),
         help: "side of the square part (mm)",
     },
     ParamSpec {
         name: "layers",
         default: "3",
-        kind: ParamKind::Int,
+        kind: ParamKind::int(1, 20),
         help: "most roughing layers of a pocket (each pocket has 1..=layers)",
     },
     ParamSpec {
         name: "modes",
         default: "4",
-        kind: ParamKind::Int,
+        kind: ParamKind::int(1, 16),
         help: "start points per closed contour",
     },
     ParamSpec {
         name: "holes",
         default: "0.3",
-        kind: ParamKind::Float,
+        kind: ParamKind::float(0.0, 1.0),
         help: "share of features that are holes (spot drill, then drill)",
     },
 ];
 
 /// `generalized` parameters.
 pub static GENERALIZED_SPECS: &[ParamSpec] = &[
-    n_spec("100"),
+    n_spec("100", super::MAX_N),
     ParamSpec {
         name: "c",
         default: "1000",
-        kind: ParamKind::Int,
+        kind: ParamKind::int(1, 1_000_000),
         help: "side of the square the nodes lie in; costs are rounded distances",
     },
     p_spec("15"),
     ParamSpec {
         name: "modes",
         default: "4",
-        kind: ParamKind::Int,
+        kind: ParamKind::int(1, 64),
         help: "most modes (nodes) per cell; each cell has 1..=modes",
     },
     ParamSpec {
         name: "spread",
         default: "5",
-        kind: ParamKind::Float,
+        kind: ParamKind::float(0.0, 100.0),
         help: "a cell's nodes lie within spread % of c of its centre",
     },
     ParamSpec {
         name: "open",
         default: "0",
-        kind: ParamKind::Float,
+        kind: ParamKind::float(0.0, 1.0),
         help: "share of cells that are open features: two modes, entered at one end and left at the other (asymmetric costs)",
     },
 ];
@@ -97,19 +97,7 @@ pub fn geometric_sparse(p: &Params, seed: u64) -> Result<Instance> {
     let layers = p.int("layers");
     let modes = p.int("modes") as usize;
     let holes = p.float("holes");
-    let bad = |m: String| Err(Error::Param(format!("geometric-sparse: {m}")));
-    if n == 0 || n > 1_000_000 {
-        return bad(format!("n must lie in 1..=1000000, got {n}"));
-    }
-    if !(size.is_finite() && size >= 100.0) {
-        return bad(format!("size must be at least 100 mm, got {size}"));
-    }
-    if !(1..=20).contains(&layers) || !(1..=16).contains(&modes) {
-        return bad("layers must lie in 1..=20 and modes in 1..=16".into());
-    }
-    if !(0.0..=1.0).contains(&holes) {
-        return bad(format!("holes must lie in [0, 1], got {holes}"));
-    }
+    // every parameter lies in its declared range (checked by `Params`)
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let mut cells: Vec<Cell> = Vec::with_capacity(n);
     let mut precedence = Vec::new();
@@ -206,6 +194,19 @@ pub fn geometric_sparse(p: &Params, seed: u64) -> Result<Instance> {
     })
 }
 
+/// Checks `generalized`'s parameters together (the matrix's size depends on n and modes);
+/// the number of cells.
+pub fn generalized_check(p: &Params) -> Result<u64> {
+    let (n, modes) = (p.int("n") as usize, p.int("modes") as usize);
+    let most = if p.float("open") > 0.0 {
+        modes.max(2)
+    } else {
+        modes
+    };
+    check_matrix_n("generalized", n, most)?;
+    Ok(n as u64 + 2)
+}
+
 /// `generalized`: cells of 1..=modes nodes each, the nodes of a cell near its centre in a
 /// square of side c; costs are rounded distances between nodes; precedence of closure
 /// density p %. SOP-shaped (dummy start and end cells). With `open` > 0 that share of the
@@ -213,34 +214,13 @@ pub fn geometric_sparse(p: &Params, seed: u64) -> Result<Instance> {
 /// stroke cut one way or the other, so a mode is entered at one end and left at the other
 /// and the cost of u then v is the distance from u's exit to v's entry (asymmetric).
 pub fn generalized(p: &Params, seed: u64) -> Result<Instance> {
+    generalized_check(p)?;
     let n = p.int("n") as usize;
     let modes = p.int("modes") as usize;
     let open = p.float("open");
-    if !(1..=64).contains(&modes) {
-        return Err(Error::Param(format!(
-            "generalized: modes must lie in 1..=64, got {modes}"
-        )));
-    }
-    if !(0.0..=1.0).contains(&open) {
-        return Err(Error::Param(format!(
-            "generalized: open is a share in 0..=1, got {open}"
-        )));
-    }
-    let most = if open > 0.0 { modes.max(2) } else { modes };
-    check_matrix_n("generalized", n, most)?;
     let c = p.int("c");
-    if c == 0 || c > 1_000_000 {
-        return Err(Error::Param(format!(
-            "generalized: c must lie in 1..=1000000, got {c}"
-        )));
-    }
-    let density = check_p("generalized", p.float("p"))?;
+    let density = p.float("p") / 100.0;
     let spread = p.float("spread");
-    if !(0.0..=100.0).contains(&spread) {
-        return Err(Error::Param(format!(
-            "generalized: spread is a percentage in 0..=100, got {spread}"
-        )));
-    }
     let side = c as f64;
     let radius = spread / 100.0 * side;
     let mut rng = ChaCha8Rng::seed_from_u64(seed);

@@ -1,6 +1,6 @@
 //! Random matrix families: `random-sop`, `atsp`, `symmetric`, `near-symmetric`.
 
-use super::{C_SPEC, check_matrix_n, check_p, dag::random_dag, n_spec, p_spec, sop_shaped};
+use super::{C_SPEC, dag::random_dag, n_spec, p_spec, sop_shaped};
 use crate::error::{Error, Result};
 use crate::model::Instance;
 use crate::params::{ParamKind, ParamSpec, Params};
@@ -8,11 +8,11 @@ use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 /// `random-sop` parameters.
-pub static RANDOM_SOP_SPECS: &[ParamSpec] = &[n_spec("200"), C_SPEC, p_spec("15")];
+pub static RANDOM_SOP_SPECS: &[ParamSpec] = &[n_spec("200", super::MAX_N), C_SPEC, p_spec("15")];
 
 /// `atsp` parameters.
 pub static ATSP_SPECS: &[ParamSpec] = &[
-    n_spec("200"),
+    n_spec("200", super::MAX_N),
     C_SPEC,
     ParamSpec {
         name: "class",
@@ -23,17 +23,17 @@ pub static ATSP_SPECS: &[ParamSpec] = &[
 ];
 
 /// `symmetric` parameters.
-pub static SYMMETRIC_SPECS: &[ParamSpec] = &[n_spec("200"), C_SPEC, p_spec("0")];
+pub static SYMMETRIC_SPECS: &[ParamSpec] = &[n_spec("200", super::MAX_N), C_SPEC, p_spec("0")];
 
 /// `near-symmetric` parameters.
 pub static NEAR_SYMMETRIC_SPECS: &[ParamSpec] = &[
-    n_spec("200"),
+    n_spec("200", super::MAX_N),
     C_SPEC,
     p_spec("0"),
     ParamSpec {
         name: "asym",
         default: "5",
-        kind: ParamKind::Float,
+        kind: ParamKind::float(0.0, 100.0),
         help: "asymmetric part: each arc adds an integer uniform in [0, asym % of c]",
     },
 ];
@@ -64,23 +64,11 @@ fn symmetric_costs(n: usize, c: u64, rng: &mut ChaCha8Rng) -> Vec<f64> {
     m
 }
 
-/// The `c` parameter, refused outside 1..=1 000 000.
-pub(crate) fn cost_range(kind: &str, p: &Params) -> Result<u64> {
-    let c = p.int("c");
-    if c == 0 || c > 1_000_000 {
-        return Err(Error::Param(format!(
-            "{kind}: c must lie in 1..=1000000, got {c}"
-        )));
-    }
-    Ok(c)
-}
-
 /// `random-sop`: asymmetric costs uniform in [0, c], precedence of closure density p %.
 pub fn random_sop(p: &Params, seed: u64) -> Result<Instance> {
     let n = p.int("n") as usize;
-    check_matrix_n("random-sop", n, 1)?;
-    let c = cost_range("random-sop", p)?;
-    let density = check_p("random-sop", p.float("p"))?;
+    let c = p.int("c");
+    let density = p.float("p") / 100.0;
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let m = uniform_costs(n, c, &mut rng);
     let edges = random_dag(n, density, &mut rng);
@@ -88,17 +76,23 @@ pub fn random_sop(p: &Params, seed: u64) -> Result<Instance> {
     Ok(sop_shaped(name, &vec![1; n], |u, v| m[u * n + v], &edges))
 }
 
-/// `atsp`: no precedence; `amat` costs uniform in [0, c], `tmat` their shortest-path closure.
-pub fn atsp(p: &Params, seed: u64) -> Result<Instance> {
-    let n = p.int("n") as usize;
-    check_matrix_n("atsp", n, 1)?;
-    let c = cost_range("atsp", p)?;
-    let class = p.word("class").to_string();
-    if class == "tmat" && n > 2000 {
+/// Checks `atsp`'s parameters together (`tmat` is O(n³)); the number of cells.
+pub fn atsp_check(p: &Params) -> Result<u64> {
+    let n = p.int("n");
+    if p.word("class") == "tmat" && n > 2000 {
         return Err(Error::Param(format!(
             "atsp: class=tmat is O(n^3): n must be at most 2000, got {n}"
         )));
     }
+    Ok(n + 2)
+}
+
+/// `atsp`: no precedence; `amat` costs uniform in [0, c], `tmat` their shortest-path closure.
+pub fn atsp(p: &Params, seed: u64) -> Result<Instance> {
+    atsp_check(p)?;
+    let n = p.int("n") as usize;
+    let c = p.int("c");
+    let class = p.word("class").to_string();
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let mut m = uniform_costs(n, c, &mut rng);
     if class == "tmat" {
@@ -122,9 +116,8 @@ pub fn atsp(p: &Params, seed: u64) -> Result<Instance> {
 /// `symmetric`: symmetric costs uniform in [0, c], precedence of closure density p %.
 pub fn symmetric(p: &Params, seed: u64) -> Result<Instance> {
     let n = p.int("n") as usize;
-    check_matrix_n("symmetric", n, 1)?;
-    let c = cost_range("symmetric", p)?;
-    let density = check_p("symmetric", p.float("p"))?;
+    let c = p.int("c");
+    let density = p.float("p") / 100.0;
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let m = symmetric_costs(n, c, &mut rng);
     let edges = random_dag(n, density, &mut rng);
@@ -135,15 +128,9 @@ pub fn symmetric(p: &Params, seed: u64) -> Result<Instance> {
 /// `near-symmetric`: symmetric costs plus an asymmetric part in [0, asym % of c].
 pub fn near_symmetric(p: &Params, seed: u64) -> Result<Instance> {
     let n = p.int("n") as usize;
-    check_matrix_n("near-symmetric", n, 1)?;
-    let c = cost_range("near-symmetric", p)?;
-    let density = check_p("near-symmetric", p.float("p"))?;
+    let c = p.int("c");
+    let density = p.float("p") / 100.0;
     let asym = p.float("asym");
-    if !(0.0..=100.0).contains(&asym) {
-        return Err(Error::Param(format!(
-            "near-symmetric: asym is a percentage in 0..=100, got {asym}"
-        )));
-    }
     let top = (asym / 100.0 * c as f64).round() as u64;
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let mut m = symmetric_costs(n, c, &mut rng);

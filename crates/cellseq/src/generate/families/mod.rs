@@ -33,12 +33,15 @@ use crate::precedence::{Dag, topological_order};
 /// Largest number of matrix nodes a family generates (a matrix of 5000 nodes takes 200 MB).
 pub const MAX_MATRIX_NODES: usize = 5000;
 
-/// The `n` parameter (free cells) with a default.
-pub(crate) const fn n_spec(default: &'static str) -> ParamSpec {
+/// Largest `n` of a matrix family: [`MAX_MATRIX_NODES`] less the dummy start and end cells.
+pub const MAX_N: u64 = MAX_MATRIX_NODES as u64 - 2;
+
+/// The `n` parameter (free cells) with a default, in `1..=max`.
+pub(crate) const fn n_spec(default: &'static str, max: u64) -> ParamSpec {
     ParamSpec {
         name: "n",
         default,
-        kind: ParamKind::Int,
+        kind: ParamKind::int(1, max),
         help: "number of cells (matrix families add a dummy start and end cell)",
     }
 }
@@ -47,7 +50,7 @@ pub(crate) const fn n_spec(default: &'static str) -> ParamSpec {
 pub(crate) const C_SPEC: ParamSpec = ParamSpec {
     name: "c",
     default: "100",
-    kind: ParamKind::Int,
+    kind: ParamKind::int(1, 1_000_000),
     help: "costs are integers in [0, c]",
 };
 
@@ -56,12 +59,13 @@ pub(crate) const fn p_spec(default: &'static str) -> ParamSpec {
     ParamSpec {
         name: "p",
         default,
-        kind: ParamKind::Float,
+        kind: ParamKind::float(0.0, 100.0),
         help: "precedence closure density in percent of the n(n-1)/2 pairs of free cells (0..=100)",
     }
 }
 
-/// Refuses a matrix family's `n` outside 1..=[`MAX_MATRIX_NODES`] − 2.
+/// Refuses a matrix family whose `n` cells of up to `nodes_per_cell` nodes each (and the two
+/// dummies) make more than [`MAX_MATRIX_NODES`] nodes.
 pub(crate) fn check_matrix_n(kind: &str, n: usize, nodes_per_cell: usize) -> Result<()> {
     let nodes = n.saturating_mul(nodes_per_cell).saturating_add(2);
     if n == 0 || nodes > MAX_MATRIX_NODES {
@@ -73,14 +77,10 @@ pub(crate) fn check_matrix_n(kind: &str, n: usize, nodes_per_cell: usize) -> Res
     Ok(())
 }
 
-/// Refuses a density outside 0..=100 %.
-pub(crate) fn check_p(kind: &str, p: f64) -> Result<f64> {
-    if !(0.0..=100.0).contains(&p) {
-        return Err(Error::Param(format!(
-            "{kind}: p is a percentage in 0..=100, got {p}"
-        )));
-    }
-    Ok(p / 100.0)
+/// The number of cells of a family instance whose parameters need no check beyond their
+/// ranges: `n`, plus the two dummies of a matrix family (`dummies`).
+pub(crate) fn cells_of(p: &crate::params::Params, dummies: u64) -> Result<u64> {
+    Ok(p.int("n") + dummies)
 }
 
 /// Builds an SOP-shaped matrix instance: a dummy start cell 0, the free cells 1..=n (free

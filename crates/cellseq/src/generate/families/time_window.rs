@@ -10,7 +10,7 @@
 //! `random-sop`, whose dense precedence is a random DAG over uniform costs, the orders here
 //! come in overlapping windows of about `w` jobs, and nearby jobs are cheap to chain.
 
-use super::{C_SPEC, check_matrix_n, matrix::cost_range, sop_shaped};
+use super::{C_SPEC, sop_shaped};
 use crate::error::{Error, Result};
 use crate::model::Instance;
 use crate::params::{ParamKind, ParamSpec, Params};
@@ -19,12 +19,12 @@ use rand_chacha::ChaCha8Rng;
 
 /// `time-window` parameters.
 pub static SPECS: &[ParamSpec] = &[
-    super::n_spec("200"),
+    super::n_spec("200", super::MAX_N),
     C_SPEC,
     ParamSpec {
         name: "w",
         default: "10",
-        kind: ParamKind::Float,
+        kind: ParamKind::float_above(0.0, super::MAX_N as f64),
         help: "mean window length in jobs: releases are uniform over a horizon of n jobs, \
                window lengths uniform in [0, 2w] (0 < w <= n)",
     },
@@ -38,18 +38,24 @@ fn travel(a: Slot, b: Slot) -> i64 {
     (a.0 - b.0).abs().max(2 * (a.1 - b.1).abs())
 }
 
-/// `time-window`: n crane jobs in a rack `c` columns wide and `c / 4` levels high, windows of
-/// mean length `w` jobs; job `i` precedes job `j` when `i`'s window closes before `j`'s opens.
-pub fn generate(p: &Params, seed: u64) -> Result<Instance> {
-    let n = p.int("n") as usize;
-    check_matrix_n("time-window", n, 1)?;
-    let c = cost_range("time-window", p)?;
-    let w = p.float("w");
-    if !(w > 0.0 && w <= n as f64) {
+/// Checks the parameters together (`w` ≤ `n`); the number of cells.
+pub fn check(p: &Params) -> Result<u64> {
+    let (n, w) = (p.int("n"), p.float("w"));
+    if w > n as f64 {
         return Err(Error::Param(format!(
             "time-window: w must lie in (0, n] = (0, {n}], got {w}"
         )));
     }
+    Ok(n + 2)
+}
+
+/// `time-window`: n crane jobs in a rack `c` columns wide and `c / 4` levels high, windows of
+/// mean length `w` jobs; job `i` precedes job `j` when `i`'s window closes before `j`'s opens.
+pub fn generate(p: &Params, seed: u64) -> Result<Instance> {
+    check(p)?;
+    let n = p.int("n") as usize;
+    let c = p.int("c");
+    let w = p.float("w");
     let (cols, levels) = (c as i64, (c as i64 / 4).max(1));
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let mut jobs: Vec<(f64, f64, Slot, Slot)> = (0..n)

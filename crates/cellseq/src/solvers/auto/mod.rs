@@ -95,7 +95,7 @@ rules were chosen: [notes/portfolio.md](../notes/portfolio.md).",
         ParamSpec {
             name: "seconds",
             default: "10",
-            kind: ParamKind::Float,
+            kind: ParamKind::float_above(0.0, crate::params::MAX_SECONDS),
             help: "wall-clock budget used when neither --time-limit nor --max-evals is given",
         },
         ParamSpec {
@@ -229,7 +229,7 @@ impl Auto {
             ),
         };
         Ok(Auto {
-            seconds: p.float("seconds").max(0.001),
+            seconds: p.float("seconds"),
             portfolio,
             plan,
             beam_share,

@@ -70,13 +70,13 @@ rbg109a, prob.42, p43.1–p43.4, ft53.4 and ry48p.4 (p43.2 the slowest, at about
         ParamSpec {
             name: "max_width",
             default: "1048576",
-            kind: ParamKind::Int,
+            kind: ParamKind::int(1, 1_000_000_000),
             help: "stop doubling the beam width after this width",
         },
         ParamSpec {
             name: "memory_mb",
             default: "2048",
-            kind: ParamKind::Int,
+            kind: ParamKind::int(1, crate::params::MAX_MEMORY_MB),
             help: "do not start an iteration whose stored prefixes could pass this many MiB",
         },
         ParamSpec {
@@ -129,20 +129,20 @@ rbg109a, prob.42, p43.1–p43.4, ft53.4 and ry48p.4 (p43.2 the slowest, at about
         ParamSpec {
             name: "growth",
             default: "4",
-            kind: ParamKind::Int,
+            kind: ParamKind::int(2, 1024),
             help: "factor by which the beam width grows from width 1024 on (doubling before)",
         },
         ParamSpec {
             name: "exhaustive_from",
             default: "16384",
-            kind: ParamKind::Int,
+            kind: ParamKind::int(0, 1_000_000_000),
             help: "after the pass of this width, one pass without a width limit (stopped at \
                    memory_mb) before wider truncated passes; 0 = never",
         },
         ParamSpec {
             name: "warm_evals",
             default: "2000000",
-            kind: ParamKind::Int,
+            kind: ParamKind::int(0, 1_000_000_000_000),
             help: "evaluations of an `ils` run that gives the first incumbent (0 = none)",
         },
     ],
@@ -156,7 +156,7 @@ rbg109a, prob.42, p43.1–p43.4, ft53.4 and ry48p.4 (p43.2 the slowest, at about
 /// Builds the solver from validated parameters.
 pub fn from_params(p: &Params) -> Beam {
     Beam {
-        max_width: p.int("max_width").max(1) as usize,
+        max_width: p.int("max_width") as usize,
         memory_mb: p.int("memory_mb"),
         root_bound: p.bool("root_bound"),
         refine: p.bool("refine"),
@@ -165,7 +165,7 @@ pub fn from_params(p: &Params) -> Beam {
         warm_evals: p.int("warm_evals"),
         qpath: p.bool("qpath"),
         sec: p.bool("sec"),
-        growth: p.int("growth").max(2) as usize,
+        growth: p.int("growth") as usize,
         twins: p.bool("twins"),
         exhaustive_from: p.int("exhaustive_from") as usize,
     }
