@@ -209,21 +209,14 @@ fn optimize_options(
     Ok((solver, reversible, opts))
 }
 
-/// The budget of the whole command, from its start (reading counts): `--time-limit` must be
-/// a positive number of seconds (at most [`MAX_TIME_LIMIT_S`]).
+/// The budget of the whole command, from its start (reading counts); `--time-limit` was
+/// range-checked by its parser, and `Allowance::new` checks it again.
 fn allowance(a: &OptimizeArgs) -> anyhow::Result<cellseq_programs::optimize::Allowance> {
-    if let Some(t) = a.time_limit
-        && !(t.is_finite() && t > 0.0 && t <= MAX_TIME_LIMIT_S)
-    {
-        bail!(
-            "--time-limit must be a positive number of seconds, at most {MAX_TIME_LIMIT_S:e} (got {t})"
-        );
-    }
-    Ok(cellseq_programs::optimize::Allowance::new(a.time_limit, a.max_evals))
+    Ok(cellseq_programs::optimize::Allowance::new(
+        a.time_limit,
+        a.max_evals,
+    )?)
 }
-
-/// The longest `--time-limit` of a drawing (about three years).
-pub const MAX_TIME_LIMIT_S: f64 = 1e8;
 
 /// The semantics line of the report: the reading kept, why, and the others tried.
 fn say_semantics(out: &pipe::Optimized) {
