@@ -30,6 +30,7 @@ mod figure_fonts;
 mod gcode;
 mod gcode_reverse;
 mod gcode_shopfloor;
+mod gcode_touch_off;
 mod generated_suite;
 mod generators;
 mod golden;

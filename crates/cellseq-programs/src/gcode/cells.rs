@@ -145,6 +145,12 @@ fn cut_ranges(p: &Program, split: Split, safe: f64) -> Result<Vec<CutRange>, (us
                         ));
                     }
                     if li.tool_change {
+                        let from = ranges.last().map_or(0, |r| r.1);
+                        if touch_off(p, (from, s, i)) {
+                            // part of the tool change, kept with it in the block's preamble
+                            open = None;
+                            continue;
+                        }
                         return Err((li.line, "tool change while below the safe height; retract above the safe height before the tool change and try again".into()));
                     }
                     if li.motion != Motion::None && zafter.is_some_and(|z| z >= safe - EPS) {
@@ -208,6 +214,33 @@ fn cut_ranges(p: &Program, split: Split, safe: f64) -> Result<Vec<CutRange>, (us
         ranges.push((s, e, false));
     }
     Ok(ranges)
+}
+
+/// True when the lines `[s, i)` before the tool change on line `i` are a touch-off that
+/// belongs to that tool change, not a cut: straight moves along Z only (pcb-gcode's tool-zero
+/// step: `M06 T02`, `G01 Z0`, `M06`, then up), at an X and Y that an absolute move of the gap
+/// `[from, s)` sets, so that they do not depend on which cell came before (in the header,
+/// `from` is 0 and nothing comes before).
+fn touch_off(p: &Program, (from, s, i): (usize, usize, usize)) -> bool {
+    let along_z = p.lines[s..i].iter().all(|l| match l.motion {
+        Motion::None => true,
+        Motion::Rapid | Motion::Feed => {
+            l.cuts.iter().all(|c| matches!(c.kind, CutKind::Line))
+                && l.pos_before[0].is_some()
+                && l.pos_before[1].is_some()
+                && l.pos_before[0] == l.pos_after[0]
+                && l.pos_before[1] == l.pos_after[1]
+        }
+        _ => false,
+    });
+    let placed = from == 0
+        || p.lines[from..s].iter().any(|l| {
+            matches!(l.motion, Motion::Rapid | Motion::Feed)
+                && l.before.absolute
+                && l.words.has('X')
+                && l.words.has('Y')
+        });
+    along_z && placed
 }
 
 /// True when every cut of the range ends where the program knows the position.
@@ -699,6 +732,34 @@ fn cuts_something(li: &super::interp::LineInfo) -> bool {
     li.cuts
         .iter()
         .any(|c| !matches!(c.kind, CutKind::Line) || c.length() > super::verify::ZERO_MOVE)
+}
+
+/// Where a block's preamble leaves the tool, when the preamble itself says so: the position
+/// after its last move up to its last boundary (the tool change, written as it is whatever the
+/// order), provided an absolute move of the preamble gave X and Y and nothing after it moved
+/// them (pcb-gcode goes to `G00 X0 Y0` before each `M06`: the block starts from there, not
+/// from the previous block's last hole). `None` when the preamble does not fix the position.
+pub fn preamble_home(p: &Program, b: &Block) -> Option<[f64; 3]> {
+    let last = *b.preamble.iter().rev().find(|&&g| is_boundary(p, g))?;
+    let mut home: Option<[f64; 3]> = None;
+    for &g in b.preamble.iter().filter(|&&g| g <= last) {
+        let li = &p.lines[g];
+        match li.motion {
+            Motion::None => {}
+            Motion::Rapid | Motion::Feed => {
+                let set = li.before.absolute && li.words.has('X') && li.words.has('Y');
+                let moved_xy =
+                    li.pos_before[0] != li.pos_after[0] || li.pos_before[1] != li.pos_after[1];
+                home = match (set, moved_xy) {
+                    (true, _) => known(&li.pos_after),
+                    (false, false) => home.and_then(|_| known(&li.pos_after)),
+                    (false, true) => None,
+                };
+            }
+            _ => home = None,
+        }
+    }
+    home
 }
 
 /// True for a rapid that moves only in Z (a block's descent to its working height after a

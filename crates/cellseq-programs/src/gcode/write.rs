@@ -388,9 +388,10 @@ impl Writer<'_> {
 
     /// The block's preamble when the output enters the block at another cell than its first:
     /// the lines up to its last boundary as written, then, up to the first move across, the
-    /// rapids straight down or up to a height no lower than `low` (the block's own link
-    /// height) as written (so that a dwell after the spindle start happens at the height the
-    /// program gives it), then the other words without their motion.
+    /// rapids straight up, and those straight down to a height no lower than `low` (the
+    /// block's own link height), as written (so that a dwell after the spindle start happens
+    /// at the height the program gives it: pcb-gcode rises from its tool-zero touch at Z0 to
+    /// its drilling height before it), then the other words without their motion.
     fn preamble(&mut self, b: &Block, first_start: usize, low: f64) {
         let p = self.p;
         let last = b
@@ -404,7 +405,9 @@ impl Writer<'_> {
             .find(|&g| {
                 g > last
                     && p.lines[g].motion != Motion::None
-                    && !(vertical(p, g) && p.lines[g].pos_after[2].is_some_and(|z| z >= low - 1e-9))
+                    && !(vertical(p, g)
+                        && (rises(p, g)
+                            || p.lines[g].pos_after[2].is_some_and(|z| z >= low - 1e-9)))
             })
             .unwrap_or(first_start);
         let verbatim: Vec<usize> = b
@@ -423,6 +426,12 @@ impl Writer<'_> {
         }
         self.cur = p.lines[first_start].before;
     }
+}
+
+/// True for a rapid that ends no lower than it starts (a rise is safe wherever the tool is).
+fn rises(p: &Program, g: usize) -> bool {
+    let li = &p.lines[g];
+    matches!((li.pos_before[2], li.pos_after[2]), (Some(a), Some(b)) if b >= a - 1e-9)
 }
 
 /// Writes the program with cells in `order` (indices into `layout.cells`); `rev[k]` holds the

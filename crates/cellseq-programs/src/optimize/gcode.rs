@@ -227,7 +227,15 @@ fn solve_groups(
     };
     let mut home = l.start.unwrap_or(l.cells[0].entry);
     let mut left = total;
+    let mut prev_block = l.cells[0].block;
     for g in gs {
+        // a block whose tool change goes to a fixed place starts from there
+        let b = l.cells[g[0]].block;
+        if b != prev_block
+            && let Some(h) = gcode::cells::preamble_home(&p.program, &l.blocks[b])
+        {
+            home = h;
+        }
         let (inst, d) = gcode::group_instance(p, g, home, opts.margin, pl);
         s.dropped += d as usize;
         let budget = allowance.share(g.len(), left, total, reserve_s);
@@ -258,6 +266,7 @@ fn solve_groups(
         }
         s.spans.push((from, s.order.len()));
         if let Some(v) = seq.last() {
+            prev_block = l.cells[g[v.cell]].block;
             home = match s.rev.last().copied().flatten() {
                 Some(x) => x.exit,
                 None => l.cells[g[v.cell]].exit,
