@@ -184,7 +184,7 @@ def optimize_drawing(
 def sequence_paths(
     paths: Sequence[npt.ArrayLike],
     *,
-    start: Tuple[float, float] = (0.0, 0.0),
+    start: Optional[Tuple[float, float]] = None,
     reversible: bool = True,
     max_starts: int = 8,
     solver: str = "drawing",

@@ -5,9 +5,9 @@ use crate::convert;
 use crate::errors::{guard, rs, value_error};
 use crate::info::solver_kind;
 use crate::run::{Spec, run_polling};
-use cellseq::Sequence;
 use cellseq::geom::Point3;
 use cellseq::model::{Cell, Instance, Machine, Metadata, Mode, Objective, StepKind, Tool, Visit};
+use cellseq::{Sequence, SolverKind};
 use numpy::{PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -99,11 +99,40 @@ fn modes_of(p: &[[f64; 2]], reversible: bool, max_starts: usize) -> (Vec<Mode>, 
     (modes, or)
 }
 
+/// Where the pen starts, as the instance's home: at `start` on the sheet, or (no start given:
+/// the travel to the first path is not counted, as vpype's `pen_up_length`) far above the
+/// first path's start, at a height `H` of a million times the drawing's extent `D` (at most
+/// 5·10⁸): every first path then costs `H` to within `D²/2H = D/2·10⁻⁶`, a tie-break toward the
+/// given order's start.
+fn home(paths: &[Vec<[f64; 2]>], start: Option<[f64; 2]>) -> Point3 {
+    if let Some(s) = start {
+        return Point3::new(s[0], s[1], 0.0);
+    }
+    let mut lo = [f64::INFINITY; 2];
+    let mut hi = [f64::NEG_INFINITY; 2];
+    for q in paths.iter().flatten() {
+        for a in 0..2 {
+            lo[a] = lo[a].min(q[a]);
+            hi[a] = hi[a].max(q[a]);
+        }
+    }
+    let extent = (hi[0] - lo[0]).max(hi[1] - lo[1]).max(1.0);
+    let first = paths.first().map_or([0.0, 0.0], |p| p[0]);
+    Point3::new(first[0], first[1], (1e6 * extent).min(FREE_HOME_MAX))
+}
+
+/// Fewest paths on which the `drawing` solver searches beyond its greedy start; fewer are
+/// solved by `exact`.
+const DRAWING_MIN: usize = 4;
+
+/// Highest free-start home (below the coordinate limit of 10⁹ the validator enforces).
+const FREE_HOME_MAX: f64 = 5e8;
+
 /// The instance of the paths: one cell per path, its modes its directions (open paths) or
-/// start vertices (closed paths), the pen starting at `start`, no lift height (a plotter).
+/// start vertices (closed paths), the pen starting at `home`, no lift height (a plotter).
 fn instance(
     paths: &[Vec<[f64; 2]>],
-    start: [f64; 2],
+    home: Point3,
     reversible: bool,
     max_starts: usize,
 ) -> (Instance, Vec<Vec<Orient>>) {
@@ -121,7 +150,6 @@ fn instance(
             c
         })
         .collect();
-    let home = Point3::new(start[0], start[1], 0.0);
     let inst = Instance {
         name: "<paths>".into(),
         meta: Metadata {
@@ -167,28 +195,31 @@ fn travel(inst: &Instance, seq: &Sequence) -> (f64, f64) {
 }
 
 /// The order and direction in which to draw `paths` (a list of `(k, 2)` arrays of x, y: one
-/// plotter layer) with the least pen-up travel, the pen starting at `start`.
+/// plotter layer) with the least pen-up travel: between paths only (vpype's `pen_up_length`,
+/// `start=None`, the default), or also from a pen starting at `start`.
 ///
 /// Each path is a cell: an open path may be drawn backwards (`reversible`, default on, as
 /// vpype's `linesort`), a closed one (last point equal to the first, three distinct vertices
 /// or more) may start at one of `max_starts` evenly spaced vertices (also only when
 /// `reversible`). The registry solver `solver` (default `drawing`) sequences them with
 /// `time_limit` seconds or `max_evals` evaluations (default: 4000 evaluations per path, at
-/// least 10^6: deterministic); the given order is kept unless the solver's is shorter.
+/// least 10^6: deterministic); the given order is kept unless the solver's is shorter. Fewer
+/// than 4 paths, where `drawing` keeps its greedy order, are solved by `exact`.
 ///
 /// Returns a dict: `order` (path indices in drawing order), `reversed` (per position: drawn
 /// backwards), `start` (per position: the index of the path's vertex it starts from),
 /// `pen_up_before`/`pen_up_after` (travel between paths, vpype's metric),
-/// `lead_in_before`/`lead_in_after` (from `start` to the first path), `kept_original`,
+/// `lead_in_before`/`lead_in_after` (from `start` to the first path; `None` without a start),
+/// `kept_original`,
 /// `evaluations`, `elapsed_s`. The GIL is released while it runs; Ctrl-C stops it.
 #[pyfunction]
-#[pyo3(signature = (paths, *, start=(0.0, 0.0), reversible=true, max_starts=8,
+#[pyo3(signature = (paths, *, start=None, reversible=true, max_starts=8,
     solver="drawing", time_limit=None, max_evals=None, seed=1, params=None, progress=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn sequence_paths<'py>(
     py: Python<'py>,
     paths: &Bound<'py, PyAny>,
-    start: (f64, f64),
+    start: Option<(f64, f64)>,
     reversible: bool,
     max_starts: usize,
     solver: &str,
@@ -203,8 +234,12 @@ pub fn sequence_paths<'py>(
             "max_starts must be in 1..=1000, got {max_starts}"
         )));
     }
-    if !(start.0.is_finite() && start.1.is_finite()) {
-        return Err(value_error("start must be two finite numbers"));
+    if let Some(s) = start
+        && !(s.0.is_finite() && s.1.is_finite() && s.0.abs() <= 1e9 && s.1.abs() <= 1e9)
+    {
+        return Err(value_error(
+            "start must be two finite numbers of magnitude at most 1e9",
+        ));
     }
     let pts: Vec<Vec<[f64; 2]>> = paths
         .try_iter()?
@@ -221,8 +256,13 @@ pub fn sequence_paths<'py>(
         )),
         (_, n) => n,
     };
+    let mut kind = solver_kind(solver)?;
+    if kind == SolverKind::Drawing && pts.len() < DRAWING_MIN {
+        // `drawing` keeps its greedy start below 4 strokes; Held–Karp is exact and instant
+        kind = SolverKind::Exact;
+    }
     let spec = Spec {
-        solver: solver_kind(solver)?,
+        solver: kind,
         params: convert::params(params)?,
         seed,
         budget,
@@ -230,7 +270,8 @@ pub fn sequence_paths<'py>(
         lower_bound: false,
     };
     rs(spec.build().validated_params())?;
-    let (inst, orient) = instance(&pts, [start.0, start.1], reversible, max_starts);
+    let start = start.map(|s| [s.0, s.1]);
+    let (inst, orient) = instance(&pts, home(&pts, start), reversible, max_starts);
     rs(cellseq::validate::validate(&inst, "<paths>"))?;
     let original: Sequence = inst.as_given.clone().unwrap_or_default();
     let (seq, kept, evaluations, elapsed_s) = if pts.is_empty() {
@@ -248,6 +289,7 @@ pub fn sequence_paths<'py>(
     };
     let (lead0, between0) = travel(&inst, &original);
     let (lead1, between1) = travel(&inst, &seq);
+    let lead = |l: f64| start.map(|_| l);
     let d = PyDict::new(py);
     let or: Vec<Orient> = seq.iter().map(|v| orient[v.cell][v.mode]).collect();
     d.set_item("order", seq.iter().map(|v| v.cell).collect::<Vec<_>>())?;
@@ -258,8 +300,8 @@ pub fn sequence_paths<'py>(
     d.set_item("start", or.iter().map(|o| o.start).collect::<Vec<_>>())?;
     d.set_item("pen_up_before", between0)?;
     d.set_item("pen_up_after", between1)?;
-    d.set_item("lead_in_before", lead0)?;
-    d.set_item("lead_in_after", lead1)?;
+    d.set_item("lead_in_before", lead(lead0))?;
+    d.set_item("lead_in_after", lead(lead1))?;
     d.set_item("kept_original", kept)?;
     d.set_item("evaluations", evaluations)?;
     d.set_item("elapsed_s", elapsed_s)?;
