@@ -59,9 +59,11 @@ fn matrix_costs(costs: &Bound<'_, PyAny>) -> PyResult<(usize, Vec<f64>)> {
             shape[0], shape[1]
         )));
     }
+    // a C-contiguous array is the row-major matrix as it is; any other layout (Fortran
+    // order, a strided view) is read in logical (row-major) order
     let v = match arr.as_slice() {
-        Ok(s) => s.to_vec(),
-        Err(_) => arr.as_array().iter().copied().collect(),
+        Ok(s) if arr.is_c_contiguous() => s.to_vec(),
+        _ => arr.as_array().iter().copied().collect(),
     };
     Ok((shape[0], v))
 }

@@ -272,7 +272,9 @@ pub fn sequence_paths<'py>(
     rs(spec.build().validated_params())?;
     let start = start.map(|s| [s.0, s.1]);
     let (inst, orient) = instance(&pts, home(&pts, start), reversible, max_starts);
-    rs(cellseq::validate::validate(&inst, "<paths>"))?;
+    if !pts.is_empty() {
+        rs(cellseq::validate::validate(&inst, "<paths>"))?;
+    }
     let original: Sequence = inst.as_given.clone().unwrap_or_default();
     let (seq, kept, evaluations, elapsed_s) = if pts.is_empty() {
         (original.clone(), true, 0, 0.0)
