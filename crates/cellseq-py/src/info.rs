@@ -140,3 +140,20 @@ pub fn bounds<'py>(
     d.set_item("parts", parts)?;
     Ok(d)
 }
+
+/// Every generator kind: `[{"name", "summary", "params": [{"name", "default", "kind",
+/// "help"}]}]`.
+#[pyfunction]
+pub fn generators(py: Python<'_>) -> PyResult<Bound<'_, PyList>> {
+    let items: Vec<Bound<'_, PyDict>> = cellseq::generate::KINDS
+        .iter()
+        .map(|k| {
+            let d = PyDict::new(py);
+            d.set_item("name", k.name)?;
+            d.set_item("summary", k.summary)?;
+            d.set_item("params", param_specs(py, k.params)?)?;
+            Ok(d)
+        })
+        .collect::<PyResult<_>>()?;
+    PyList::new(py, items)
+}

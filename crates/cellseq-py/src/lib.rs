@@ -34,7 +34,7 @@ fn _cellseq(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<programs::PyOptimized>()?;
     m.add_function(wrap_pyfunction!(instance::read, m)?)?;
     m.add_function(wrap_pyfunction!(instance::generate, m)?)?;
-    m.add_function(wrap_pyfunction!(instance::generators, m)?)?;
+    m.add_function(wrap_pyfunction!(info::generators, m)?)?;
     m.add_function(wrap_pyfunction!(info::solvers, m)?)?;
     m.add_function(wrap_pyfunction!(info::check, m)?)?;
     m.add_function(wrap_pyfunction!(info::bounds, m)?)?;
