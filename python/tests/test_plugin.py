@@ -16,6 +16,9 @@ import vpype as vp  # noqa: E402
 
 from conftest import ROOT  # noqa: E402
 
+# the `vpype` command of this interpreter's environment
+VPYPE = os.path.join(os.path.dirname(sys.executable), "vpype")
+
 FILES = sorted(glob.glob(os.path.join(ROOT, "tests", "fixtures", "svg", "real", "*.svg")))
 
 
@@ -25,7 +28,7 @@ def test_the_corpus_is_there():
 
 def test_the_plugin_is_registered():
     out = subprocess.run(
-        [sys.executable, "-m", "vpype", "cellsort", "--help"], capture_output=True, text=True
+        [VPYPE, "cellsort", "--help"], capture_output=True, text=True
     )
     assert out.returncode == 0, out.stderr
     assert "--time-limit" in out.stdout and "--no-flip" in out.stdout
@@ -73,7 +76,7 @@ def test_cellsort_on_the_command_line(tmp_path):
     src = os.path.join(ROOT, "tests", "fixtures", "svg", "real", "vpype_multilayer_3layers.svg")
     out = tmp_path / "o.svg"
     r = subprocess.run(
-        [sys.executable, "-m", "vpype", "read", src, "cellsort", "--time-limit", "5",
+        [VPYPE, "read", src, "cellsort", "--time-limit", "5",
          "write", str(out)],
         capture_output=True, text=True,
     )
