@@ -32,8 +32,9 @@ def test_a_second_thread_runs_during_a_solve():
         done.set()
         t.join()
     during = [x for x in ticks if t0 < x < t0 + r.elapsed_s]
-    # the ticker runs about 200 times a second; with the GIL held it could not run at all
-    assert len(during) >= 20, (len(during), r.elapsed_s)
+    # the ticker wakes about 200 times a second; with the GIL held it could not run at all
+    # (a loaded machine may wake it far less often: 5 is enough to tell)
+    assert len(during) >= 5, (len(during), r.elapsed_s)
 
 
 def test_two_solves_in_two_threads_agree_with_one():
@@ -100,6 +101,6 @@ def test_ctrl_c_raises_keyboard_interrupt_promptly():
             p.kill()
     assert p.returncode == 3, (out, err)
     assert "interrupted" in out
-    # a solve of 120 s ends within a few seconds of the signal (polls every 20 ms; the solver
-    # stops at its next budget check); generous for a loaded machine
-    assert waited < 15, waited
+    # a solve of 120 s ends within a moment of the signal (the caller polls every 20 ms, the
+    # solver stops at its next budget check); 30 s is a margin for a loaded machine
+    assert waited < 30, waited
