@@ -7,9 +7,8 @@
 #   scripts/test.sh              # everything
 #   scripts/test.sh --python     # only the Python part (after a `cargo test --release`)
 #
-# The extension is built into the workspace's target/ with the release profile and the core's
-# feature set of the test build (feature `workspace-test-build`), so cargo reuses the compiled
-# core crates and builds only PyO3 and the bindings again (notes/python.md has the times).
+# The extension is built by maturin into the workspace's target/ with the release profile, so
+# what the test build compiled with the same features is reused (notes/python.md has the times).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -25,10 +24,10 @@ fi
 pip=("$venv/bin/python" -m pip --disable-pip-version-check -q)
 "${pip[@]}" install -r python/requirements-test.txt
 # the package, as `pip install .` would build it (maturin, release profile), installed editable
-VIRTUAL_ENV="$PWD/$venv" "$venv/bin/maturin" develop --release --quiet \
-    --features extension-module,workspace-test-build
+VIRTUAL_ENV="$PWD/$venv" "$venv/bin/maturin" develop --release --quiet
 # the plugin is pure Python (setuptools comes with the venv; no build isolation to download)
 "${pip[@]}" install --no-build-isolation --no-deps ./python/vpype-cellseq
 # the round-trip tests run the command line that `cargo test --release` built
-[[ -x target/release/cellseq ]] || cargo build --release --quiet -p cellseq-cli
+export CELLSEQ_BIN="${CARGO_TARGET_DIR:-$PWD/target}/release/cellseq"
+[[ -x "$CELLSEQ_BIN" ]] || cargo build --release --quiet -p cellseq-cli
 "$venv/bin/python" -m pytest python/tests -q -p no:cacheprovider
