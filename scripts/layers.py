@@ -33,6 +33,7 @@ CRATES = {
     "cellseq-programs": ["cellseq"],
     "cellseq-lab": ["cellseq", "cellseq-programs"],
     "cellseq-cli": ["cellseq", "cellseq-programs", "cellseq-lab"],
+    "cellseq-py": ["cellseq", "cellseq-programs", "cellseq-lab"],
 }
 
 # Crates the core's (normal) dependency tree must not contain.
@@ -76,6 +77,14 @@ LAYERS = {
     "cellseq-cli": [
         ["cli"],
         ["main"],
+    ],
+    "cellseq-py": [
+        ["errors"],
+        ["convert"],
+        ["run", "instance"],
+        ["info"],
+        ["solve", "paths", "programs", "lab"],
+        ["lib"],
     ],
 }
 
