@@ -21,7 +21,6 @@ use crate::engine::neighbours::Neighbours;
 use crate::error::Result;
 use crate::model::{Objective, Visit};
 use std::collections::VecDeque;
-use std::time::{Duration, Instant};
 
 /// Registry entry.
 pub static INFO: SolverInfo = SolverInfo {
@@ -500,12 +499,12 @@ impl<'m> Path<'m> {
     /// sweep is O(n²) cheap evaluations, milliseconds at the cap) and depends on nothing but
     /// the path, so results stay deterministic; under a time limit it stops at `deadline`
     /// (the clock read once per row of pairs).
-    fn polish(&mut self, ctx: &mut Context, deadline: Option<Instant>) {
+    fn polish(&mut self, ctx: &mut Context, deadline: crate::clock::Deadline) {
         let n = self.t.len();
         if n > POLISH_MAX {
             return;
         }
-        let past = || deadline.is_some_and(|d| Instant::now() >= d);
+        let past = || deadline.passed();
         for _ in 0..POLISH_SWEEPS {
             let mut improved = false;
             for i in 0..n {

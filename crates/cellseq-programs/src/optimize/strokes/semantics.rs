@@ -99,24 +99,35 @@ pub struct Reading {
     pub pens: Pens,
     /// What a plain top-level group is.
     pub blocks: Blocks,
+    /// Each scope's strokes in containment order (every stroke inside a closed stroke before
+    /// it, as `--cut` orders them): how a boxes.py part read as one pen keeps its inner cuts
+    /// before its outer cut ([module docs](self)).
+    pub inner_first: bool,
 }
 
 impl Reading {
     /// The strictest reading, which every other allows: a colour is a pen inside each layer,
     /// a plain group is a part.
-    pub const STRICT: Reading = Reading {
-        pens: Pens::Colour,
-        blocks: Blocks::Group,
-    };
+    pub const STRICT: Reading = Reading::new(Pens::Colour, Blocks::Group);
+
+    /// A reading of `pens` and `blocks`, in the order the search finds best within a scope.
+    pub const fn new(pens: Pens, blocks: Blocks) -> Reading {
+        Reading {
+            pens,
+            blocks,
+            inner_first: false,
+        }
+    }
 }
 
 impl std::fmt::Display for Reading {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(
             f,
-            "pens {}, blocks {}",
+            "pens {}, blocks {}{}",
             self.pens.name(),
-            self.blocks.name()
+            self.blocks.name(),
+            if self.inner_first { ", inner first" } else { "" }
         )
     }
 }
