@@ -7,8 +7,8 @@
 //!
 //! `cargo bench --bench drawing` (one group: `cargo bench --bench drawing -- groups`).
 
-use cellseq_programs::svg::{self, ReadOptions};
 use cellseq_programs::optimize::strokes::{self as pipe, Blocks, Options, Pens};
+use cellseq_programs::svg::{self, ReadOptions};
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use std::fmt::Write as _;
 use std::hint::black_box;

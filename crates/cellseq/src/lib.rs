@@ -68,7 +68,9 @@ macro_rules! internal {
         #[cfg(feature = "internals")]
         #[doc(hidden)]
         pub mod $module;
+        // what only the tests and benches call (through `internals`) is not dead code
         #[cfg(not(feature = "internals"))]
+        #[allow(dead_code, unused_imports)]
         mod $module;
     )*};
 }

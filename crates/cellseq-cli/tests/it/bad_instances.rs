@@ -284,7 +284,7 @@ fn sop_declared_dimension_is_checked_before_allocating() {
     let p = write(d.path(), "dim.sop", &t);
     let out = crate::common::cellseq()
         .args(["validate", p.to_str().unwrap()])
-        .env("CELLSEQ_MAX_MATRIX_NODES", "1000000")
+        .env("CELLSEQ_MAX_MATRIX_NODES", "100000")
         .output()
         .unwrap();
     let err = String::from_utf8_lossy(&out.stderr);

@@ -189,7 +189,7 @@ fn bad_solver_and_parameters_are_refused() {
     );
     fails_with(
         &run(&["solve", f, "--solver", "exact", "--param", "memory_mb=lots"]),
-        &["memory_mb", "integer"],
+        &["memory_mb", "whole number"],
     );
     fails_with(
         &run(&["solve", f, "--param", "novalue"]),

@@ -7,10 +7,10 @@
 use crate::common::{cellseq, s, stderr, write};
 use cellseq::construct::greedy;
 use cellseq::cost::CostModel;
-use cellseq_programs::dxf::{self, ReadOptions as DxfOptions};
-use cellseq_programs::svg::{self, ReadOptions};
 use cellseq::model::{Objective, Visit};
+use cellseq_programs::dxf::{self, ReadOptions as DxfOptions};
 use cellseq_programs::optimize::strokes::{self as pipe, Options, blocks};
+use cellseq_programs::svg::{self, ReadOptions};
 use std::fmt::Write as _;
 use std::time::{Duration, Instant};
 

@@ -79,7 +79,8 @@ fn cli_generate_solve_plot() {
         i,
     ]);
     assert!(!o.status.success());
-    assert!(String::from_utf8_lossy(&o.stderr).contains("rows"));
+    // the first parameter out of range is named (the parameters are checked by name)
+    assert!(String::from_utf8_lossy(&o.stderr).contains("must be a whole number in [1, 1e5]"));
 }
 
 #[test]

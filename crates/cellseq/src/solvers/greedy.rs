@@ -2,7 +2,7 @@
 //! [`crate::construct::greedy`].
 
 use super::Build;
-use super::{Caps, Context, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo, outcome_of};
+use super::{Caps, Context, Outcome, Params, Solver, SolverInfo, outcome_of};
 use crate::error::Result;
 
 pub use crate::construct::greedy::{geometric, matrix};
@@ -13,27 +13,15 @@ pub static INFO: SolverInfo = SolverInfo {
     summary: "precedence-aware nearest neighbour (k-d tree per tool on geometric instances)",
     description: "Precedence-aware nearest neighbour: from the current cell, the cheapest next cell whose \
 predecessors are all done. On geometric instances the candidates come from a k-d tree per \
-tool, so 10^5 cells take well under a second. `randomize` makes it a randomized start for \
-multi-start solvers.",
-    params: &[ParamSpec {
-        name: "randomize",
-        default: "0",
-        kind: ParamKind::float(0.0, 1.0),
-        help: "probability of taking the second-best candidate at a step (0 = pure greedy)",
-    }],
+tool, so 10^5 cells take well under a second. Deterministic; the multi-start solvers draw \
+their randomized starts from a randomized fringe construction instead (`start.rs`).",
+    params: &[],
     caps: Caps { ..Caps::NONE },
-    build: Build::Fresh(|p: &Params| {
-        Ok(Box::new(Greedy {
-            randomize: p.float("randomize"),
-        }))
-    }),
+    build: Build::Fresh(|_: &Params| Ok(Box::new(Greedy))),
 };
 
 /// The greedy solver.
-pub struct Greedy {
-    /// Probability of taking the second-best candidate.
-    pub randomize: f64,
-}
+pub struct Greedy;
 
 impl Solver for Greedy {
     fn solve(&self, ctx: &mut Context) -> Result<Outcome> {

@@ -127,7 +127,11 @@ impl std::fmt::Display for Reading {
             "pens {}, blocks {}{}",
             self.pens.name(),
             self.blocks.name(),
-            if self.inner_first { ", inner first" } else { "" }
+            if self.inner_first {
+                ", inner first"
+            } else {
+                ""
+            }
         )
     }
 }

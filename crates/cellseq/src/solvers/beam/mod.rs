@@ -76,8 +76,9 @@ rbg109a, prob.42, p43.1–p43.4, ft53.4 and ry48p.4 (p43.2 the slowest, at about
         ParamSpec {
             name: "memory_mb",
             default: "2048",
-            kind: ParamKind::int(1, crate::params::MAX_MEMORY_MB),
-            help: "do not start an iteration whose stored prefixes could pass this many MiB",
+            kind: ParamKind::int(0, crate::params::MAX_MEMORY_MB),
+            help: "do not start an iteration whose stored prefixes could pass this many MiB \
+                   (0: none that stores prefixes; the exhaustive pass stops at once)",
         },
         ParamSpec {
             name: "guide",
