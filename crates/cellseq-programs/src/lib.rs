@@ -4,7 +4,8 @@
 //! produce) read real programs, extract a [`cellseq::model::Instance`] from them and write the
 //! program back in a new order; they run no solver. The [`optimize`] pipeline does: groups in their
 //! required order → instance → solver → the original order kept where it is not worse → verify
-//! → write atomically.
+//! → write atomically; [`job`] is that pipeline in one call, from a file or text to the new
+//! text and the report `cellseq optimize --json` prints.
 
 // No unsafe code.
 #![forbid(unsafe_code)]
@@ -16,5 +17,6 @@
 pub mod drawing;
 pub mod dxf;
 pub mod gcode;
+pub mod job;
 pub mod optimize;
 pub mod svg;

@@ -5,10 +5,8 @@ use crate::convert;
 use crate::errors::{guard, rs, value_error};
 use crate::info::solver_kind;
 use cellseq::files::{ensure_not_input, read_text, write_atomic};
-use cellseq_programs::optimize::Allowance;
-use cellseq_programs::optimize::gcode as gpipe;
-use cellseq_programs::optimize::strokes as spipe;
-use cellseq_programs::{dxf, gcode, svg};
+use cellseq_programs::job;
+use cellseq_programs::optimize::strokes::{Blocks, Pens};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::path::{Path, PathBuf};
@@ -60,14 +58,6 @@ fn source(path: Option<&Path>, text: Option<String>) -> PyResult<(String, String
     }
 }
 
-/// A time limit checked as the command line checks it.
-fn limit(t: Option<f64>) -> PyResult<Option<f64>> {
-    if let Some(t) = t {
-        rs(cellseq::solve::checked_seconds("time_limit", t))?;
-    }
-    Ok(t)
-}
-
 /// Optimizes a G-code program (LinuxCNC, Fanuc-style, GRBL) as `cellseq optimize` does: cells
 /// sequenced group by group (tool blocks keep their order unless `merge_tool_blocks`), the
 /// program written state-exact and verified move by move against the original (every cut in
@@ -94,164 +84,32 @@ pub fn optimize_gcode(
     reversible: Option<bool>,
     margin: f64,
 ) -> PyResult<PyOptimized> {
-    let allowance = Allowance::new(limit(time_limit)?, max_evals);
-    let solver = solver_kind(solver)?;
-    if !(margin.is_finite() && (0.0..=1e6).contains(&margin)) {
-        return Err(value_error(format!(
-            "margin must be a number of mm in [0, 1e6], got {margin}"
-        )));
-    }
-    let opts = gpipe::Options {
-        solver,
+    let opts = job::Options {
+        solver: Some(solver_kind(solver)?),
         time_limit,
         max_evals,
         seed,
-        merge: merge_tool_blocks,
+        merge_tool_blocks,
         margin,
         reversible,
+        ..Default::default()
     };
     py.detach(|| {
         guard("optimize_gcode", || {
-            let t0 = std::time::Instant::now();
             let (file, text) = source(path.as_deref(), text)?;
-            let parsed = rs(gcode::parse(&file, &text))?;
-            let parse_s = t0.elapsed().as_secs_f64();
-            let mut out = rs(gpipe::optimize_within(&parsed, &opts, &allowance))?;
-            out.timings.parse_s = parse_s;
-            let reversed = out.reversed.iter().filter(|&&r| r).count();
-            let report = serde_json::json!({
-                "input": file,
-                "output": null,
-                "solver": solver.name(),
-                "cells": parsed.layout.cells.len(),
-                "tool_blocks": parsed.layout.blocks.len(),
-                "groups": out.groups,
-                "verified_cutting_moves": out.cuts,
-                "verified_events": out.events,
-                "inner_first_dropped_groups": out.inner_first_dropped,
-                "kept_original_order": out.kept_original(),
-                "kept": out.kept,
-                "kept_note": out.note,
-                "reversal": out.reversal_on,
-                "reversible_cells": out.reversible_cells,
-                "reversed_cells": reversed,
-                "timings": out.timings,
-                "solve_s": out.timings.solve_s,
-                "total_s": allowance.started.elapsed().as_secs_f64(),
-                "before": out.before,
-                "after": out.after,
-            });
+            let j = rs(job::optimize_source(
+                &file,
+                text.as_bytes(),
+                job::Format::Gcode,
+                &opts,
+            ))?;
             Ok(PyOptimized {
-                text: out.text,
-                report,
+                report: j.report.to_json(None),
+                text: j.text,
                 input: path.clone(),
             })
         })
     })
-}
-
-/// Options of a drawing, as `cellseq optimize` takes them.
-struct DrawingOpts {
-    format: String,
-    tolerance: f64,
-    skip_unsupported: bool,
-    max_points: usize,
-    pipe: spipe::Options,
-    output: String,
-}
-
-/// Reads an SVG as the command line does (the tolerance is in mm; the reader works in user
-/// units, known after a first read).
-fn read_svg(file: &str, text: &str, o: &DrawingOpts) -> PyResult<svg::Drawing> {
-    let probe = rs(svg::read(
-        file,
-        text,
-        svg::ReadOptions {
-            tolerance: 1e9,
-            skip_unsupported: true,
-            max_points: o.max_points,
-        },
-    ))?;
-    rs(svg::read(
-        file,
-        text,
-        svg::ReadOptions {
-            tolerance: o.tolerance / probe.mm_per_unit,
-            skip_unsupported: o.skip_unsupported,
-            max_points: o.max_points,
-        },
-    ))
-}
-
-/// Reads a DXF (millimetre tolerances scaled to the drawing's unit).
-fn read_dxf(file: &str, bytes: &[u8], o: &DrawingOpts) -> PyResult<svg::Drawing> {
-    let mut r = dxf::ReadOptions {
-        tolerance: o.tolerance,
-        join: 0.001,
-        skip_unsupported: o.skip_unsupported,
-        units: None,
-    };
-    let d = rs(dxf::read(file, bytes, r))?;
-    if d.mm_per_unit == 1.0 {
-        return Ok(d);
-    }
-    r.tolerance /= d.mm_per_unit;
-    r.join /= d.mm_per_unit;
-    rs(dxf::read(file, bytes, r))
-}
-
-/// A drawing's content: text (SVG, or DXF given as text) or a DXF file's bytes.
-enum Input {
-    Text(String),
-    Bytes(Vec<u8>),
-}
-
-/// Runs the drawing pipeline on `file`'s `text` and builds the report of `--json`.
-fn run_drawing(
-    file: &str,
-    input: Input,
-    mut o: DrawingOpts,
-) -> PyResult<(String, serde_json::Value)> {
-    let t0 = std::time::Instant::now();
-    let d = match input {
-        Input::Bytes(b) => read_dxf(file, &b, &o)?,
-        Input::Text(t) if o.format == "dxf" => read_dxf(file, t.as_bytes(), &o)?,
-        Input::Text(t) => read_svg(file, &t, &o)?,
-    };
-    let read_s = t0.elapsed().as_secs_f64();
-    o.pipe.contain_tol /= d.mm_per_unit;
-    let mut out = rs(spipe::optimize(&d, &o.pipe))?;
-    let post = dxf::Post::default();
-    let kind = if o.output == "gcode" {
-        spipe::Output::Gcode(&post)
-    } else {
-        spipe::Output::Svg
-    };
-    let (new_text, segments) = rs(spipe::render(&d, &mut out, kind))?;
-    let report = serde_json::json!({
-        "input": file,
-        "output": null,
-        "output_kind": o.output,
-        "solver": o.pipe.solver.name(),
-        "strokes": d.strokes.len(),
-        "closed_strokes": d.strokes.iter().filter(|s| s.closed).count(),
-        "scopes": out.scopes,
-        "precedence_edges": out.edges,
-        "reversible": o.pipe.reversible,
-        "verified_segments": segments,
-        "skipped": d.skipped,
-        "warnings": d.warnings,
-        "mm_per_unit": d.mm_per_unit,
-        "read_s": read_s,
-        "solve_s": out.solve_s,
-        "total_s": t0.elapsed().as_secs_f64(),
-        "kept_original_scopes": out.kept_original,
-        "groups_reordered": out.groups_reordered,
-        "kept_note": out.note,
-        "before": out.before,
-        "after": out.after,
-    });
-    Ok((new_text, report))
 }
 
 /// Optimizes a drawing (SVG, or DXF) as `cellseq optimize` does: strokes sequenced per layer
@@ -312,56 +170,45 @@ pub fn optimize_drawing(
             "output '{output}': svg, or gcode for a DXF input"
         )));
     }
-    for (name, v) in [("tolerance", tolerance), ("contain_tol", contain_tol)] {
-        if !(v.is_finite() && v > 0.0 && v <= 1e6) {
-            return Err(value_error(format!(
-                "{name} must be in (0, 1e6] mm, got {v}"
-            )));
-        }
-    }
-    if !(1..=1000).contains(&max_starts) {
-        return Err(value_error(format!(
-            "max_starts must be in 1..=1000, got {max_starts}"
-        )));
-    }
-    let o = DrawingOpts {
-        tolerance,
-        skip_unsupported,
-        max_points,
-        output,
-        pipe: spipe::Options {
-            solver: solver_kind(solver)?,
-            time_limit: limit(time_limit)?,
-            max_evals,
-            params: convert::text_params(params)?,
-            seed,
-            reversible,
-            scopes,
-            cut: cut.unwrap_or(format == "dxf"),
-            free_groups: !keep_group_order,
+    let pens = if scopes { Pens::Auto } else { Pens::None };
+    let blocks = if scopes { Blocks::Auto } else { Blocks::None };
+    let opts = job::Options {
+        solver: Some(solver_kind(solver)?),
+        time_limit,
+        max_evals,
+        seed,
+        params: convert::text_params(params)?,
+        reversible: Some(reversible),
+        drawing: job::DrawingOptions {
+            tolerance,
+            pens,
+            blocks,
+            cut,
+            keep_group_order,
             contain_tol,
             max_starts,
+            skip_unsupported,
+            max_points,
+            svg_output: output == "svg",
+            ..Default::default()
         },
-        format,
+        ..Default::default()
+    };
+    let fmt = if format == "dxf" {
+        job::Format::Dxf
+    } else {
+        job::Format::Svg
     };
     py.detach(|| {
         guard("optimize_drawing", || {
-            let (file, input) = match (&path, text) {
-                (Some(p), None) if o.format == "dxf" => (
-                    p.display().to_string(),
-                    Input::Bytes(std::fs::read(p).map_err(|e| {
-                        crate::errors::to_py(cellseq::Error::io(p.display().to_string(), e))
-                    })?),
-                ),
-                (p, t) => {
-                    let (f, t) = source(p.as_deref(), t)?;
-                    (f, Input::Text(t))
-                }
+            let j = match (&path, text) {
+                (Some(p), None) => rs(job::optimize_file_as(p, Some(fmt.name()), &opts))?,
+                (None, Some(t)) => rs(job::optimize_source("<text>", t.as_bytes(), fmt, &opts))?,
+                _ => return Err(value_error("give exactly one of path and text")),
             };
-            let (new_text, report) = run_drawing(&file, input, o)?;
             Ok(PyOptimized {
-                text: new_text,
-                report,
+                report: j.report.to_json(None),
+                text: j.text,
                 input: path.clone(),
             })
         })

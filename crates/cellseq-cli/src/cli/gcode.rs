@@ -6,8 +6,8 @@ use cellseq::files::ensure_not_input;
 use cellseq::files::read_text;
 use cellseq::formats::save_instance;
 use cellseq_programs::gcode::{self, Figures};
-use cellseq_programs::optimize::Allowance;
-use cellseq_programs::optimize::gcode::{self as gcode_pipeline, Kept, Options};
+use cellseq_programs::job::{self, Report};
+use cellseq_programs::optimize::gcode::Kept;
 use clap::Args;
 use std::path::{Path, PathBuf};
 
@@ -104,23 +104,7 @@ pub struct VerifyArgs {
 }
 
 pub(super) fn format_of(path: &Path, given: Option<&str>) -> anyhow::Result<&'static str> {
-    let f = match given {
-        Some(g) => g.to_ascii_lowercase(),
-        None => path
-            .extension()
-            .and_then(|e| e.to_str())
-            .unwrap_or("")
-            .to_ascii_lowercase(),
-    };
-    Ok(match f.as_str() {
-        "gcode" | "ngc" | "nc" | "tap" | "gco" | "g" | "cnc" | "txt" => "gcode",
-        "svg" => "svg",
-        "dxf" => "dxf",
-        other => bail!(
-            "{}: cannot tell the format from '{other}' (use --format gcode)",
-            path.display()
-        ),
-    })
+    Ok(job::Format::of_path(path, given)?.name())
 }
 
 fn print_figures(before: &Figures, after: &Figures) {
@@ -172,119 +156,77 @@ fn refuse_non_gcode_output(o: &Path) -> anyhow::Result<()> {
 }
 
 fn optimize_gcode(a: &OptimizeArgs) -> anyhow::Result<()> {
-    let allowance = Allowance::new(a.time_limit, a.max_evals)?;
+    let t0 = std::time::Instant::now();
     if let Some(o) = &a.output {
         refuse_non_gcode_output(o)?;
     }
-    let file = a.input.display().to_string();
-    let t0 = std::time::Instant::now();
-    let text = read_text(&a.input)?;
-    let parsed = gcode::parse(&file, &text)?;
-    let parse_s = t0.elapsed().as_secs_f64();
-    let solver: cellseq::SolverKind = match &a.solver {
-        Some(s) => s.parse()?,
-        None => cellseq::SolverKind::default(),
+    let opts = super::strokes::job_options(a, "gcode")?;
+    let mut j = job::optimize_file_as(&a.input, Some("gcode"), &opts)?;
+    let Report::Gcode(r) = &mut j.report else {
+        bail!("{}: not read as G-code", a.input.display());
     };
-    let opts = Options {
-        solver,
-        time_limit: a.time_limit,
-        max_evals: a.max_evals,
-        seed: a.seed,
-        merge: a.merge_tool_blocks,
-        margin: a.margin,
-        reversible: if a.reversible {
-            Some(true)
-        } else if a.no_reversible {
-            Some(false)
-        } else {
-            None
-        },
-    };
-    let mut out = gcode_pipeline::optimize_within(&parsed, &opts, &allowance)?;
-    out.timings.parse_s = parse_s;
     if a.output.is_some() {
         let t = std::time::Instant::now();
-        write_output(a.output.as_deref(), &out.text)?;
-        out.timings.write_s += t.elapsed().as_secs_f64();
+        write_output(a.output.as_deref(), &j.text)?;
+        r.timings.write_s += t.elapsed().as_secs_f64();
     }
-    let reversed = out.reversed.iter().filter(|&&r| r).count();
+    r.total_s = t0.elapsed().as_secs_f64();
     if a.json {
-        let v = serde_json::json!({
-            "input": file,
-            "output": a.output.as_ref().map(|p| p.display().to_string()),
-            "solver": solver.name(),
-            "cells": parsed.layout.cells.len(),
-            "tool_blocks": parsed.layout.blocks.len(),
-            "groups": out.groups,
-            "verified_cutting_moves": out.cuts,
-            "verified_events": out.events,
-            "inner_first_dropped_groups": out.inner_first_dropped,
-            "kept_original_order": out.kept_original(),
-            "kept": out.kept,
-            "kept_note": out.note,
-            "reversal": out.reversal_on,
-            "reversible_cells": out.reversible_cells,
-            "reversed_cells": reversed,
-            "timings": out.timings,
-            "solve_s": out.timings.solve_s,
-            "total_s": allowance.started.elapsed().as_secs_f64(),
-            "before": out.before,
-            "after": out.after,
-            "units": "mm",
-            "program_units": gcode::program_units(&parsed.program),
-        });
+        let v = j.report.to_json(a.output.as_deref());
         say!("{}", serde_json::to_string_pretty(&v)?);
-    } else {
-        say!(
-            "{file}: {} cells in {} tool blocks, {} groups; solver {}; {} cutting moves and {} events verified in the same machine state",
-            parsed.layout.cells.len(),
-            parsed.layout.blocks.len(),
-            out.groups,
-            solver,
-            out.cuts,
-            out.events
-        );
-        if out.reversal_on {
-            if out.reversible_cells == 0 {
-                say!("reversal: on, but no cell could be reversed");
-            } else {
-                say!(
-                    "reversal: {reversed} of {} reversible cells cut backwards",
-                    out.reversible_cells
-                );
-            }
-        }
-        match out.kept {
-            Kept::Whole => say!(
-                "note: the program is kept in its original order ({})",
-                out.note
-                    .as_deref()
-                    .unwrap_or("the solver found no better order")
-            ),
-            Kept::Groups(g) => say!(
-                "note: the original order was kept in {g} of {} group(s) (the new order was not better there)",
-                out.groups
-            ),
-            Kept::Nothing => {}
-        }
-        if out.inner_first_dropped > 0 {
+        return Ok(());
+    }
+    say!(
+        "{}: {} cells in {} tool blocks, {} groups; solver {}; {} cutting moves and {} events verified in the same machine state",
+        r.input,
+        r.cells,
+        r.tool_blocks,
+        r.groups,
+        r.solver,
+        r.verified_cutting_moves,
+        r.verified_events
+    );
+    if r.reversal {
+        if r.reversible_cells == 0 {
+            say!("reversal: on, but no cell could be reversed");
+        } else {
             say!(
-                "note: in {} group(s) inner-first contradicted the original order of overlapping cells; original order kept",
-                out.inner_first_dropped
+                "reversal: {} of {} reversible cells cut backwards",
+                r.reversed_cells,
+                r.reversible_cells
             );
         }
-        print_figures(&out.before, &out.after);
-        say_units(gcode::program_units(&parsed.program));
-        let t = &out.timings;
-        say!(
-            "time: parse {:.3} s, solve {:.3} s, verify {:.3} s, write {:.3} s",
-            t.parse_s,
-            t.solve_s,
-            t.verify_s,
-            t.write_s
-        );
-        say_wrote(a.output.as_deref());
     }
+    match r.kept {
+        Kept::Whole => say!(
+            "note: the program is kept in its original order ({})",
+            r.kept_note
+                .as_deref()
+                .unwrap_or("the solver found no better order")
+        ),
+        Kept::Groups(g) => say!(
+            "note: the original order was kept in {g} of {} group(s) (the new order was not better there)",
+            r.groups
+        ),
+        Kept::Nothing => {}
+    }
+    if r.inner_first_dropped_groups > 0 {
+        say!(
+            "note: in {} group(s) inner-first contradicted the original order of overlapping cells; original order kept",
+            r.inner_first_dropped_groups
+        );
+    }
+    print_figures(&r.before, &r.after);
+    say_units(r.program_units);
+    let t = &r.timings;
+    say!(
+        "time: parse {:.3} s, solve {:.3} s, verify {:.3} s, write {:.3} s",
+        t.parse_s,
+        t.solve_s,
+        t.verify_s,
+        t.write_s
+    );
+    say_wrote(a.output.as_deref());
     Ok(())
 }
 

@@ -2,10 +2,11 @@
 
 use super::gcode::{ImportArgs, OptimizeArgs};
 use super::rows::{Table, say_wrote, write_output};
-use anyhow::{Context as _, bail};
+use anyhow::bail;
 use cellseq::SolverKind;
 use cellseq::files::read_text;
 use cellseq::formats::save_instance;
+use cellseq_programs::job::{self, Report};
 use cellseq_programs::optimize::strokes as pipe;
 use cellseq_programs::svg;
 use clap::Args;
@@ -118,18 +119,22 @@ pub fn import(a: &ImportArgs, fmt: &str) -> anyhow::Result<()> {
     } else {
         read_dxf(&a.input, &a.drawing)?
     };
-    let mut opts = svg_options(
-        &d,
-        &a.drawing,
-        !a.no_reversible,
-        SolverKind::Greedy,
-        None,
-        1,
-    )?;
+    let mut drawing = drawing_options(&a.drawing, false);
     if fmt == "dxf" {
-        opts.cut = !a.drawing.no_inner_first;
+        drawing.cut = Some(!a.drawing.no_inner_first);
     }
-    let inst = pipe::import(&d, &opts)?;
+    let jo = job::Options {
+        solver: Some(SolverKind::Greedy),
+        reversible: Some(!a.no_reversible),
+        drawing,
+        ..Default::default()
+    };
+    let format = if fmt == "dxf" {
+        job::Format::Dxf
+    } else {
+        job::Format::Svg
+    };
+    let inst = pipe::import(&d, &job::drawing_options(&d, format, &jo))?;
     cellseq::validate::validate(&inst, &file)?;
     save_instance(&a.output, &inst)?;
     say!(
@@ -143,116 +148,92 @@ pub fn import(a: &ImportArgs, fmt: &str) -> anyhow::Result<()> {
 }
 
 fn read_svg(path: &Path, d: &DrawingArgs) -> anyhow::Result<svg::Drawing> {
-    let file = path.display().to_string();
     let text = read_text(path)?;
-    // the tolerance is given in mm; the reader works in user units
-    Ok(svg::read::read_mm(
-        &file,
+    Ok(job::read_svg(
+        &path.display().to_string(),
         &text,
-        d.tolerance,
-        svg::ReadOptions {
-            tolerance: d.tolerance,
-            skip_unsupported: d.skip_unsupported,
-            max_points: d.max_points,
-        },
+        &drawing_options(d, false),
     )?)
 }
 
-fn svg_options(
-    d: &svg::Drawing,
-    a: &DrawingArgs,
-    reversible: bool,
-    solver: SolverKind,
-    time_limit: Option<f64>,
-    seed: u64,
-) -> anyhow::Result<pipe::Options> {
+/// The drawing options of `a` for the library ([`job::DrawingOptions`]); `svg_output` for a DXF
+/// preview.
+fn drawing_options(a: &DrawingArgs, svg_output: bool) -> job::DrawingOptions {
+    let (pens, blocks) = if a.no_scopes {
+        (pipe::Pens::None, pipe::Blocks::None)
+    } else {
+        (a.pens, a.blocks)
+    };
+    job::DrawingOptions {
+        tolerance: a.tolerance,
+        pens,
+        blocks,
+        cut: if a.cut { Some(true) } else { None },
+        keep_group_order: a.keep_group_order,
+        contain_tol: a.contain_tol,
+        max_starts: a.max_starts,
+        skip_unsupported: a.skip_unsupported,
+        max_points: a.max_points,
+        join_tol: a.join_tol,
+        units: a.units.clone(),
+        svg_output,
+        post: cellseq_programs::dxf::Post {
+            safe_height: a.safe_height,
+            depth: a.cut_depth,
+            feed: a.feed,
+            plunge_feed: a.plunge_feed,
+            spindle: a.spindle,
+            laser_power: a.laser_power,
+        },
+    }
+}
+
+/// The library options of `optimize` on a file of format `fmt` (`gcode`, `svg`, `dxf`).
+pub(super) fn job_options(a: &OptimizeArgs, fmt: &str) -> anyhow::Result<job::Options> {
     use pipe::{Blocks, Pens};
-    if a.no_scopes && !matches!(a.pens, Pens::Auto | Pens::None) {
+    let d = &a.drawing;
+    if d.no_scopes && !matches!(d.pens, Pens::Auto | Pens::None) {
         bail!(
             "--no-scopes is --pens none: it cannot go with --pens {}",
-            a.pens.name()
+            d.pens.name()
         );
     }
-    if a.keep_group_order && a.blocks == Blocks::None {
+    if d.keep_group_order && d.blocks == Blocks::None {
         bail!("--keep-group-order keeps plain groups as blocks: it cannot go with --blocks none");
     }
-    Ok(pipe::Options {
-        solver,
-        time_limit,
-        max_evals: None,
-        params: Default::default(),
-        seed,
-        reversible,
-        scopes: !a.no_scopes,
-        pens: a.pens,
-        blocks: a.blocks,
-        cut: a.cut,
-        free_groups: !a.keep_group_order,
-        contain_tol: a.contain_tol / d.mm_per_unit,
-        max_starts: a.max_starts,
-    })
-}
-
-/// The solver (default `drawing`), whether strokes may be reversed (by default yes) and the
-/// pipeline options of `optimize` on drawing `d`.
-fn optimize_options(
-    a: &OptimizeArgs,
-    d: &svg::Drawing,
-) -> anyhow::Result<(SolverKind, bool, pipe::Options)> {
-    let reversible = !a.no_reversible;
-    let solver = match &a.solver {
-        Some(s) => s.parse()?,
-        None => pipe::DRAWING_SOLVER,
-    };
-    let mut opts = svg_options(d, &a.drawing, reversible, solver, a.time_limit, a.seed)?;
-    opts.max_evals = a.max_evals;
-    Ok((solver, reversible, opts))
-}
-
-/// The budget of the whole command, from its start (reading counts); `--time-limit` was
-/// range-checked by its parser, and `Allowance::new` checks it again.
-fn allowance(a: &OptimizeArgs) -> anyhow::Result<cellseq_programs::optimize::Allowance> {
-    Ok(cellseq_programs::optimize::Allowance::new(
-        a.time_limit,
-        a.max_evals,
-    )?)
-}
-
-/// The semantics line of the report: the reading kept, why, and the others tried.
-fn say_semantics(out: &pipe::Optimized) {
-    let others: Vec<String> = out
-        .tried
-        .iter()
-        .filter(|(r, _)| *r != out.reading)
-        .map(|(r, up)| format!("{r}: {up:.1} mm"))
-        .collect();
-    let also = if others.is_empty() {
-        String::new()
+    let solver = a.solver.as_deref().map(str::parse).transpose()?;
+    let reversible = if a.reversible {
+        Some(true)
+    } else if a.no_reversible {
+        Some(false)
     } else {
-        format!("; also tried {}", others.join(", "))
+        None
     };
-    say!("semantics: {} ({}){also}", out.reading, out.semantics);
-}
-
-/// The semantics of the JSON report.
-fn json_semantics(out: &pipe::Optimized) -> serde_json::Value {
-    serde_json::json!({
-        "pens": out.reading.pens.name(),
-        "blocks": out.reading.blocks.name(),
-        "inner_first": out.reading.inner_first,
-        "why": out.semantics,
-        "tried": out.tried.iter().map(|(r, up)| serde_json::json!({
-            "pens": r.pens.name(),
-            "blocks": r.blocks.name(),
-            "inner_first": r.inner_first,
-            "pen_up_total_mm": up,
-        })).collect::<Vec<_>>(),
+    let mut drawing = drawing_options(d, false);
+    if fmt == "dxf" {
+        drawing.cut = Some(!d.no_inner_first);
+        drawing.svg_output = a
+            .output
+            .as_ref()
+            .and_then(|o| o.extension())
+            .is_some_and(|e| e.eq_ignore_ascii_case("svg"));
+    }
+    Ok(job::Options {
+        solver,
+        time_limit: a.time_limit,
+        max_evals: a.max_evals,
+        seed: a.seed,
+        params: Default::default(),
+        reversible,
+        merge_tool_blocks: a.merge_tool_blocks,
+        margin: a.margin,
+        drawing,
     })
 }
 
 /// The elements the reader skipped, and the note when the original order was kept.
-fn say_skipped(d: &svg::Drawing, note: Option<&String>) {
-    for s in &d.skipped {
+fn say_skipped(skipped: &[String], note: Option<&String>) {
+    for s in skipped {
         say!("skipped: {s}");
     }
     if let Some(n) = note {
@@ -261,169 +242,92 @@ fn say_skipped(d: &svg::Drawing, note: Option<&String>) {
 }
 
 fn optimize_svg(a: &OptimizeArgs) -> anyhow::Result<()> {
-    let file = a.input.display().to_string();
-    let allowance = allowance(a)?;
-    let t0 = allowance.started;
-    let d = read_svg(&a.input, &a.drawing)?;
-    let read_s = t0.elapsed().as_secs_f64();
-    let (solver, reversible, opts) = optimize_options(a, &d)?;
-    let mut out = pipe::optimize_within(&d, &opts, &allowance)?;
-    let (text, segments) = pipe::render(&d, &mut out, pipe::Output::Svg)?;
-    write_output(a.output.as_deref(), &text)?;
-    let total_s = t0.elapsed().as_secs_f64();
+    let t0 = std::time::Instant::now();
+    let opts = job_options(a, "svg")?;
+    let mut j = job::optimize_file_as(&a.input, Some("svg"), &opts)?;
+    write_output(a.output.as_deref(), &j.text)?;
+    j.report.set_total_s(t0.elapsed().as_secs_f64());
     if a.json {
-        let v = serde_json::json!({
-            "input": file,
-            "output": a.output.as_ref().map(|p| p.display().to_string()),
-            "solver": solver.name(),
-            "strokes": d.strokes.len(),
-            "scopes": out.scopes,
-            "precedence_edges": out.edges,
-            "reversible": reversible,
-            "verified_segments": segments,
-            "skipped": d.skipped,
-            "read_s": read_s,
-            "solve_s": out.solve_s,
-            "total_s": total_s,
-            "kept_original_scopes": out.kept_original,
-            "groups_reordered": out.groups_reordered,
-            "semantics": json_semantics(&out),
-            "kept_note": out.note,
-            "before": out.before,
-            "after": out.after,
-        });
+        let v = j.report.to_json(a.output.as_deref());
         say!("{}", serde_json::to_string_pretty(&v)?);
-    } else {
-        say!(
-            "{file}: {} strokes in {} scope(s); solver {} ({:.3} s, total {:.3} s); {} segments verified identical",
-            d.strokes.len(),
-            out.scopes,
-            solver,
-            out.solve_s,
-            total_s,
-            segments
-        );
-        say_skipped(&d, out.note.as_ref());
-        say_semantics(&out);
-        if out.groups_reordered {
-            say!(
-                "top-level groups drawn in a shorter order than the file's (--keep-group-order keeps it)"
-            );
-        }
-        let (b, f) = (&out.before, &out.after);
-        let t = Table::new(20);
-        t.saved("pen-up mm (layer)", b.pen_up_mm, f.pen_up_mm);
-        t.saved("pen-up mm (total)", b.pen_up_total_mm, f.pen_up_total_mm);
-        t.counts("pen lifts", b.lifts, f.lifts);
-        t.values("pen-down mm", b.draw_mm, f.draw_mm);
-        say_wrote(a.output.as_deref());
+        return Ok(());
     }
+    let Report::Svg(r) = &j.report else {
+        bail!("{}: not read as SVG", a.input.display());
+    };
+    say!(
+        "{}: {} strokes in {} scope(s); solver {} ({:.3} s, total {:.3} s); {} segments verified identical",
+        r.input,
+        r.strokes,
+        r.scopes,
+        r.solver,
+        r.solve_s,
+        r.total_s,
+        r.verified_segments
+    );
+    say_skipped(&r.skipped, r.kept_note.as_ref());
+    say!("semantics: {}", r.semantics.line());
+    if r.groups_reordered {
+        say!(
+            "top-level groups drawn in a shorter order than the file's (--keep-group-order keeps it)"
+        );
+    }
+    let (b, f) = (&r.before, &r.after);
+    let t = Table::new(20);
+    t.saved("pen-up mm (layer)", b.pen_up_mm, f.pen_up_mm);
+    t.saved("pen-up mm (total)", b.pen_up_total_mm, f.pen_up_total_mm);
+    t.counts("pen lifts", b.lifts, f.lifts);
+    t.values("pen-down mm", b.draw_mm, f.draw_mm);
+    say_wrote(a.output.as_deref());
     Ok(())
 }
 
 fn read_dxf(path: &Path, d: &DrawingArgs) -> anyhow::Result<svg::Drawing> {
-    let file = path.display().to_string();
     let bytes = cellseq::files::read_bytes(path)?;
-    let units = match &d.units {
-        Some(u) => Some(
-            cellseq_programs::dxf::unit_mm(u)
-                .with_context(|| format!("--units {u}: use mm, cm, m, in, ft, mil or um"))?,
-        ),
-        None => None,
-    };
-    let mut o = cellseq_programs::dxf::ReadOptions {
-        tolerance: d.tolerance,
-        join: d.join_tol,
-        skip_unsupported: d.skip_unsupported,
-        units,
-    };
-    let dr = cellseq_programs::dxf::read(&file, &bytes, o)?;
-    if dr.mm_per_unit == 1.0 {
-        return Ok(dr);
-    }
-    o.tolerance /= dr.mm_per_unit;
-    o.join /= dr.mm_per_unit;
-    Ok(cellseq_programs::dxf::read(&file, &bytes, o)?)
+    Ok(job::read_dxf(
+        &path.display().to_string(),
+        &bytes,
+        &drawing_options(d, false),
+    )?)
 }
 
 fn optimize_dxf(a: &OptimizeArgs) -> anyhow::Result<()> {
-    use cellseq_programs::dxf;
-    let file = a.input.display().to_string();
-    let allowance = allowance(a)?;
-    let t0 = allowance.started;
-    let d = read_dxf(&a.input, &a.drawing)?;
-    for w in &d.warnings {
-        eprintln!("warning: {file}: {w}");
+    let t0 = std::time::Instant::now();
+    let opts = job_options(a, "dxf")?;
+    let mut j = job::optimize_file_as(&a.input, Some("dxf"), &opts)?;
+    write_output(a.output.as_deref(), &j.text)?;
+    j.report.set_total_s(t0.elapsed().as_secs_f64());
+    let Report::Dxf(r) = &j.report else {
+        bail!("{}: not read as DXF", a.input.display());
+    };
+    for w in &r.warnings {
+        eprintln!("warning: {}: {w}", r.input);
     }
-    let (solver, reversible, mut opts) = optimize_options(a, &d)?;
-    opts.cut = !a.drawing.no_inner_first;
-    let mut out = pipe::optimize_within(&d, &opts, &allowance)?;
-    let post = dxf::Post {
-        safe_height: a.drawing.safe_height,
-        depth: a.drawing.cut_depth,
-        feed: a.drawing.feed,
-        plunge_feed: a.drawing.plunge_feed,
-        spindle: a.drawing.spindle,
-        laser_power: a.drawing.laser_power,
-    };
-    let preview = a
-        .output
-        .as_ref()
-        .and_then(|o| o.extension())
-        .is_some_and(|e| e.eq_ignore_ascii_case("svg"));
-    let kind = if preview {
-        pipe::Output::Svg
-    } else {
-        pipe::Output::Gcode(&post)
-    };
-    let (text, segments) = pipe::render(&d, &mut out, kind)?;
-    write_output(a.output.as_deref(), &text)?;
-    let total_s = t0.elapsed().as_secs_f64();
-    let closed = d.strokes.iter().filter(|s| s.closed).count();
     if a.json {
-        let v = serde_json::json!({
-            "input": file,
-            "output": a.output.as_ref().map(|p| p.display().to_string()),
-            "output_kind": if preview { "svg" } else { "gcode" },
-            "solver": solver.name(),
-            "contours": d.strokes.len(),
-            "closed_contours": closed,
-            "layers": d.layers.len() - 1,
-            "scopes": out.scopes,
-            "inner_first_edges": out.edges,
-            "reversible": reversible,
-            "verified_segments": segments,
-            "skipped": d.skipped,
-            "warnings": d.warnings,
-            "mm_per_unit": d.mm_per_unit,
-            "semantics": json_semantics(&out),
-            "kept_note": out.note,
-            "solve_s": out.solve_s,
-            "total_s": total_s,
-            "before": out.before,
-            "after": out.after,
-        });
+        let v = j.report.to_json(a.output.as_deref());
         say!("{}", serde_json::to_string_pretty(&v)?);
-    } else {
-        say!(
-            "{file}: {} contours ({closed} closed) on {} layer(s); {} inner-first edges; solver {} ({:.3} s); {} segments verified identical",
-            d.strokes.len(),
-            d.layers.len() - 1,
-            out.edges,
-            solver,
-            out.solve_s,
-            segments
-        );
-        say_skipped(&d, out.note.as_ref());
-        say_semantics(&out);
-        say!(
-            "travel mm (file order -> optimized): {:.1} -> {:.1}; pierces {} -> {}",
-            out.before.pen_up_total_mm,
-            out.after.pen_up_total_mm,
-            out.before.lifts,
-            out.after.lifts
-        );
-        say_wrote(a.output.as_deref());
+        return Ok(());
     }
+    say!(
+        "{}: {} contours ({} closed) on {} layer(s); {} inner-first edges; solver {} ({:.3} s); {} segments verified identical",
+        r.input,
+        r.contours,
+        r.closed_contours,
+        r.layers,
+        r.inner_first_edges,
+        r.solver,
+        r.solve_s,
+        r.verified_segments
+    );
+    say_skipped(&r.skipped, r.kept_note.as_ref());
+    say!("semantics: {}", r.semantics.line());
+    say!(
+        "travel mm (file order -> optimized): {:.1} -> {:.1}; pierces {} -> {}",
+        r.before.pen_up_total_mm,
+        r.after.pen_up_total_mm,
+        r.before.lifts,
+        r.after.lifts
+    );
+    say_wrote(a.output.as_deref());
     Ok(())
 }
