@@ -19,7 +19,8 @@
 use crate::dxf;
 use crate::gcode::{self, Figures};
 use crate::optimize::Allowance;
-use crate::optimize::gcode::{self as gpipe, Kept, Timings};
+use crate::optimize::Timings;
+use crate::optimize::gcode::{self as gpipe, Kept};
 use crate::optimize::strokes::{self as spipe, Blocks, Pens, Reading};
 use crate::svg::{self, Drawing, PenUp};
 use cellseq::error::{Error, Result};

@@ -19,8 +19,14 @@ pub fn param_specs<'py>(py: Python<'py>, specs: &[ParamSpec]) -> PyResult<Bound<
             d.set_item("name", p.name)?;
             d.set_item("default", p.default)?;
             let kind = match p.kind {
-                ParamKind::Int => "int".to_string(),
-                ParamKind::Float => "float".to_string(),
+                ParamKind::Int(r) => {
+                    d.set_item("range", r.to_string())?;
+                    "int".to_string()
+                }
+                ParamKind::Float(r) => {
+                    d.set_item("range", r.to_string())?;
+                    "float".to_string()
+                }
                 ParamKind::Bool => "bool".to_string(),
                 ParamKind::Choice(c) => format!("one of {}", c.join(", ")),
                 ParamKind::Text => "text".to_string(),
