@@ -100,9 +100,15 @@ def test_dxf_matches_the_cli(cli, tmp_path):
 
 
 def test_gcode_errors_carry_the_line(tmp_path):
+    # O-word control flow is refused, naming the line
+    program = tmp_path / "osub.ngc"
+    program.write_text("G21\nG0 X0 Y0 Z5\no100 sub\nG1 Z-1 F100\no100 endsub\nM2\n")
     with pytest.raises(cellseq.ParseError) as e:
-        cellseq.optimize_gcode(f"{ROOT}/tests/fixtures/gcode/real/camotics_heart.ngc")
-    assert e.value.line == 3 and e.value.file.endswith("camotics_heart.ngc")
+        cellseq.optimize_gcode(program)
+    assert e.value.line == 3 and e.value.file.endswith("osub.ngc")
+    with pytest.raises(cellseq.ParseError) as e:
+        cellseq.optimize_gcode(text=program.read_text())
+    assert e.value.line == 3 and e.value.file == "<text>"
     with pytest.raises(ValueError, match="exactly one"):
         cellseq.optimize_gcode()
     with pytest.raises(ValueError, match="solver"):

@@ -10,7 +10,10 @@ use clap::Parser;
 fn main() {
     let args = cli::Cli::try_parse().unwrap_or_else(|e| {
         use clap::error::ErrorKind;
-        if matches!(e.kind(), ErrorKind::ValueValidation | ErrorKind::InvalidValue) {
+        if matches!(
+            e.kind(),
+            ErrorKind::ValueValidation | ErrorKind::InvalidValue
+        ) {
             // a value out of range: one line naming the flag and the range (clap's own
             // rendering adds a hint about --help below it)
             let text = e.render().to_string();

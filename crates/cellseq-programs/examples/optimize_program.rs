@@ -11,7 +11,10 @@ use std::path::PathBuf;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut args = std::env::args().skip(1);
-    let input = PathBuf::from(args.next().ok_or("usage: optimize_program INPUT [OUTPUT]")?);
+    let input = PathBuf::from(
+        args.next()
+            .ok_or("usage: optimize_program INPUT [OUTPUT]")?,
+    );
     let output = args.next().map(PathBuf::from);
     let opts = Options {
         time_limit: Some(5.0), // the whole call: reading, solving, verifying

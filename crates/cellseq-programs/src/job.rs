@@ -23,10 +23,10 @@ use crate::optimize::Timings;
 use crate::optimize::gcode::{self as gpipe, Kept};
 use crate::optimize::strokes::{self as spipe, Blocks, Pens, Reading};
 use crate::svg::{self, Drawing, PenUp};
+use cellseq::SolverKind;
 use cellseq::error::{Error, Result};
 use cellseq::files::{ensure_not_input, read_bytes, read_text, write_atomic};
 use cellseq::params::{FloatRange, IntRange};
-use cellseq::SolverKind;
 use serde::Serialize;
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -88,7 +88,9 @@ impl Format {
             other => {
                 return Err(Error::Invalid {
                     file: path.display().to_string(),
-                    msg: format!("cannot tell the format from '{other}' (give the format: gcode, svg or dxf)"),
+                    msg: format!(
+                        "cannot tell the format from '{other}' (give the format: gcode, svg or dxf)"
+                    ),
                 });
             }
         })
@@ -392,7 +394,10 @@ impl Semantics {
     /// The line the command line prints: the reading kept, why, and the others tried.
     pub fn line(&self) -> String {
         let name = |p: &str, b: &str, i: bool| {
-            format!("pens {p}, blocks {b}{}", if i { ", inner first" } else { "" })
+            format!(
+                "pens {p}, blocks {b}{}",
+                if i { ", inner first" } else { "" }
+            )
         };
         let kept = name(self.pens, self.blocks, self.inner_first);
         let others: Vec<String> = self
@@ -509,7 +514,13 @@ pub fn optimize_file_as(path: &Path, given: Option<&str>, opts: &Options) -> Res
         Format::Dxf => read_bytes(path)?,
         _ => read_text(path)?.into_bytes(),
     };
-    run(&path.display().to_string(), &bytes, format, opts, &allowance)
+    run(
+        &path.display().to_string(),
+        &bytes,
+        format,
+        opts,
+        &allowance,
+    )
 }
 
 /// Optimizes `content` (a G-code program or SVG as text, a DXF as text or bytes) named `file`
@@ -525,10 +536,18 @@ pub fn optimize_source(file: &str, content: &[u8], format: Format, opts: &Option
 fn text_of<'a>(file: &str, content: &'a [u8]) -> Result<&'a str> {
     let line_at = |at: usize| 1 + content[..at].iter().filter(|&&b| b == b'\n').count();
     if let Some(at) = content.iter().position(|&b| b == 0) {
-        return Err(Error::parse(file, line_at(at), format!("a NUL byte at byte {}: not a text file", at + 1)));
+        return Err(Error::parse(
+            file,
+            line_at(at),
+            format!("a NUL byte at byte {}: not a text file", at + 1),
+        ));
     }
     std::str::from_utf8(content).map_err(|e| {
-        Error::parse(file, line_at(e.valid_up_to()), format!("not UTF-8 text (byte {})", e.valid_up_to()))
+        Error::parse(
+            file,
+            line_at(e.valid_up_to()),
+            format!("not UTF-8 text (byte {})", e.valid_up_to()),
+        )
     })
 }
 
@@ -651,7 +670,13 @@ pub fn drawing_options(d: &Drawing, format: Format, opts: &Options) -> spipe::Op
     }
 }
 
-fn drawing_job(file: &str, d: Drawing, format: Format, opts: &Options, a: &Allowance) -> Result<Job> {
+fn drawing_job(
+    file: &str,
+    d: Drawing,
+    format: Format,
+    opts: &Options,
+    a: &Allowance,
+) -> Result<Job> {
     let read_s = a.started.elapsed().as_secs_f64();
     let po = drawing_options(&d, format, opts);
     let mut out = spipe::optimize_within(&d, &po, a)?;

@@ -186,10 +186,7 @@ fn boxes_py_groups_are_parts_and_groups_with_conflicting_colour_orders_too() {
                     *pos.get(&key(s))
                         .unwrap_or_else(|| panic!("{name}: stroke {:?} not in the output", key(s)))
                 };
-                assert!(
-                    at(sa) < at(sb),
-                    "{name}: stroke {a} after {b}"
-                );
+                assert!(at(sa) < at(sb), "{name}: stroke {a} after {b}");
             }
         }
     }
