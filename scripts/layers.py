@@ -45,7 +45,7 @@ CORE_FORBIDDEN = [
 # Module ranks per crate, lowest first: a module may import modules of lower rank only.
 LAYERS = {
     "cellseq": [
-        ["error"],
+        ["error", "clock"],
         ["files", "geom", "params"],
         ["precedence"],
         ["model"],
@@ -63,6 +63,7 @@ LAYERS = {
         ["drawing", "units"],
         ["gcode", "svg", "dxf"],
         ["optimize"],
+        ["job"],
         ["api"],
         ["lib"],
     ],

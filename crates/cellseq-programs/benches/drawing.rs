@@ -115,8 +115,11 @@ fn pipeline(text: &str, opts: &Options) -> usize {
     segments
 }
 
+/// A family of drawings: its name, its maker by size, and the options it runs with.
+type Case = (&'static str, fn(usize) -> String, Options);
+
 fn growth(c: &mut Criterion) {
-    let cases: [(&str, fn(usize) -> String, Options); 4] = [
+    let cases: [Case; 4] = [
         ("strokes", strokes, Options::default()),
         (
             "groups",

@@ -1,5 +1,5 @@
 //! Deadlines: the wall-clock end of a run as one value that long computations below the
-//! solvers (bounds, table builds, constructions) can check without a [`crate::context::Context`].
+//! solvers (bounds, table builds, constructions) can check without a solver's context.
 //!
 //! A [`Deadline`] is a point in time or none at all; [`Deadline::passed`] reads the clock
 //! (tens of nanoseconds), so a loop whose single step is cheap checks it every few thousand

@@ -43,11 +43,11 @@ fn map_of_groups() -> String {
     let mut body = String::new();
     for g in 0..21 {
         let _ = write!(body, "<g id=\"tile{g}\">");
-        for c in 0..4 {
+        for (c, colour) in colours.iter().enumerate() {
             for k in 0..3 {
                 let x = (g % 7) as f64 * 14.0 + k as f64 * 4.0;
                 let y = (g / 7) as f64 * 30.0 + c as f64 * 6.0;
-                body.push_str(&line(x, y, 3.0, colours[c]));
+                body.push_str(&line(x, y, 3.0, colour));
             }
         }
         body.push_str("</g>\n");

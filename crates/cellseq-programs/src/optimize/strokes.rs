@@ -712,7 +712,7 @@ fn solve_reading(
 /// [`render`] then writes and verifies the result.
 ///
 /// The allowance's time limit covers the whole command from `allowance.started`: a reserve
-/// ([`reserve_s`]) is kept for writing and verifying, the solver and block ordering stop at
+/// (`reserve_s`) is kept for writing and verifying, the solver and block ordering stop at
 /// it, and a scope left without time keeps the file's order.
 pub fn optimize_within(d: &Drawing, opts: &Options, allowance: &Allowance) -> Result<Optimized> {
     let (pens, blocks) = given(opts);

@@ -577,7 +577,7 @@ fn mutate(b: &[u8], rng: &mut ChaCha8Rng) -> Vec<u8> {
             }
             out
         }
-        1 | 2 | 3 if lines.len() > 1 => {
+        1..=3 if lines.len() > 1 => {
             let (i, j) = (
                 rng.random_range(0..lines.len()),
                 rng.random_range(0..lines.len()),
