@@ -260,3 +260,45 @@ proptest! {
         }
     }
 }
+
+/// Percentage lengths (osm2svg4art's background `<rect width="100%" height="100%">`) are of
+/// the viewport: its viewBox, else the root's size in px; without either they are refused.
+#[test]
+fn percentage_lengths_are_of_the_viewport() {
+    let doc = |root: &str, body: &str| {
+        format!("<svg xmlns=\"http://www.w3.org/2000/svg\" {root}>{body}</svg>")
+    };
+    let rect = "<rect x=\"10%\" width=\"50%\" height=\"100%\" stroke=\"black\" fill=\"none\"/>";
+    let d = svg::read(
+        "p.svg",
+        &doc(
+            "width=\"160mm\" height=\"100mm\" viewBox=\"0 0 160 100\"",
+            rect,
+        ),
+        ReadOptions::default(),
+    )
+    .unwrap();
+    let s = &d.strokes[0];
+    assert!(s.closed);
+    let xs: Vec<f64> = s.points.iter().map(|p| p[0]).collect();
+    let ys: Vec<f64> = s.points.iter().map(|p| p[1]).collect();
+    let min = |v: &[f64]| v.iter().cloned().fold(f64::MAX, f64::min);
+    let max = |v: &[f64]| v.iter().cloned().fold(f64::MIN, f64::max);
+    assert_eq!(min(&xs), 16.0);
+    assert_eq!(max(&xs), 96.0);
+    assert_eq!((min(&ys), max(&ys)), (0.0, 100.0));
+    // without a viewBox: the root's size in px
+    let d = svg::read(
+        "p.svg",
+        &doc("width=\"200\" height=\"50\"", rect),
+        ReadOptions::default(),
+    )
+    .unwrap();
+    let xs: Vec<f64> = d.strokes[0].points.iter().map(|p| p[0]).collect();
+    assert_eq!(xs.iter().cloned().fold(f64::MIN, f64::max), 120.0);
+    // no viewport: refused with the line
+    let e = svg::read("p.svg", &doc("", rect), ReadOptions::default())
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("p.svg:1") && e.contains("bad x='10%'"), "{e}");
+}

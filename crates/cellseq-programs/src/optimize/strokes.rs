@@ -7,7 +7,7 @@
 //! inner-before-outer precedence.
 
 use super::{Allowance, solve_group};
-use crate::drawing::{Drawing, PenUp, Stroke, pen_up};
+use crate::drawing::{Drawing, PenUp, Stroke, dist, pen_up};
 use crate::dxf::{self, Post};
 use crate::svg;
 use cellseq::SolverKind;
@@ -570,6 +570,37 @@ fn solve_pass(
     Ok(p)
 }
 
+/// Starts every closed stroke of the drawn sequence at the vertex that makes the pen's way
+/// from the previous stroke's end and on to the next stroke's start shortest (the sequence,
+/// and so the drawing, is unchanged; a closed stroke ends where it starts, so its start is
+/// also its exit, which a scope's solve chooses without knowing what comes after the scope:
+/// a boxes.py part drawn inner first ends on its outline, wherever the next part is). Two
+/// sweeps, each linear in the points; a vertex is taken only when strictly shorter, so the
+/// travel never grows.
+fn start_vertices(strokes: &mut [Stroke], origin: [f64; 2]) {
+    for _ in 0..2 {
+        let mut prev = origin;
+        for i in 0..strokes.len() {
+            if strokes[i].closed && strokes[i].points.len() > 2 {
+                let next = strokes.get(i + 1).map(Stroke::start);
+                let cost = |q: [f64; 2]| dist(prev, q) + next.map_or(0.0, |n| dist(q, n));
+                let s = &strokes[i];
+                let mut best = (0, cost(s.points[0]));
+                for (k, &q) in s.points.iter().enumerate().skip(1) {
+                    let c = cost(q);
+                    if c < best.1 - 1e-9 {
+                        best = (k, c);
+                    }
+                }
+                if best.0 != 0 {
+                    strokes[i].points.rotate_left(best.0);
+                }
+            }
+            prev = strokes[i].end();
+        }
+    }
+}
+
 /// The blocks of scopes `sc` (file order, one layer's scopes contiguous): `(first scope, end
 /// scope, free)` per layer. A block is free when its layer is a plain group that is a child of
 /// the root (not an Inkscape layer, not the root's own strokes).
@@ -683,15 +714,24 @@ fn solve_reading(
         ..opts.clone()
     };
     let opts_in = &inner;
+    // closed strokes' start vertices are set once the order is known (start_vertices), after
+    // the block order is chosen from each scope's own entry and exit
+    let polish = |mut p: Pass| {
+        if opts.reversible {
+            start_vertices(&mut p.strokes, [0.0, 0.0]);
+        }
+        p
+    };
     let best = solve_pass(d, sc, opts_in, allowance, shares)?;
     if !reorders(opts, r, sc) {
-        return Ok((best, false));
+        return Ok((polish(best), false));
     }
     let Some(order) = free_block_order(d, sc, &best, deadline) else {
-        return Ok((best, false));
+        return Ok((polish(best), false));
     };
+    let best = polish(best);
     let sc2: Vec<Vec<usize>> = order.iter().map(|&k| sc[k].clone()).collect();
-    let p = solve_pass(d, &sc2, opts_in, allowance, shares)?;
+    let p = polish(solve_pass(d, &sc2, opts_in, allowance, shares)?);
     let (a, b) = (figures(&best.strokes), figures(&p.strokes));
     Ok(if b.pen_up_total_mm < a.pen_up_total_mm {
         let solve_s = best.solve_s + p.solve_s;

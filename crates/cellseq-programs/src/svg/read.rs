@@ -61,6 +61,8 @@ struct Ctx<'a> {
     /// Index of each distinct style in `out.styles` (colour, width bits): a file may have a
     /// style per element, so the lookup is hashed, not a scan.
     styles: HashMap<(String, u64), usize>,
+    /// The root viewport in user units (width, height), what percentage lengths refer to.
+    viewport: Option<(f64, f64)>,
 }
 
 /// Inherited presentation state.
@@ -150,6 +152,7 @@ fn read_with(
         text,
         points: 0,
         styles: HashMap::new(),
+        viewport: viewport(root),
         doc: &lines,
         opts,
         out: Drawing {
@@ -217,20 +220,37 @@ fn line_of(l: &Lines, n: Node) -> usize {
     l.starts.partition_point(|&s| s <= n.range().start)
 }
 
+/// The root's viewBox numbers (x, y, width, height), when there are four and the size is
+/// positive and finite.
+fn view_box(root: Node) -> Option<[f64; 4]> {
+    let v = root.attribute("viewBox")?;
+    let p: Vec<f64> = v
+        .split(|c: char| c == ',' || c.is_whitespace())
+        .filter(|s| !s.is_empty())
+        .filter_map(|s| s.parse().ok())
+        .collect();
+    (p.len() == 4 && p.iter().all(|x| x.is_finite()) && p[2] > 0.0 && p[3] > 0.0)
+        .then(|| [p[0], p[1], p[2], p[3]])
+}
+
+/// The viewport in user units that percentage lengths refer to: the viewBox's size, else the
+/// root's width and height in px (user units without a viewBox).
+fn viewport(root: Node) -> Option<(f64, f64)> {
+    if let Some(vb) = view_box(root) {
+        return Some((vb[2], vb[3]));
+    }
+    let px = |a: &str| {
+        root.attribute(a)
+            .and_then(length_mm)
+            .map(|mm| mm * 96.0 / 25.4)
+    };
+    Some((px("width")?, px("height")?)).filter(|(w, h)| *w > 0.0 && *h > 0.0)
+}
+
 /// Millimetres per user unit from the root's width and viewBox (96 px per inch).
 fn mm_per_unit(root: Node) -> f64 {
     let width_mm = root.attribute("width").and_then(length_mm);
-    let vb_w = root.attribute("viewBox").and_then(|v| {
-        let p: Vec<f64> = v
-            .split(|c: char| c == ',' || c.is_whitespace())
-            .filter(|s| !s.is_empty())
-            .filter_map(|s| s.parse().ok())
-            .collect();
-        // `filter`, not `then_some(p[2])`: the index must not be evaluated on fewer numbers
-        Some(p)
-            .filter(|p| p.len() == 4 && p[2] > 0.0 && p[2].is_finite())
-            .map(|p| p[2])
-    });
+    let vb_w = view_box(root).map(|vb| vb[2]);
     match (width_mm, vb_w) {
         (Some(w), Some(vb)) if w > 0.0 && (w / vb).is_normal() => w / vb,
         _ => 25.4 / 96.0,
@@ -311,6 +331,20 @@ fn normalize_colour(s: &str) -> String {
     }
 }
 
+/// A percentage length (`100%`) of the viewport, as SVG resolves it: of its width for `x`,
+/// `width`, `cx`, `rx`, `x1`, `x2`; of its height for `y`, `height`, `cy`, `ry`, `y1`, `y2`; of
+/// its normalized diagonal (√((w² + h²) / 2)) otherwise (`r`).
+fn percent(ctx: &Ctx, name: &str, v: &str) -> Option<f64> {
+    let p: f64 = v.trim().strip_suffix('%')?.trim().parse().ok()?;
+    let (w, h) = ctx.viewport?;
+    let base = match name {
+        "x" | "width" | "cx" | "rx" | "x1" | "x2" => w,
+        "y" | "height" | "cy" | "ry" | "y1" | "y2" => h,
+        _ => ((w * w + h * h) / 2.0).sqrt(),
+    };
+    Some(p / 100.0 * base).filter(|x| x.is_finite())
+}
+
 fn number(s: &str) -> Option<f64> {
     let s = s.trim().trim_end_matches("px");
     s.parse::<f64>().ok().filter(|v| v.is_finite())
@@ -318,7 +352,7 @@ fn number(s: &str) -> Option<f64> {
 
 fn attr_num(ctx: &Ctx, n: Node, name: &str, default: Option<f64>) -> Result<f64> {
     match n.attribute(name) {
-        Some(v) => number(v).ok_or_else(|| {
+        Some(v) => number(v).or_else(|| percent(ctx, name, v)).ok_or_else(|| {
             Error::parse(
                 ctx.file,
                 line_of(ctx.doc, n),
@@ -516,8 +550,12 @@ fn shape(ctx: &Ctx, n: Node) -> Result<BezPath> {
             let y = attr_num(ctx, n, "y", Some(0.0))?;
             let w = attr_num(ctx, n, "width", None)?;
             let h = attr_num(ctx, n, "height", None)?;
-            let rx = n.attribute("rx").and_then(number);
-            let ry = n.attribute("ry").and_then(number);
+            let rx = n
+                .attribute("rx")
+                .and_then(|v| number(v).or_else(|| percent(ctx, "rx", v)));
+            let ry = n
+                .attribute("ry")
+                .and_then(|v| number(v).or_else(|| percent(ctx, "ry", v)));
             let r = rx.or(ry).unwrap_or(0.0).min(w / 2.0).min(h / 2.0).max(0.0);
             let tol = sized(w.abs().max(h.abs()))?;
             if w < 0.0 || h < 0.0 {
