@@ -171,6 +171,8 @@ def optimize_drawing(
     params: Optional[Dict[str, _Param]] = None,
     reversible: bool = True,
     scopes: bool = True,
+    pens: str = "auto",
+    blocks: str = "auto",
     cut: Optional[bool] = None,
     keep_group_order: bool = False,
     tolerance: float = 0.01,
@@ -179,7 +181,12 @@ def optimize_drawing(
     skip_unsupported: bool = False,
     max_points: int = 10_000_000,
 ) -> Optimized:
-    """Optimizes an SVG or DXF drawing as ``cellseq optimize`` does (verified)."""
+    """Optimizes an SVG or DXF drawing as ``cellseq optimize`` does (verified).
+
+    ``pens``: ``layer``, ``colour``, ``none`` or ``auto``; ``blocks``: ``group``, ``none`` or
+    ``auto`` (docs/drawings.md); ``scopes=False`` is ``pens="none", blocks="none"``. The
+    report's ``semantics`` names the reading used and every reading tried.
+    """
 
 def sequence_paths(
     paths: Sequence[npt.ArrayLike],

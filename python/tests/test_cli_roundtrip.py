@@ -126,3 +126,17 @@ def test_optimized_save_refuses_the_input(tmp_path):
         o.save(src)
     o.save(tmp_path / "q.ngc")
     assert (tmp_path / "q.ngc").read_text() == o.text
+
+
+def test_drawing_pens_and_blocks_match_the_cli(cli, tmp_path):
+    f = f"{ROOT}/tests/fixtures/svg/real/boxespy_Spool.svg"
+    out = tmp_path / "spool.svg"
+    c = cli("optimize", f, "-o", out, "--max-evals", 100_000, "--pens", "layer", "--blocks", "none", "--json")
+    mine = cellseq.optimize_drawing(f, max_evals=100_000, pens="layer", blocks="none")
+    assert mine.text == out.read_text()
+    assert mine.report["semantics"] == c["semantics"]
+    assert (mine.report["semantics"]["pens"], mine.report["semantics"]["blocks"]) == ("layer", "none")
+    with pytest.raises(ValueError, match="pens"):
+        cellseq.optimize_drawing(f, pens="marker")
+    with pytest.raises(ValueError, match="scopes"):
+        cellseq.optimize_drawing(f, scopes=False, pens="layer")

@@ -121,11 +121,13 @@ pub fn optimize_gcode(
 ///
 /// Give `path` or `text` (`format` `svg` or `dxf`, by default from the path's extension, else
 /// `svg`). `output`: `svg` (default for SVG, a preview for DXF) or `gcode` (default for DXF:
-/// its simple post). Tolerances are in mm. Returns an `Optimized`.
+/// its simple post). `pens` (`layer`, `colour`, `none`, `auto`) and `blocks` (`group`, `none`,
+/// `auto`) are the command line's `--pens` and `--blocks`; `scopes=False` is `pens="none",
+/// blocks="none"`. Tolerances are in mm. Returns an `Optimized`.
 #[pyfunction]
 #[pyo3(signature = (path=None, *, text=None, format=None, output=None, solver="drawing",
     time_limit=None, max_evals=None, seed=1, params=None, reversible=true, scopes=true,
-    cut=None, keep_group_order=false, tolerance=0.01, contain_tol=0.01, max_starts=8,
+    pens="auto", blocks="auto", cut=None, keep_group_order=false, tolerance=0.01, contain_tol=0.01, max_starts=8,
     skip_unsupported=false, max_points=10_000_000))]
 #[allow(clippy::too_many_arguments)]
 pub fn optimize_drawing(
@@ -141,6 +143,8 @@ pub fn optimize_drawing(
     params: Option<&Bound<'_, PyDict>>,
     reversible: bool,
     scopes: bool,
+    pens: &str,
+    blocks: &str,
     cut: Option<bool>,
     keep_group_order: bool,
     tolerance: f64,
@@ -170,8 +174,17 @@ pub fn optimize_drawing(
             "output '{output}': svg, or gcode for a DXF input"
         )));
     }
-    let pens = if scopes { Pens::Auto } else { Pens::None };
-    let blocks = if scopes { Blocks::Auto } else { Blocks::None };
+    let pens = Pens::parse(pens)
+        .ok_or_else(|| value_error(format!("pens '{pens}': use layer, colour, none or auto")))?;
+    let blocks = Blocks::parse(blocks)
+        .ok_or_else(|| value_error(format!("blocks '{blocks}': use group, none or auto")))?;
+    let (pens, blocks) = if scopes {
+        (pens, blocks)
+    } else if matches!(pens, Pens::Auto | Pens::None) {
+        (Pens::None, Blocks::None)
+    } else {
+        return Err(value_error("scopes=False is pens='none': it cannot go with another pens"));
+    };
     let opts = job::Options {
         solver: Some(solver_kind(solver)?),
         time_limit,

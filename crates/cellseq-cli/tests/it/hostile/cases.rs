@@ -609,6 +609,7 @@ fn mutate(b: &[u8], rng: &mut ChaCha8Rng) -> Vec<u8> {
 /// Every category; each case gets one.
 pub const CATEGORIES: &[&str] = &[
     "limits",
+    "fields",
     "nonfinite",
     "truncate",
     "nonutf8",
