@@ -183,7 +183,9 @@ pub fn optimize_drawing(
     } else if matches!(pens, Pens::Auto | Pens::None) {
         (Pens::None, Blocks::None)
     } else {
-        return Err(value_error("scopes=False is pens='none': it cannot go with another pens"));
+        return Err(value_error(
+            "scopes=False is pens='none': it cannot go with another pens",
+        ));
     };
     let opts = job::Options {
         solver: Some(solver_kind(solver)?),

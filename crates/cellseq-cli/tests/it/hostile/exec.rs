@@ -202,14 +202,17 @@ pub struct Outcome {
     pub stderr: String,
 }
 
-/// Occurrences of non-finite words (`NaN`, `inf`, `Infinity`) in `text`.
+/// Occurrences of non-finite values (`NaN`, `inf`, `-Infinity`, …) in `text`: tokens between
+/// white space and punctuation that are such a value on their own, so that text which merely
+/// contains the letters (a tool id `EM+inf` echoed from the input) is not counted.
 pub fn non_finite(text: &[u8]) -> usize {
     String::from_utf8_lossy(text)
-        .split(|c: char| !(c.is_ascii_alphanumeric() || c == '_'))
+        .split(|c: char| c.is_whitespace() || "\"',:;=()[]{}<>%/|".contains(c))
         .filter(|w| {
+            let w = w.trim_start_matches(['+', '-']);
             matches!(
-                *w,
-                "NaN" | "nan" | "inf" | "Inf" | "INF" | "Infinity" | "infinity"
+                w,
+                "NaN" | "nan" | "NAN" | "inf" | "Inf" | "INF" | "Infinity" | "infinity"
             )
         })
         .count()
