@@ -17,6 +17,8 @@
 
 pub mod arborescence;
 pub mod assignment;
+pub mod assignment_knn;
+pub mod auction;
 pub mod cells;
 pub mod knn;
 pub mod qpath;
@@ -114,6 +116,14 @@ pub fn compute(m: &CostModel, opt: &BoundOptions) -> Bounds {
             value: constant + v,
             seconds: t0.elapsed().as_secs_f64(),
         });
+        let t = Instant::now();
+        if let Some(v) = assignment_knn::assignment_knn_until(m, opt.knn.max(1), dl) {
+            parts.push(BoundValue {
+                name: "assignment_knn",
+                value: constant + v,
+                seconds: t.elapsed().as_secs_f64(),
+            });
+        }
     }
     if parts.is_empty() {
         parts.push(BoundValue {
