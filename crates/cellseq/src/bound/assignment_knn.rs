@@ -110,11 +110,18 @@ fn candidates(m: &CostModel, k: usize, deadline: Deadline) -> Option<Problem> {
             .query(&exit_at[i])
             .nearest_n::<SquaredEuclidean<f64>>(NonZero::new(want).expect("n > 0"))
             .execute();
+        // the centroid distance from which cells are left out: the first allowed cell past
+        // the k listed, else past the last found (results come nearest first)
         let mut listed = 0;
+        let mut far = None;
         for r in &res {
             let j = r.item;
-            if listed == k || j as usize == i || barred_cells.contains(&j) {
+            if j as usize == i || barred_cells.contains(&j) {
                 continue;
+            }
+            if listed == k {
+                far = Some(r.distance.sqrt());
+                break;
             }
             let c = cheapest(m, i, j as usize);
             if c.is_finite() {
@@ -123,14 +130,17 @@ fn candidates(m: &CostModel, k: usize, deadline: Deadline) -> Option<Problem> {
                 listed += 1;
             }
         }
+        if far.is_none() && res.len() < n {
+            far = Some(res.last().map(|r| r.distance.sqrt()).unwrap_or(0.0));
+        }
         let row = g.first[i];
         let links = list_links(m, &nodes, i, &barred_cells, &mut g, row);
-        if res.len() < n {
-            let far = res.last().map(|r| r.distance.sqrt()).unwrap_or(0.0);
+        if let Some(far) = far {
             for (mi, s) in exit_off[i].iter().enumerate() {
                 let r = (far - rho - s).max(0.0);
-                // without `links`, every unlisted entry lies beyond the link distance
-                let lift = m.lift_floor(i, mi) + r.max(m.link_distance()) * rapid;
+                // with `links`, every unlisted entry lies beyond the link distance too
+                let reach = if links { r.max(m.link_distance()) } else { r };
+                let lift = m.lift_floor(i, mi) + reach * rapid;
                 let same = if links { lift } else { lift.min(r * link_rate) };
                 g.same[i] = g.same[i].min(same);
                 g.other[i] = g.other[i].min(m.change_offset(i, mi));
