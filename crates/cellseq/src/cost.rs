@@ -434,6 +434,20 @@ impl CostModel {
             }
         }
     }
+    /// The part of any tool-changing move into `node` that depends on the target: from the
+    /// tool-change point over to above its entry at clearance, and down (0 on matrix
+    /// instances). A tool change out of (cell, mode) into `node` costs
+    /// [`CostModel::change_offset`] plus this.
+    pub fn change_tail(&self, node: usize) -> f64 {
+        match &self.geo {
+            None => 0.0,
+            Some(g) => {
+                let en = g.entry[node];
+                let air = g.tool_change.dist(&en.at_z(g.clearance)) + (g.clearance - en.z);
+                self.scale(g, air, 0, 0, 0.0)
+            }
+        }
+    }
     /// Seconds per mm at rapid (geometric), used by lower bounds on moves.
     pub fn rapid_rate(&self) -> f64 {
         self.geo.as_ref().map(|g| g.rapid_rate).unwrap_or(1.0)

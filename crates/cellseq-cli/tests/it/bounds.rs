@@ -2,6 +2,7 @@
 //! known optima.
 
 use cellseq::bound::{self, BoundOptions};
+use cellseq::clock::Deadline;
 use cellseq::cost::CostModel;
 use cellseq::formats::{self, Format};
 use cellseq::model::{Instance, Objective, Sequence};
@@ -322,7 +323,7 @@ fn lagrangian_beats_assignment_on_ry48p() {
 }
 
 #[test]
-fn knn_bound_is_below_a_solution_on_a_large_geometric_instance() {
+fn knn_bounds_are_below_a_solution_on_a_large_geometric_instance() {
     let mut p = BTreeMap::new();
     p.insert("n".to_string(), "4000".to_string());
     p.insert("tools".to_string(), "2".to_string());
@@ -333,9 +334,112 @@ fn knn_bound_is_below_a_solution_on_a_large_geometric_instance() {
         ..BoundOptions::default()
     };
     let b = bound::compute(&m, &opts);
-    assert_eq!(b.best_name, "degree_knn");
+    assert_eq!(b.best_name, "assignment_knn");
     let g = solve("greedy", &inst, Objective::Time).unwrap();
-    assert!(b.best > m.constant() && b.best <= g.report.cost);
+    for name in ["degree_knn", "assignment_knn"] {
+        let p = b.parts.iter().find(|p| p.name == name).expect(name);
+        assert!(p.value > m.constant() && p.value <= g.report.cost, "{name}");
+    }
+}
+
+/// A `uniform` instance with the machine varied: cells linked at feed up to `link` mm, a
+/// return home, an initial tool (the precedence, modes, tools and lifts come from `uniform`).
+#[allow(clippy::too_many_arguments)]
+fn geometric_variant(
+    n: usize,
+    tools: usize,
+    density: f64,
+    layers: usize,
+    lift: f64,
+    link: f64,
+    home: bool,
+    seed: u64,
+) -> Instance {
+    let mut p = BTreeMap::new();
+    for (k, v) in [
+        ("n", n.to_string()),
+        ("tools", tools.to_string()),
+        ("density", density.to_string()),
+        ("layers", layers.to_string()),
+        ("lift", lift.to_string()),
+        ("size", "60".to_string()),
+        ("closed", "0.4".to_string()),
+        ("modes", "3".to_string()),
+        ("reversible", (seed & 1 == 1).to_string()),
+    ] {
+        p.insert(k.to_string(), v);
+    }
+    let mut inst = cellseq::generate::generate("uniform", &p, seed).unwrap();
+    inst.machine.link_distance = link;
+    inst.machine.return_home = home;
+    if seed.is_multiple_of(3) {
+        inst.machine.initial_tool = inst.tools.first().map(|t| t.id.clone());
+    }
+    inst
+}
+
+/// The sparse assignment bound at several candidate counts: below `upper` and below the
+/// dense assignment bound (its duals are feasible for a graph with more arcs).
+fn check_assignment_knn(inst: &Instance, obj: Objective, upper: f64) {
+    let m = CostModel::new(inst, obj);
+    let tol = 1e-6 * upper.abs().max(1.0);
+    let dense = bound::compute(
+        &m,
+        &BoundOptions {
+            lagrangian_max_cells: 0,
+            qpath_work: 0.0,
+            sec_work: 0.0,
+            ..BoundOptions::default()
+        },
+    );
+    let ap = dense
+        .parts
+        .iter()
+        .find(|p| p.name == "assignment")
+        .map(|p| p.value);
+    for k in [1, 2, 5, 16] {
+        let v = bound::assignment_knn::assignment_knn_until(&m, k, Deadline::NONE)
+            .expect("a bound without a deadline");
+        let b = m.constant() + v;
+        assert!(
+            b <= upper + tol,
+            "{} {obj:?} k={k}: assignment_knn {b} exceeds {upper}",
+            inst.name
+        );
+        if let Some(a) = ap {
+            assert!(
+                b <= a + tol,
+                "{} k={k}: {b} above the assignment {a}",
+                inst.name
+            );
+        }
+    }
+}
+
+#[test]
+fn assignment_knn_is_below_solutions_on_larger_geometric_instances() {
+    for (seed, n) in [(1u64, 150usize), (2, 400), (3, 900)] {
+        for (link, home) in [(0.0, false), (8.0, true)] {
+            let inst = geometric_variant(n, 3, 0.002, 2, 7.0, link, home, seed);
+            for obj in [Objective::Time, Objective::Air] {
+                let budget = Budget {
+                    time_limit: None,
+                    max_evals: Some(300_000),
+                };
+                let r = solve_with("ils", &inst, obj, &BTreeMap::new(), budget).unwrap();
+                check_assignment_knn(&inst, obj, r.report.cost);
+            }
+        }
+    }
+    // the family of issue 51, beyond the dense bounds: close to a solution
+    let mut p = BTreeMap::new();
+    p.insert("n".to_string(), "5000".to_string());
+    let inst = cellseq::generate::generate("geometric-sparse", &p, 4).unwrap();
+    let m = CostModel::new(&inst, Objective::Time);
+    let b = bound::compute(&m, &BoundOptions::default());
+    assert_eq!(b.best_name, "assignment_knn");
+    let g = solve("greedy", &inst, Objective::Time).unwrap();
+    assert!(b.best <= g.report.cost && b.best >= 0.8 * g.report.cost);
 }
 
 /// A random PCGTSP (PCGLNS) text: `groups` clusters of 1–3 nodes, integer costs, random
@@ -640,5 +744,22 @@ proptest! {
         let inst = cellseq::generate::generate("uniform", &p, seed).unwrap();
         check_instance(&inst, Objective::Time);
         check_instance(&inst, Objective::Air);
+    }
+
+    #[test]
+    fn assignment_knn_below_optimum_on_random_geometric(
+        n in 2usize..=8,
+        tools in 1usize..=3,
+        density in 0.0f64..0.5,
+        layers in 1usize..=3,
+        lift in prop::sample::select(vec![0.0, 7.0]),
+        link in prop::sample::select(vec![0.0, 4.0, 20.0]),
+        home in any::<bool>(),
+        seed in 0u64..1000,
+    ) {
+        let inst = geometric_variant(n, tools, density, layers, lift, link, home, seed);
+        for obj in [Objective::Time, Objective::Air] {
+            check_assignment_knn(&inst, obj, exact(&inst, obj));
+        }
     }
 }

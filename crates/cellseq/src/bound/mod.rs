@@ -7,6 +7,9 @@
 //! - `degree`: Σ cheapest in-arc, and Σ cheapest out-arc, over cells and home; the max.
 //! - `degree_knn`: the in-degree bound of large geometric instances from K nearest
 //!   neighbours only (memory linear in n).
+//! - `assignment_knn`: the assignment bound of the same large geometric instances, by an
+//!   auction on a sparse candidate graph whose left-out arcs are covered by proven floors
+//!   ([`assignment_knn`], O(n K) memory).
 //! - `assignment`: Hungarian method on the cell graph.
 //! - `lagrangian`: minimum spanning 1-arborescence with subgradient out-degree penalties.
 //! - `sec`: assignment with Lagrangian subtour-elimination multipliers ([`sec`]).
@@ -17,6 +20,8 @@
 
 pub mod arborescence;
 pub mod assignment;
+pub mod assignment_knn;
+pub mod auction;
 pub mod cells;
 pub mod knn;
 pub mod qpath;
@@ -32,7 +37,7 @@ use std::time::Instant;
 #[derive(Debug, Clone, Copy)]
 pub struct BoundOptions {
     /// Largest n for the dense cell graph (O(n²) memory); larger geometric instances get the
-    /// K-nearest-neighbour degree bound only.
+    /// K-nearest-neighbour degree and sparse assignment bounds only.
     pub dense_max_cells: usize,
     /// Largest n for the assignment bound (O(n³) time).
     pub assignment_max_cells: usize,
@@ -46,7 +51,8 @@ pub struct BoundOptions {
     /// Work budget of the `sec` bound (d³ per subgradient iteration; 0 = skip it); it runs
     /// only when at least 10 iterations fit.
     pub sec_work: f64,
-    /// Neighbours per node in the K-nearest-neighbour degree bound.
+    /// Neighbours per node in the K-nearest-neighbour degree bound, and cells per row in the
+    /// sparse assignment bound.
     pub knn: usize,
     /// A known solution cost (with the constant), used to size subgradient steps.
     pub upper: Option<f64>,
@@ -74,7 +80,7 @@ impl Default for BoundOptions {
 /// One computed bound.
 #[derive(Debug, Clone, PartialEq)]
 pub struct BoundValue {
-    /// Bound name (`degree`, `degree_knn`, `assignment`, `lagrangian`).
+    /// Bound name (`degree`, `degree_knn`, `assignment_knn`, `assignment`, `lagrangian`, …).
     pub name: &'static str,
     /// Its value, in objective units, constant included.
     pub value: f64,
@@ -114,6 +120,14 @@ pub fn compute(m: &CostModel, opt: &BoundOptions) -> Bounds {
             value: constant + v,
             seconds: t0.elapsed().as_secs_f64(),
         });
+        let t = Instant::now();
+        if let Some(v) = assignment_knn::assignment_knn_until(m, opt.knn.max(1), dl) {
+            parts.push(BoundValue {
+                name: "assignment_knn",
+                value: constant + v,
+                seconds: t.elapsed().as_secs_f64(),
+            });
+        }
     }
     if parts.is_empty() {
         parts.push(BoundValue {
