@@ -360,6 +360,10 @@ pub struct Semantics {
     pub why: String,
     /// Every reading solved, with its pen-up travel in all.
     pub tried: Vec<Tried>,
+    /// The readings as the pipeline has them: the kept one and every one tried (for
+    /// [`Semantics::line`]; not in the JSON).
+    #[serde(skip)]
+    readings: (Reading, Vec<(Reading, f64)>),
 }
 
 /// One reading solved.
@@ -389,23 +393,16 @@ impl Semantics {
             inner_first: out.reading.inner_first,
             why: out.semantics.clone(),
             tried: out.tried.iter().map(|(r, up)| tried(r, *up)).collect(),
+            readings: (out.reading, out.tried.clone()),
         }
     }
     /// The line the command line prints: the reading kept, why, and the others tried.
     pub fn line(&self) -> String {
-        let name = |p: &str, b: &str, i: bool| {
-            format!(
-                "pens {p}, blocks {b}{}",
-                if i { ", inner first" } else { "" }
-            )
-        };
-        let kept = name(self.pens, self.blocks, self.inner_first);
-        let others: Vec<String> = self
-            .tried
+        let (kept, tried) = &self.readings;
+        let others: Vec<String> = tried
             .iter()
-            .map(|t| (name(t.pens, t.blocks, t.inner_first), t.pen_up_total_mm))
-            .filter(|(n, _)| *n != kept)
-            .map(|(n, up)| format!("{n}: {up:.1} mm"))
+            .filter(|(r, _)| r != kept)
+            .map(|(r, up)| format!("{r}: {up:.1} mm"))
             .collect();
         let also = if others.is_empty() {
             String::new()

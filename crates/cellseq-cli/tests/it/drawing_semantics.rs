@@ -146,38 +146,22 @@ fn boxes_py_groups_are_parts_and_groups_with_conflicting_colour_orders_too() {
             continue;
         }
         // inner first: every stroke inside a closed stroke of its part comes before it
+        // a stroke is named by its layer and the sum of its points, rounded: the same set of
+        // points whichever vertex a closed stroke starts from (the first is not repeated),
+        // though the order of the sum differs
+        let key = |s: &svg::Stroke| {
+            let sum = s
+                .points
+                .iter()
+                .fold([0.0f64; 2], |a, p| [a[0] + p[0], a[1] + p[1]]);
+            (s.layer, format!("{:?}", sum.map(|v| (v * 1e3).round())))
+        };
         let pos: std::collections::HashMap<(usize, String), usize> = out
             .strokes
             .iter()
             .enumerate()
-            .map(|(k, s)| {
-                (
-                    (
-                        s.layer,
-                        format!(
-                            "{:?}",
-                            ring(s)
-                                .iter()
-                                .fold([0.0f64; 2], |a, p| [a[0] + p[0], a[1] + p[1]])
-                                .map(|v| (v * 1e3).round())
-                        ),
-                    ),
-                    k,
-                )
-            })
+            .map(|(k, s)| (key(s), k))
             .collect();
-        let key = |s: &svg::Stroke| {
-            (
-                s.layer,
-                format!(
-                    "{:?}",
-                    ring(s)
-                        .iter()
-                        .fold([0.0f64; 2], |a, p| [a[0] + p[0], a[1] + p[1]])
-                        .map(|v| (v * 1e3).round())
-                ),
-            )
-        };
         let all: Vec<usize> = (0..d.strokes.len()).collect();
         for (a, b) in pipe::containment(&d, &all, 0.01) {
             let (sa, sb) = (&d.strokes[a], &d.strokes[b]);
@@ -289,11 +273,4 @@ fn real_inkscape_files_with_colours_in_their_layers_are_never_longer_than_the_st
             "{name}"
         );
     }
-}
-
-/// A stroke's points: the same set whichever vertex a closed stroke starts from (the first
-/// point is not repeated), so their sum names the stroke; the sums are compared rounded, as
-/// the order of the sum differs.
-fn ring(s: &svg::Stroke) -> &[[f64; 2]] {
-    &s.points
 }

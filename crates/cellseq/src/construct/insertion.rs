@@ -221,14 +221,7 @@ const MAX_SEARCH_MODES: usize = 64;
 fn append_in_order(m: &CostModel, seq: &mut Sequence, rest: &[u32]) {
     for &c in rest {
         let c = c as usize;
-        let cost = |md: usize| match seq.last() {
-            None => m.start(c, md),
-            Some(p) => m.arc(p.cell, p.mode, c, md),
-        };
-        let md = (0..m.modes(c))
-            .min_by(|&a, &b| cost(a).total_cmp(&cost(b)))
-            .unwrap_or(0);
-        seq.push(Visit::new(c, md));
+        seq.push(Visit::new(c, super::cheapest_after(m, seq, c)));
     }
 }
 

@@ -33,14 +33,7 @@ pub fn complete(m: &CostModel, seq: &mut Sequence) {
         .map(std::cmp::Reverse)
         .collect();
     while let Some(std::cmp::Reverse(c)) = ready.pop() {
-        let cost = |md: usize| match seq.last() {
-            None => m.start(c, md),
-            Some(p) => m.arc(p.cell, p.mode, c, md),
-        };
-        let md = (0..m.modes(c))
-            .min_by(|&a, &b| cost(a).total_cmp(&cost(b)))
-            .unwrap_or(0);
-        seq.push(Visit::new(c, md));
+        seq.push(Visit::new(c, cheapest_after(m, seq, c)));
         done[c] = true;
         for &s in &m.dag.succs[c] {
             let s = s as usize;
@@ -50,6 +43,18 @@ pub fn complete(m: &CostModel, seq: &mut Sequence) {
             }
         }
     }
+}
+
+/// The mode of cell `c` that is cheapest to reach from the end of `seq` (from the start when
+/// `seq` is empty).
+pub(crate) fn cheapest_after(m: &CostModel, seq: &Sequence, c: usize) -> usize {
+    let cost = |md: usize| match seq.last() {
+        None => m.start(c, md),
+        Some(p) => m.arc(p.cell, p.mode, c, md),
+    };
+    (0..m.modes(c))
+        .min_by(|&a, &b| cost(a).total_cmp(&cost(b)))
+        .unwrap_or(0)
 }
 
 /// The quickest feasible sequence: [`complete`] from nothing. What a solver returns when its
