@@ -1,4 +1,4 @@
-//! The assignment bound: a minimum-cost assignment (Hungarian method, O(d³)) on the cell
+//! The assignment bound: a minimum-cost assignment ([`super::lap`]) on the cell
 //! graph closed into a cycle through home. Every feasible sequence plus its return to home is
 //! a cyclic permutation, hence an assignment, so the optimum assignment is a lower bound.
 
@@ -31,108 +31,14 @@ pub fn hungarian_duals(d: usize, cost: impl Fn(usize, usize) -> f64) -> Option<A
     hungarian_duals_until(d, cost, Deadline::NONE)
 }
 
-/// Like [`hungarian_duals`], or `None` once `deadline` passes (checked before each of the d
-/// augmentations, each O(d²)).
+/// Like [`hungarian_duals`], or `None` once `deadline` passes (checked before each
+/// augmenting search; [`super::lap`] has the method).
 pub fn hungarian_duals_until(
     d: usize,
     cost: impl Fn(usize, usize) -> f64,
     deadline: Deadline,
 ) -> Option<Assignment> {
-    if d == 0 {
-        return Some(Assignment {
-            value: 0.0,
-            col: Vec::new(),
-            u: Vec::new(),
-            v: Vec::new(),
-        });
-    }
-    // Replace forbidden entries by a penalty larger than any finite assignment.
-    let mut finite_max = 0.0f64;
-    for i in 0..d {
-        for j in 0..d {
-            let c = cost(i, j);
-            if c.is_finite() {
-                finite_max = finite_max.max(c.abs());
-            }
-        }
-    }
-    let big = (finite_max + 1.0) * (d as f64 + 1.0) * 4.0;
-    let a = |i: usize, j: usize| {
-        let c = cost(i, j);
-        if c.is_finite() { c } else { big }
-    };
-    // e-maxx formulation, 1-based with a virtual column 0.
-    let inf = f64::INFINITY;
-    let mut u = vec![0.0; d + 1];
-    let mut v = vec![0.0; d + 1];
-    let mut p = vec![0usize; d + 1];
-    let mut way = vec![0usize; d + 1];
-    for i in 1..=d {
-        if deadline.passed() {
-            return None;
-        }
-        p[0] = i;
-        let mut j0 = 0usize;
-        let mut minv = vec![inf; d + 1];
-        let mut used = vec![false; d + 1];
-        loop {
-            used[j0] = true;
-            let i0 = p[j0];
-            let mut delta = inf;
-            let mut j1 = 0usize;
-            for j in 1..=d {
-                if !used[j] {
-                    let cur = a(i0 - 1, j - 1) - u[i0] - v[j];
-                    if cur < minv[j] {
-                        minv[j] = cur;
-                        way[j] = j0;
-                    }
-                    if minv[j] < delta {
-                        delta = minv[j];
-                        j1 = j;
-                    }
-                }
-            }
-            for j in 0..=d {
-                if used[j] {
-                    u[p[j]] += delta;
-                    v[j] -= delta;
-                } else {
-                    minv[j] -= delta;
-                }
-            }
-            j0 = j1;
-            if p[j0] == 0 {
-                break;
-            }
-        }
-        loop {
-            let j1 = way[j0];
-            p[j0] = p[j1];
-            j0 = j1;
-            if j0 == 0 {
-                break;
-            }
-        }
-    }
-    let mut col = vec![0usize; d];
-    for j in 1..=d {
-        col[p[j] - 1] = j - 1;
-    }
-    let mut total = 0.0;
-    for (i, &j) in col.iter().enumerate() {
-        let c = cost(i, j);
-        if !c.is_finite() {
-            return None;
-        }
-        total += c;
-    }
-    Some(Assignment {
-        value: total,
-        col,
-        u: u[1..].to_vec(),
-        v: v[1..].to_vec(),
-    })
+    super::lap::solve(d, cost, deadline)
 }
 
 /// The assignment bound on the arc part of the cost (without the model's constant).
@@ -143,6 +49,111 @@ pub fn assignment_bound(g: &CellGraph) -> Option<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use rand::{RngExt, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+
+/// The dense O(d³) Hungarian method (the e-maxx formulation): the oracle of the sparse one.
+    fn dense_oracle(
+        d: usize,
+        cost: impl Fn(usize, usize) -> f64,
+        deadline: Deadline,
+    ) -> Option<Assignment> {
+        if d == 0 {
+            return Some(Assignment {
+                value: 0.0,
+                col: Vec::new(),
+                u: Vec::new(),
+                v: Vec::new(),
+            });
+        }
+        // Replace forbidden entries by a penalty larger than any finite assignment.
+        let mut finite_max = 0.0f64;
+        for i in 0..d {
+            for j in 0..d {
+                let c = cost(i, j);
+                if c.is_finite() {
+                    finite_max = finite_max.max(c.abs());
+                }
+            }
+        }
+        let big = (finite_max + 1.0) * (d as f64 + 1.0) * 4.0;
+        let a = |i: usize, j: usize| {
+            let c = cost(i, j);
+            if c.is_finite() { c } else { big }
+        };
+        // e-maxx formulation, 1-based with a virtual column 0.
+        let inf = f64::INFINITY;
+        let mut u = vec![0.0; d + 1];
+        let mut v = vec![0.0; d + 1];
+        let mut p = vec![0usize; d + 1];
+        let mut way = vec![0usize; d + 1];
+        for i in 1..=d {
+            if deadline.passed() {
+                return None;
+            }
+            p[0] = i;
+            let mut j0 = 0usize;
+            let mut minv = vec![inf; d + 1];
+            let mut used = vec![false; d + 1];
+            loop {
+                used[j0] = true;
+                let i0 = p[j0];
+                let mut delta = inf;
+                let mut j1 = 0usize;
+                for j in 1..=d {
+                    if !used[j] {
+                        let cur = a(i0 - 1, j - 1) - u[i0] - v[j];
+                        if cur < minv[j] {
+                            minv[j] = cur;
+                            way[j] = j0;
+                        }
+                        if minv[j] < delta {
+                            delta = minv[j];
+                            j1 = j;
+                        }
+                    }
+                }
+                for j in 0..=d {
+                    if used[j] {
+                        u[p[j]] += delta;
+                        v[j] -= delta;
+                    } else {
+                        minv[j] -= delta;
+                    }
+                }
+                j0 = j1;
+                if p[j0] == 0 {
+                    break;
+                }
+            }
+            loop {
+                let j1 = way[j0];
+                p[j0] = p[j1];
+                j0 = j1;
+                if j0 == 0 {
+                    break;
+                }
+            }
+        }
+        let mut col = vec![0usize; d];
+        for j in 1..=d {
+            col[p[j] - 1] = j - 1;
+        }
+        let mut total = 0.0;
+        for (i, &j) in col.iter().enumerate() {
+            let c = cost(i, j);
+            if !c.is_finite() {
+                return None;
+            }
+            total += c;
+        }
+        Some(Assignment {
+            value: total,
+            col,
+            u: u[1..].to_vec(),
+            v: v[1..].to_vec(),
+        })
+    }
 
     #[test]
     fn hungarian_small_matrix() {
@@ -167,5 +178,66 @@ mod tests {
         assert!(hungarian(2, |i, j| m[i][j]).is_none());
         let m = [[inf, 7.0], [3.0, inf]];
         assert_eq!(hungarian(2, |i, j| m[i][j]).unwrap().0, 10.0);
+    }
+
+    /// Random d × d matrices: value equal to the dense oracle's, duals feasible on every
+    /// finite arc and tight on the chosen ones, a permutation; over wide and tiny cost ranges
+    /// (many ties), negative costs and forbidden arcs (also rows with fewer finite arcs than
+    /// a list holds, and instances with no finite assignment).
+    #[test]
+    fn sparse_method_matches_the_dense_oracle() {
+        let mut infeasible = 0;
+        for seed in 0..300u64 {
+            let mut rng = ChaCha8Rng::seed_from_u64(seed);
+            let d = 1 + rng.random_range(0..60usize);
+            let range = [1u64, 3, 20, 1000][seed as usize % 4];
+            let forbid = [0.0, 0.2, 0.6, 0.9][(seed as usize / 4) % 4];
+            let shift = if seed % 7 == 0 { -5.0 } else { 0.0 };
+            let m: Vec<f64> = (0..d * d)
+                .map(|_| {
+                    if rng.random_bool(forbid) {
+                        f64::INFINITY
+                    } else {
+                        rng.random_range(0..=range) as f64 + shift
+                    }
+                })
+                .collect();
+            let c = |i: usize, j: usize| m[i * d + j];
+            let want = dense_oracle(d, c, Deadline::NONE);
+            let got = hungarian_duals(d, c);
+            match (&want, &got) {
+                (None, None) => infeasible += 1,
+                (Some(w), Some(g)) => {
+                    assert!((w.value - g.value).abs() < 1e-9, "seed {seed}: {} vs {}", w.value, g.value);
+                    let mut seen = vec![false; d];
+                    for (i, &j) in g.col.iter().enumerate() {
+                        assert!(!seen[j], "seed {seed}: column {j} twice");
+                        seen[j] = true;
+                        assert!((c(i, j) - g.u[i] - g.v[j]).abs() < 1e-9, "seed {seed}: not tight");
+                    }
+                    for i in 0..d {
+                        for j in 0..d {
+                            if c(i, j).is_finite() {
+                                assert!(c(i, j) - g.u[i] - g.v[j] >= -1e-9, "seed {seed}: dual ({i},{j})");
+                            }
+                        }
+                    }
+                    let dual: f64 = g.u.iter().chain(&g.v).sum();
+                    assert!((dual - g.value).abs() < 1e-6, "seed {seed}: dual {dual}");
+                }
+                _ => panic!("seed {seed}: oracle {:?}, sparse {:?}", want.map(|a| a.value), got.map(|a| a.value)),
+            }
+        }
+        assert!(infeasible > 0 && infeasible < 150, "{infeasible} infeasible cases");
+    }
+
+    /// A matrix of equal costs (every assignment optimal) of the size where the dense method
+    /// took its O(d³): solved, with feasible duals.
+    #[test]
+    fn all_ties() {
+        let d = 400;
+        let a = hungarian_duals(d, |i, j| if i == j { 5.0 } else { 0.0 }).unwrap();
+        assert_eq!(a.value, 0.0);
+        assert!(a.col.iter().enumerate().all(|(i, &j)| i != j));
     }
 }

@@ -10,7 +10,7 @@
 //! - `assignment_knn`: the assignment bound of the same large geometric instances, by an
 //!   auction on a sparse candidate graph whose left-out arcs are covered by proven floors
 //!   ([`assignment_knn`], O(n K) memory).
-//! - `assignment`: Hungarian method on the cell graph.
+//! - `assignment`: the assignment problem on the cell graph ([`lap`]).
 //! - `lagrangian`: minimum spanning 1-arborescence with subgradient out-degree penalties.
 //! - `sec`: assignment with Lagrangian subtour-elimination multipliers ([`sec`]).
 //! - `qpath`: position-indexed path relaxation (precedence windows, no 2-cycles) with
@@ -24,6 +24,7 @@ pub mod assignment_knn;
 pub mod auction;
 pub mod cells;
 pub mod knn;
+pub mod lap;
 pub mod qpath;
 pub mod sec;
 
