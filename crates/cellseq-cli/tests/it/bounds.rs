@@ -763,3 +763,38 @@ proptest! {
         }
     }
 }
+
+/// A zero optimum gives bounds of 0, never -0 (the integral rounding used to print "-0"), and
+/// the assignment bound of a matrix of many equal costs is exact.
+#[test]
+fn zero_bounds_are_positive_zero() {
+    let n = 60;
+    let costs: Vec<f64> = (0..n * n)
+        .map(|k| {
+            let (i, j) = (k / n, k % n);
+            // a zero path 0 -> 1 -> ... and many other zero arcs: the optimum is 0
+            if j == i + 1 || (i * 7 + j) % 5 == 0 {
+                0.0
+            } else {
+                3.0
+            }
+        })
+        .collect();
+    let inst = Instance::from_matrix("ties", n, costs, &[]).unwrap();
+    let b = all_bounds(&inst, Objective::Matrix);
+    for p in &b.parts {
+        assert!(
+            p.value <= 0.0,
+            "{}: {} above the optimum 0",
+            p.name,
+            p.value
+        );
+        assert!(
+            p.value != 0.0 || p.value.is_sign_positive(),
+            "{}: -0",
+            p.name
+        );
+    }
+    assert_eq!(b.best.to_string(), "0");
+    assert!(b.parts.iter().any(|p| p.name == "assignment"));
+}

@@ -162,7 +162,8 @@ fn dense_bounds(
     let dl = opt.deadline;
     let integral = g.integral() && constant.fract() == 0.0;
     let round = |v: f64| {
-        if integral { (v - 1e-6).ceil() } else { v }
+        // `+ 0.0`: a bound of zero is 0, not the -0 that ceil(-1e-6) gives
+        if integral { (v - 1e-6).ceil() + 0.0 } else { v }
     };
     let mi: f64 = g.min_in().iter().filter(|c| c.is_finite()).sum();
     let mo: f64 = g.min_out().iter().filter(|c| c.is_finite()).sum();
