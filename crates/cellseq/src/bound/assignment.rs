@@ -1,6 +1,7 @@
-//! The assignment bound: a minimum-cost assignment ([`super::lap`]) on the cell
-//! graph closed into a cycle through home. Every feasible sequence plus its return to home is
-//! a cyclic permutation, hence an assignment, so the optimum assignment is a lower bound.
+//! The assignment bound: a minimum-cost assignment (Hungarian method: dense, or
+//! [`super::lap`] above [`DENSE_MAX_ORDER`]) on the cell graph closed into a cycle through
+//! home. Every feasible sequence plus its return to home is a cyclic permutation, hence an
+//! assignment, so the optimum assignment is a lower bound.
 
 use super::cells::CellGraph;
 use crate::clock::Deadline;
@@ -31,14 +32,129 @@ pub fn hungarian_duals(d: usize, cost: impl Fn(usize, usize) -> f64) -> Option<A
     hungarian_duals_until(d, cost, Deadline::NONE)
 }
 
+/// Up to this order the dense method runs ([`dense_until`]), above it the sparse one
+/// ([`super::lap`]). Both are exact but reach different optimal duals, and the beam's
+/// reduced-cost bounds were tuned on the dense method's; its O(d³) worst case (all costs
+/// equal) stays under about 0.3 s here.
+pub const DENSE_MAX_ORDER: usize = 512;
+
 /// Like [`hungarian_duals`], or `None` once `deadline` passes (checked before each
-/// augmenting search; [`super::lap`] has the method).
+/// augmenting search).
 pub fn hungarian_duals_until(
     d: usize,
     cost: impl Fn(usize, usize) -> f64,
     deadline: Deadline,
 ) -> Option<Assignment> {
-    super::lap::solve(d, cost, deadline)
+    if d <= DENSE_MAX_ORDER {
+        dense_until(d, cost, deadline)
+    } else {
+        super::lap::solve(d, cost, deadline)
+    }
+}
+
+/// The dense Hungarian method (the e-maxx formulation), O(d³): each of the d augmentations
+/// scans every column per step. `None` once `deadline` passes (checked before each
+/// augmentation) or when no finite assignment exists.
+pub fn dense_until(
+    d: usize,
+    cost: impl Fn(usize, usize) -> f64,
+    deadline: Deadline,
+) -> Option<Assignment> {
+    if d == 0 {
+        return Some(Assignment {
+            value: 0.0,
+            col: Vec::new(),
+            u: Vec::new(),
+            v: Vec::new(),
+        });
+    }
+    // Replace forbidden entries by a penalty larger than any finite assignment.
+    let mut finite_max = 0.0f64;
+    for i in 0..d {
+        for j in 0..d {
+            let c = cost(i, j);
+            if c.is_finite() {
+                finite_max = finite_max.max(c.abs());
+            }
+        }
+    }
+    let big = (finite_max + 1.0) * (d as f64 + 1.0) * 4.0;
+    let a = |i: usize, j: usize| {
+        let c = cost(i, j);
+        if c.is_finite() { c } else { big }
+    };
+    // e-maxx formulation, 1-based with a virtual column 0.
+    let inf = f64::INFINITY;
+    let mut u = vec![0.0; d + 1];
+    let mut v = vec![0.0; d + 1];
+    let mut p = vec![0usize; d + 1];
+    let mut way = vec![0usize; d + 1];
+    for i in 1..=d {
+        if deadline.passed() {
+            return None;
+        }
+        p[0] = i;
+        let mut j0 = 0usize;
+        let mut minv = vec![inf; d + 1];
+        let mut used = vec![false; d + 1];
+        loop {
+            used[j0] = true;
+            let i0 = p[j0];
+            let mut delta = inf;
+            let mut j1 = 0usize;
+            for j in 1..=d {
+                if !used[j] {
+                    let cur = a(i0 - 1, j - 1) - u[i0] - v[j];
+                    if cur < minv[j] {
+                        minv[j] = cur;
+                        way[j] = j0;
+                    }
+                    if minv[j] < delta {
+                        delta = minv[j];
+                        j1 = j;
+                    }
+                }
+            }
+            for j in 0..=d {
+                if used[j] {
+                    u[p[j]] += delta;
+                    v[j] -= delta;
+                } else {
+                    minv[j] -= delta;
+                }
+            }
+            j0 = j1;
+            if p[j0] == 0 {
+                break;
+            }
+        }
+        loop {
+            let j1 = way[j0];
+            p[j0] = p[j1];
+            j0 = j1;
+            if j0 == 0 {
+                break;
+            }
+        }
+    }
+    let mut col = vec![0usize; d];
+    for j in 1..=d {
+        col[p[j] - 1] = j - 1;
+    }
+    let mut total = 0.0;
+    for (i, &j) in col.iter().enumerate() {
+        let c = cost(i, j);
+        if !c.is_finite() {
+            return None;
+        }
+        total += c;
+    }
+    Some(Assignment {
+        value: total,
+        col,
+        u: u[1..].to_vec(),
+        v: v[1..].to_vec(),
+    })
 }
 
 /// The assignment bound on the arc part of the cost (without the model's constant).
@@ -51,109 +167,6 @@ mod tests {
     use super::*;
     use rand::{RngExt, SeedableRng};
     use rand_chacha::ChaCha8Rng;
-
-/// The dense O(d³) Hungarian method (the e-maxx formulation): the oracle of the sparse one.
-    fn dense_oracle(
-        d: usize,
-        cost: impl Fn(usize, usize) -> f64,
-        deadline: Deadline,
-    ) -> Option<Assignment> {
-        if d == 0 {
-            return Some(Assignment {
-                value: 0.0,
-                col: Vec::new(),
-                u: Vec::new(),
-                v: Vec::new(),
-            });
-        }
-        // Replace forbidden entries by a penalty larger than any finite assignment.
-        let mut finite_max = 0.0f64;
-        for i in 0..d {
-            for j in 0..d {
-                let c = cost(i, j);
-                if c.is_finite() {
-                    finite_max = finite_max.max(c.abs());
-                }
-            }
-        }
-        let big = (finite_max + 1.0) * (d as f64 + 1.0) * 4.0;
-        let a = |i: usize, j: usize| {
-            let c = cost(i, j);
-            if c.is_finite() { c } else { big }
-        };
-        // e-maxx formulation, 1-based with a virtual column 0.
-        let inf = f64::INFINITY;
-        let mut u = vec![0.0; d + 1];
-        let mut v = vec![0.0; d + 1];
-        let mut p = vec![0usize; d + 1];
-        let mut way = vec![0usize; d + 1];
-        for i in 1..=d {
-            if deadline.passed() {
-                return None;
-            }
-            p[0] = i;
-            let mut j0 = 0usize;
-            let mut minv = vec![inf; d + 1];
-            let mut used = vec![false; d + 1];
-            loop {
-                used[j0] = true;
-                let i0 = p[j0];
-                let mut delta = inf;
-                let mut j1 = 0usize;
-                for j in 1..=d {
-                    if !used[j] {
-                        let cur = a(i0 - 1, j - 1) - u[i0] - v[j];
-                        if cur < minv[j] {
-                            minv[j] = cur;
-                            way[j] = j0;
-                        }
-                        if minv[j] < delta {
-                            delta = minv[j];
-                            j1 = j;
-                        }
-                    }
-                }
-                for j in 0..=d {
-                    if used[j] {
-                        u[p[j]] += delta;
-                        v[j] -= delta;
-                    } else {
-                        minv[j] -= delta;
-                    }
-                }
-                j0 = j1;
-                if p[j0] == 0 {
-                    break;
-                }
-            }
-            loop {
-                let j1 = way[j0];
-                p[j0] = p[j1];
-                j0 = j1;
-                if j0 == 0 {
-                    break;
-                }
-            }
-        }
-        let mut col = vec![0usize; d];
-        for j in 1..=d {
-            col[p[j] - 1] = j - 1;
-        }
-        let mut total = 0.0;
-        for (i, &j) in col.iter().enumerate() {
-            let c = cost(i, j);
-            if !c.is_finite() {
-                return None;
-            }
-            total += c;
-        }
-        Some(Assignment {
-            value: total,
-            col,
-            u: u[1..].to_vec(),
-            v: v[1..].to_vec(),
-        })
-    }
 
     #[test]
     fn hungarian_small_matrix() {
@@ -203,8 +216,8 @@ mod tests {
                 })
                 .collect();
             let c = |i: usize, j: usize| m[i * d + j];
-            let want = dense_oracle(d, c, Deadline::NONE);
-            let got = hungarian_duals(d, c);
+            let want = dense_until(d, c, Deadline::NONE);
+            let got = super::super::lap::solve(d, c, Deadline::NONE);
             match (&want, &got) {
                 (None, None) => infeasible += 1,
                 (Some(w), Some(g)) => {
@@ -236,7 +249,7 @@ mod tests {
     #[test]
     fn all_ties() {
         let d = 400;
-        let a = hungarian_duals(d, |i, j| if i == j { 5.0 } else { 0.0 }).unwrap();
+        let a = super::super::lap::solve(d, |i, j| if i == j { 5.0 } else { 0.0 }, Deadline::NONE).unwrap();
         assert_eq!(a.value, 0.0);
         assert!(a.col.iter().enumerate().all(|(i, &j)| i != j));
     }
