@@ -70,7 +70,7 @@ impl Default for BoundOptions {
             lagrangian_iterations: 300,
             qpath_work: 1e8,
             sec_work: 1e8,
-            knn: 16,
+            knn: 8,
             upper: None,
             deadline: Deadline::NONE,
         }
