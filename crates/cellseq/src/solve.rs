@@ -38,8 +38,30 @@ use std::time::Duration;
 pub use crate::context::{Budget, NoObserver, Observer, Progress, Trace};
 
 /// Share of a time limit kept for the lower bound when [`Solve::lower_bound`] is on: the
-/// solver gets the rest, so the limit covers the whole solve.
+/// solver gets the rest, so the limit covers the whole solve. Geometric instances of more
+/// than [`BOUND_LARGE_CELLS`] cells keep [`BOUND_SHARE_LARGE`] instead ([`bound_share`]).
 pub const BOUND_SHARE: f64 = 0.05;
+
+/// Share of a time limit kept for the lower bound on instances of more than
+/// [`BOUND_LARGE_CELLS`] cells (geometric): the sparse assignment bound's time grows with n (about
+/// 0.45 s at 10⁵ cells on one core, notes/bounds-scale.md), and what is left after the
+/// solver's end and the bound's cost model is less than the share, so 5 % of a 10 s limit
+/// does not hold it there.
+pub const BOUND_SHARE_LARGE: f64 = 0.10;
+
+/// Size (cells) above which [`BOUND_SHARE_LARGE`] applies to a geometric instance.
+pub const BOUND_LARGE_CELLS: usize = 50_000;
+
+/// The share of a time limit kept for the lower bound of `inst`: [`BOUND_SHARE_LARGE`] for a
+/// geometric instance of more than [`BOUND_LARGE_CELLS`] cells (where the sparse assignment
+/// bound runs), [`BOUND_SHARE`] otherwise.
+pub fn bound_share(inst: &Instance) -> f64 {
+    if !inst.is_matrix() && inst.n() > BOUND_LARGE_CELLS {
+        BOUND_SHARE_LARGE
+    } else {
+        BOUND_SHARE
+    }
+}
 
 /// Largest instance (cells) for which [`Solve::lower_bound`] computes a bound after solving.
 pub const BOUND_MAX_CELLS: usize = 200_000;
@@ -197,7 +219,8 @@ impl<'o> Solve<'o> {
         let deadline = Deadline::after(self.budget.time_limit);
         let mut budget = self.budget;
         if self.lower_bound {
-            budget.time_limit = budget.time_limit.map(|t| t.mul_f64(1.0 - BOUND_SHARE));
+            let share = bound_share(inst);
+            budget.time_limit = budget.time_limit.map(|t| t.mul_f64(1.0 - share));
         }
         let r = solvers::run_until(
             info.name,

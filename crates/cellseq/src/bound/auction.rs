@@ -37,63 +37,108 @@ pub struct Problem {
     pub tail: Vec<f64>,
 }
 
+/// Columns a group's cache holds when refilled.
+const CACHED: usize = 16;
+
 /// Per group, the columns by price (lazy: an entry whose price is no longer the column's
-/// is skipped).
-struct Queues(Vec<BinaryHeap<Reverse<(u64, u32)>>>);
+/// is skipped), and a cache of its cheapest columns, sorted by price, with a price `floor`
+/// that every column outside the cache is known to reach. Prices only rise during the
+/// auction: a cached column raised to at most the floor moves within the cache, one raised
+/// above it leaves, and the cache is refilled from the heap only when fewer than three
+/// remain.
+struct Queues {
+    heap: Vec<BinaryHeap<Reverse<(u64, u32)>>>,
+    cache: Vec<Vec<(usize, f64)>>,
+    floor: Vec<f64>,
+}
 
 impl Queues {
     fn new(pb: &Problem, p: &[f64]) -> Queues {
-        let mut q: Vec<BinaryHeap<Reverse<(u64, u32)>>> = vec![BinaryHeap::new(); pb.tail.len()];
+        let mut entries: Vec<Vec<Reverse<(u64, u32)>>> = vec![Vec::new(); pb.tail.len()];
         for (j, &g) in pb.group.iter().enumerate() {
             if g != NO_GROUP {
-                q[g as usize].push(Reverse((p[j].to_bits(), j as u32)));
+                entries[g as usize].push(Reverse((p[j].to_bits(), j as u32)));
             }
         }
-        Queues(q)
+        let mut q = Queues {
+            cache: vec![Vec::with_capacity(CACHED); entries.len()],
+            floor: vec![f64::INFINITY; entries.len()],
+            heap: entries.into_iter().map(BinaryHeap::from).collect(),
+        };
+        for g in 0..q.heap.len() {
+            q.refill(g, p);
+        }
+        q
     }
 
-    /// Records the new price of column j (prices are ≥ 0, so their bits order as they do).
+    /// Refills group `g`'s cache with its [`CACHED`] cheapest columns.
+    fn refill(&mut self, g: usize, p: &[f64]) {
+        let (h, cache) = (&mut self.heap[g], &mut self.cache[g]);
+        cache.clear();
+        while cache.len() < CACHED {
+            let Some(Reverse((bits, j))) = h.pop() else {
+                break;
+            };
+            if p[j as usize].to_bits() == bits {
+                cache.push((j as usize, p[j as usize]));
+            }
+        }
+        // the columns left in the heap cost at least the last taken
+        self.floor[g] = match cache.last() {
+            Some(&(_, last)) if cache.len() == CACHED => last,
+            _ => f64::INFINITY,
+        };
+        h.extend(cache.iter().map(|&(j, pj)| Reverse((pj.to_bits(), j as u32))));
+    }
+
+    /// Records the new (higher) price of column j (prices are ≥ 0, so their bits order as
+    /// they do).
     fn update(&mut self, pb: &Problem, j: usize, p: f64) {
         let g = pb.group[j];
-        if g != NO_GROUP {
-            self.0[g as usize].push(Reverse((p.to_bits(), j as u32)));
+        if g == NO_GROUP {
+            return;
+        }
+        let g = g as usize;
+        self.heap[g].push(Reverse((p.to_bits(), j as u32)));
+        let cache = &mut self.cache[g];
+        if let Some(at) = cache.iter().position(|&(c, _)| c == j) {
+            cache.remove(at);
+            if p <= self.floor[g] {
+                let to = cache.partition_point(|&(_, pc)| pc <= p);
+                cache.insert(to, (j, p));
+            }
         }
     }
 
-    /// The least price in group `g` (`INFINITY` when empty), dropping stale entries on top.
-    fn least(&mut self, g: usize, p: &[f64]) -> f64 {
-        let h = &mut self.0[g];
-        while let Some(&Reverse((bits, j))) = h.peek() {
-            if p[j as usize].to_bits() == bits {
-                return p[j as usize];
-            }
-            h.pop();
+    /// The three cheapest columns of group `g` as (column, price), `usize::MAX` past the
+    /// last.
+    fn top(&mut self, g: usize, p: &[f64]) -> [(usize, f64); 3] {
+        if self.cache[g].len() < 3 && self.floor[g].is_finite() {
+            self.refill(g, p);
         }
-        f64::INFINITY
-    }
-
-    /// The two cheapest columns of group `g` other than `skip`, as (column, price).
-    fn two(&mut self, g: usize, skip: usize, p: &[f64]) -> [(usize, f64); 2] {
-        let h = &mut self.0[g];
-        let mut out = [(usize::MAX, f64::INFINITY); 2];
-        let mut held = Vec::with_capacity(3);
-        let mut found = 0;
-        while let Some(Reverse((bits, j))) = h.pop() {
-            if p[j as usize].to_bits() != bits {
-                continue;
-            }
-            held.push(Reverse((bits, j)));
-            if j as usize != skip {
-                out[found] = (j as usize, p[j as usize]);
-                found += 1;
-                if found == 2 {
-                    break;
-                }
-            }
+        let mut out = [(usize::MAX, f64::INFINITY); 3];
+        for (o, &c) in out.iter_mut().zip(&self.cache[g]) {
+            *o = c;
         }
-        h.extend(held);
         out
     }
+}
+
+/// Per group, the two cheapest columns at prices `p` as (column, price), by one scan.
+fn two_cheapest(pb: &Problem, p: &[f64]) -> Vec<[(usize, f64); 2]> {
+    let mut two = vec![[(usize::MAX, f64::INFINITY); 2]; pb.tail.len()];
+    for (j, &g) in pb.group.iter().enumerate() {
+        if g != NO_GROUP {
+            let t = &mut two[g as usize];
+            if p[j] < t[0].1 {
+                t[1] = t[0];
+                t[0] = (j, p[j]);
+            } else if p[j] < t[1].1 {
+                t[1] = (j, p[j]);
+            }
+        }
+    }
+    two
 }
 
 /// The best and second best value a row sees, the second over other columns than the best.
@@ -147,14 +192,15 @@ impl Problem {
         let gi = self.group[i];
         if gi != NO_GROUP {
             for t in 0..self.tail.len() {
-                let floor = if t == gi as usize {
-                    self.same[i]
-                } else {
-                    self.other[i] + self.tail[t]
-                };
+                let floor = self.floor(i, gi, t);
+                if !floor.is_finite() {
+                    continue;
+                }
+                let top = q.top(t, p);
                 // a group whose least price cannot beat the second best is skipped
-                if floor.is_finite() && floor + q.least(t, p) < b.b2 {
-                    for (j, pj) in q.two(t, i, p) {
+                if floor + top[0].1 < b.b2 {
+                    // the two cheapest columns other than i
+                    for &(j, pj) in top.iter().filter(|&&(j, _)| j != i).take(2) {
                         if j != usize::MAX {
                             b.see(j, floor + pj);
                         }
@@ -165,13 +211,34 @@ impl Problem {
         b
     }
 
+    /// The floor of row `i` (of group `gi`) to the columns of group `t` it does not list.
+    #[inline]
+    fn floor(&self, i: usize, gi: u32, t: usize) -> f64 {
+        if t == gi as usize {
+            self.same[i]
+        } else {
+            self.other[i] + self.tail[t]
+        }
+    }
+
     /// The lower bound `Σ_i min_j (c_ij + p_j) − Σ_j p_j` of prices `p`; `None` when some
     /// row reaches no column.
     pub fn dual_value(&self, p: &[f64]) -> Option<f64> {
-        let mut q = Queues::new(self, p);
+        let two = two_cheapest(self, p);
         let mut total = -p.iter().sum::<f64>();
         for i in 0..self.size {
-            let u = self.best(i, p, &mut q).b1;
+            let mut u = f64::INFINITY;
+            for (j, c) in self.row(i) {
+                u = u.min(c + p[j]);
+            }
+            let gi = self.group[i];
+            if gi != NO_GROUP {
+                for (t, cheap) in two.iter().enumerate() {
+                    // the cheapest column of group t other than i
+                    let pj = if cheap[0].0 == i { cheap[1].1 } else { cheap[0].1 };
+                    u = u.min(self.floor(i, gi, t) + pj);
+                }
+            }
             if !u.is_finite() {
                 return None;
             }

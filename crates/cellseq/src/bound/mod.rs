@@ -71,7 +71,7 @@ impl Default for BoundOptions {
             lagrangian_iterations: 300,
             qpath_work: 1e8,
             sec_work: 1e8,
-            knn: 16,
+            knn: 8,
             upper: None,
             deadline: Deadline::NONE,
         }
@@ -115,16 +115,23 @@ pub fn compute(m: &CostModel, opt: &BoundOptions) -> Bounds {
             dense_bounds(m, opt, &cl, &g, t0, &mut parts);
         }
     } else if m.is_geometric() && !dl.passed() {
-        let v = knn::knn_in_bound_until(m, opt.knn.max(1), dl);
-        parts.push(BoundValue {
-            name: "degree_knn",
-            value: constant + v,
-            seconds: t0.elapsed().as_secs_f64(),
-        });
+        let k = opt.knn.max(1);
+        // the sparse assignment first: it is the stronger; under a deadline the degree
+        // bound runs only when the assignment gave nothing
         let t = Instant::now();
-        if let Some(v) = assignment_knn::assignment_knn_until(m, opt.knn.max(1), dl) {
+        let a = assignment_knn::assignment_knn_until(m, k, dl);
+        if let Some(v) = a {
             parts.push(BoundValue {
                 name: "assignment_knn",
+                value: constant + v,
+                seconds: t.elapsed().as_secs_f64(),
+            });
+        }
+        if (a.is_none() || !dl.is_set()) && !dl.passed() {
+            let t = Instant::now();
+            let v = knn::knn_in_bound_until(m, k, dl);
+            parts.push(BoundValue {
+                name: "degree_knn",
                 value: constant + v,
                 seconds: t.elapsed().as_secs_f64(),
             });
