@@ -86,6 +86,26 @@ def fmt(x):
     return "%d" % x
 
 
+def best_known_summary(rows):
+    """Per time limit, over the rows with a best known value: the mean gap of each peer's
+    medians to it, how many are at it, and how many cellseq rows are at or below LKH-3."""
+    out = ""
+    for limit in sorted({r[3] for r in rows}):
+        sel = [r for r in rows if r[3] == limit and r[6] not in (None, 0)]
+        if not sel:
+            continue
+        gap = lambda v, b: 100.0 * (v - b) / b  # noqa: E731
+        out += ("\n%g s, %d instances with a best known value: mean gap of the medians "
+                "cellseq %.3f %%, LKH-3 %.3f %%; at the best known cellseq %d, LKH-3 %d; "
+                "cellseq at or below LKH-3 on %d.\n" % (
+                    limit, len(sel),
+                    statistics.mean(gap(r[4], r[6]) for r in sel),
+                    statistics.mean(gap(r[5], r[6]) for r in sel),
+                    sum(r[4] <= r[6] for r in sel), sum(r[5] <= r[6] for r in sel),
+                    sum(r[4] <= r[5] for r in sel)))
+    return out
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("files", nargs="+")
@@ -134,7 +154,7 @@ def main():
         lines.append("| %s | %d | %s | %g | %s | %s | %s | %s | %s | %.1f / %.1f | %s |" % (
             r[0], r[1], r[2], r[3], fmt(r[4]), fmt(r[5]), fmt(r[6]), fmt(r[7]),
             "∞" if r[8] == float("inf") else "%.3f" % r[8], r[9], r[10], r[11]))
-    text = "\n".join(lines) + "\n"
+    text = "\n".join(lines) + "\n" + best_known_summary(rows)
     if loads:
         text += "\n1-minute load average at the end of each run: %.2f to %.2f (median %.2f).\n" % (
             min(loads), max(loads), statistics.median(loads))
