@@ -39,8 +39,8 @@ pub struct SolveArgs {
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
     /// Wall-clock limit of the whole command in seconds: reading the file, solving, the lower
-    /// bound after the solve (at most a twentieth of the time; `--no-bound` gives it to the
-    /// solver) and the report end within it plus a small margin (docs/bad-input.md, "Time
+    /// bound after the solve (at most a twentieth of the time, a tenth for geometric instances
+    /// above 50 000 cells; `--no-bound` gives it to the solver) and the report end within it plus a small margin (docs/bad-input.md, "Time
     /// limits"). Experiments (`cellseq run`) give each solver its full budget instead.
     #[arg(long, value_name = "SECONDS", value_parser = super::ranges::time_limit)]
     pub time_limit: Option<f64>,
