@@ -253,4 +253,31 @@ mod tests {
         assert_eq!(a.value, 0.0);
         assert!(a.col.iter().enumerate().all(|(i, &j)| i != j));
     }
+
+    /// Above [`DENSE_MAX_ORDER`] the sparse method answers: on an order-600 matrix whose
+    /// cheap arcs (costs 0–5) all go to one column in seven, the others costing 10 more, with
+    /// forbidden arcs (many ties; most rows lose the race for a cheap column) its value is
+    /// the dense method's.
+    #[test]
+    fn large_orders_take_the_sparse_method_with_the_same_value() {
+        let d = DENSE_MAX_ORDER + 88;
+        let mut rng = ChaCha8Rng::seed_from_u64(5);
+        let m: Vec<f64> = (0..d * d)
+            .map(|k| {
+                if rng.random_bool(0.3) {
+                    f64::INFINITY
+                } else {
+                    let dear = if (k % d).is_multiple_of(7) { 0 } else { 10 };
+                    (rng.random_range(0..=5u64) + dear) as f64
+                }
+            })
+            .collect();
+        let c = |i: usize, j: usize| m[i * d + j];
+        let sparse = hungarian_duals(d, c).unwrap();
+        let dense = dense_until(d, c, Deadline::NONE).unwrap();
+        assert_eq!(sparse.value, dense.value);
+        assert!(sparse.value >= 10.0 * (d - d.div_ceil(7)) as f64, "{}", sparse.value);
+        let lap = super::super::lap::solve(d, c, Deadline::NONE).unwrap();
+        assert_eq!(lap.col, sparse.col, "hungarian_duals did not take the sparse method");
+    }
 }
