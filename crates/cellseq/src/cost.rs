@@ -474,6 +474,17 @@ impl CostModel {
         }
     }
 
+    /// The cheapest arc from cell `a` to cell `b` over every pair of their modes.
+    pub fn cheapest_arc(&self, a: usize, b: usize) -> f64 {
+        let mut best = f64::INFINITY;
+        for ma in 0..self.modes(a) {
+            for mb in 0..self.modes(b) {
+                best = best.min(self.arc(a, ma, b, mb));
+            }
+        }
+        best
+    }
+
     /// Cost of going from (a, ma) to (b, mb).
     #[inline(always)]
     pub fn arc(&self, a: usize, ma: usize, b: usize, mb: usize) -> f64 {

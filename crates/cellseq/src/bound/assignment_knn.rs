@@ -123,7 +123,7 @@ fn candidates(m: &CostModel, k: usize, deadline: Deadline) -> Option<Problem> {
                 far = Some(r.distance.sqrt());
                 break;
             }
-            let c = cheapest(m, i, j as usize);
+            let c = m.cheapest_arc(i, j as usize);
             if c.is_finite() {
                 g.col.push(j);
                 g.cost.push(c);
@@ -194,7 +194,7 @@ fn list_links(
             if added == LINKS_LISTED {
                 return false;
             }
-            let c = cheapest(m, i, j as usize);
+            let c = m.cheapest_arc(i, j as usize);
             if c.is_finite() {
                 g.col.push(j);
                 g.cost.push(c);
@@ -203,17 +203,6 @@ fn list_links(
         }
     }
     true
-}
-
-/// The cheapest arc from cell `i` to cell `j` over all mode pairs.
-fn cheapest(m: &CostModel, i: usize, j: usize) -> f64 {
-    let mut best = f64::INFINITY;
-    for mi in 0..m.modes(i) {
-        for mj in 0..m.modes(j) {
-            best = best.min(m.arc(i, mi, j, mj));
-        }
-    }
-    best
 }
 
 /// Per tool, the least [`CostModel::change_tail`] over the entry points of its cells (the

@@ -48,13 +48,7 @@ impl CellGraph {
                 if !cl.arc_allowed(i, j) {
                     continue;
                 }
-                let mut best = f64::INFINITY;
-                for mi in 0..m.modes(i) {
-                    for mj in 0..m.modes(j) {
-                        best = best.min(m.arc(i, mi, j, mj));
-                    }
-                }
-                cost[i * d + j] = best;
+                cost[i * d + j] = m.cheapest_arc(i, j);
             }
         }
         Some(CellGraph { n, cost })

@@ -62,16 +62,6 @@ impl Neighbours {
     }
 }
 
-fn min_cost(m: &CostModel, a: usize, b: usize) -> f64 {
-    let mut best = f64::INFINITY;
-    for ma in 0..m.modes(a) {
-        for mb in 0..m.modes(b) {
-            best = best.min(m.arc(a, ma, b, mb));
-        }
-    }
-    best
-}
-
 fn matrix(m: &CostModel, k: usize, deadline: Deadline) -> Neighbours {
     let n = m.n();
     // one row or column of cheapest arcs at a time: O(n) memory besides the lists (an n × n
@@ -97,7 +87,7 @@ fn matrix(m: &CostModel, k: usize, deadline: Deadline) -> Neighbours {
         if a == b {
             f64::INFINITY
         } else {
-            min_cost(m, a, b)
+            m.cheapest_arc(a, b)
         }
     };
     let mut out = Vec::with_capacity(n);
