@@ -3,7 +3,19 @@
 
 pub mod polygon;
 
+use kiddo::ImmutableKdTree;
 use serde::{Deserialize, Serialize};
+
+/// A k-d tree over planar points whose items are their indices in `points`. Immutable trees
+/// are built once and are robust to many coincident or collinear points.
+pub fn xy_tree(points: impl IntoIterator<Item = [f64; 2]>) -> ImmutableKdTree<f64, 2> {
+    let pts: Vec<(u32, [f64; 2])> = points
+        .into_iter()
+        .enumerate()
+        .map(|(i, p)| (i as u32, p))
+        .collect();
+    ImmutableKdTree::new_from_entries(&pts).expect("k-d tree build")
+}
 
 /// A point in machine coordinates (mm). Serialized as `[x, y, z]`.
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]

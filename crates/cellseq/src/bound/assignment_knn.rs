@@ -27,6 +27,7 @@
 use super::auction::{NO_GROUP, Problem, auction};
 use crate::clock::{Deadline, Ticker};
 use crate::cost::CostModel;
+use crate::geom::xy_tree;
 use crate::model::Objective;
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
 use std::num::NonZero;
@@ -70,17 +71,11 @@ fn candidates(m: &CostModel, k: usize, deadline: Deadline) -> Option<Problem> {
     let (entry_at, entry_off) = centroids(m, false);
     let rho = entry_off.iter().flatten().copied().fold(0.0, f64::max);
     let (exit_at, exit_off) = centroids(m, true);
-    let pts: Vec<(u32, [f64; 2])> = entry_at.iter().enumerate().map(|(c, &p)| (c as u32, p)).collect();
-    let tree: ImmutableKdTree<f64, 2> =
-        ImmutableKdTree::new_from_entries(&pts).expect("k-d tree build");
-    let pts: Vec<(u32, [f64; 2])> = (0..m.nodes())
-        .map(|nd| {
-            let p = m.entry(nd);
-            (nd as u32, [p.x, p.y])
-        })
-        .collect();
-    let nodes: ImmutableKdTree<f64, 2> =
-        ImmutableKdTree::new_from_entries(&pts).expect("k-d tree build");
+    let tree = xy_tree(entry_at.iter().copied());
+    let nodes = xy_tree((0..m.nodes()).map(|nd| {
+        let p = m.entry(nd);
+        [p.x, p.y]
+    }));
     let time = m.objective() == Objective::Time;
     let rapid = if time { m.rapid_rate() } else { 1.0 };
     let link_rate = if time {

@@ -8,6 +8,7 @@
 
 use crate::clock::{Deadline, Ticker};
 use crate::cost::CostModel;
+use crate::geom::xy_tree;
 use crate::model::Objective;
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
 use std::num::NonZero;
@@ -26,15 +27,10 @@ pub fn knn_in_bound_until(m: &CostModel, k: usize, deadline: Deadline) -> f64 {
     if n == 0 {
         return 0.0;
     }
-    // immutable tree: robust to many coincident or collinear points
-    let pts: Vec<(u32, [f64; 2])> = (0..nodes)
-        .map(|nd| {
-            let p = m.exit(nd);
-            (nd as u32, [p.x, p.y])
-        })
-        .collect();
-    let tree: ImmutableKdTree<f64, 2> =
-        ImmutableKdTree::new_from_entries(&pts).expect("k-d tree build");
+    let tree = xy_tree((0..nodes).map(|nd| {
+        let p = m.exit(nd);
+        [p.x, p.y]
+    }));
     let max_modes = (0..n).map(|c| m.modes(c)).max().unwrap_or(1);
     let want = (k + max_modes).min(nodes).max(1);
     let rate = |cell: usize| match m.objective() {

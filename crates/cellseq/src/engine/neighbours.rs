@@ -200,15 +200,11 @@ fn lists(n: usize, deadline: Deadline, f: impl Fn(usize) -> Vec<u32> + Sync + Se
 /// Neighbour lists from k-d trees over every node's point.
 fn geometric_nodes(m: &CostModel, k: usize, deadline: Deadline) -> Neighbours {
     let n = m.n();
-    // immutable trees: built once, and robust to many coincident or collinear points
-    let build = |exit: bool| -> ImmutableKdTree<f64, 2> {
-        let pts: Vec<(u32, [f64; 2])> = (0..m.nodes())
-            .map(|nd| {
-                let p = if exit { m.exit(nd) } else { m.entry(nd) };
-                (nd as u32, [p.x, p.y])
-            })
-            .collect();
-        ImmutableKdTree::new_from_entries(&pts).expect("k-d tree build")
+    let build = |exit: bool| {
+        crate::geom::xy_tree((0..m.nodes()).map(|nd| {
+            let p = if exit { m.exit(nd) } else { m.entry(nd) };
+            [p.x, p.y]
+        }))
     };
     let entries = build(false);
     let exits = build(true);
