@@ -10,7 +10,8 @@
 //! - `assignment_knn`: the assignment bound of the same large geometric instances, by an
 //!   auction on a sparse candidate graph whose left-out arcs are covered by proven floors
 //!   ([`assignment_knn`], O(n K) memory).
-//! - `assignment`: the assignment problem on the cell graph ([`lap`]).
+//! - `assignment`: the assignment problem on the cell graph (the dense Hungarian method, and
+//!   [`lap`] above order [`assignment::DENSE_MAX_ORDER`]).
 //! - `lagrangian`: minimum spanning 1-arborescence with subgradient out-degree penalties.
 //! - `sec`: assignment with Lagrangian subtour-elimination multipliers ([`sec`]).
 //! - `qpath`: position-indexed path relaxation (precedence windows, no 2-cycles) with
@@ -40,7 +41,8 @@ pub struct BoundOptions {
     /// Largest n for the dense cell graph (O(n²) memory); larger geometric instances get the
     /// K-nearest-neighbour degree and sparse assignment bounds only.
     pub dense_max_cells: usize,
-    /// Largest n for the assignment bound (O(n³) time).
+    /// Largest n for the assignment bound (the dense method, O(n³), up to order
+    /// [`assignment::DENSE_MAX_ORDER`]; [`lap`] above).
     pub assignment_max_cells: usize,
     /// Largest n for the Lagrangian arborescence bound.
     pub lagrangian_max_cells: usize,

@@ -222,7 +222,7 @@ pub fn construct(m: &CostModel, g: &ApGraph, greedy: bool) -> Option<(Vec<u32>, 
     construct_until(m, g, greedy, Deadline::NONE)
 }
 
-/// Like [`construct`], or `None` when `deadline` passes during the assignment (O(n³)).
+/// Like [`construct`], or `None` when `deadline` passes during the assignment.
 pub fn construct_until(
     m: &CostModel,
     g: &ApGraph,
