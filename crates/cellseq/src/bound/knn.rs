@@ -10,7 +10,7 @@ use crate::clock::{Deadline, Ticker};
 use crate::cost::CostModel;
 use crate::geom::xy_tree;
 use crate::model::Objective;
-use kiddo::{ImmutableKdTree, SquaredEuclidean};
+use kiddo::SquaredEuclidean;
 use std::num::NonZero;
 
 /// Σ over cells of a lower bound on the cheapest way into the cell, plus a lower bound on
