@@ -41,8 +41,8 @@ pub struct BoundOptions {
     /// Largest n for the dense cell graph (O(n²) memory); larger geometric instances get the
     /// K-nearest-neighbour degree and sparse assignment bounds only.
     pub dense_max_cells: usize,
-    /// Largest n for the assignment bound (the dense method, O(n³), up to order
-    /// [`assignment::DENSE_MAX_ORDER`]; [`lap`] above).
+    /// Largest n for the assignment bound (the dense Hungarian method, O(n³), up to order
+    /// 512; shortest augmenting paths on sparse row lists above).
     pub assignment_max_cells: usize,
     /// Largest n for the Lagrangian arborescence bound.
     pub lagrangian_max_cells: usize,
