@@ -90,8 +90,7 @@ impl Solution {
             .min()
             .unwrap_or(self.n() as isize)
     }
-    /// True when every precedence pair is respected (O(n + edges), for assertions and tests).
-    #[cfg(any(test, feature = "internals"))]
+    /// True when every precedence pair is respected (O(n + edges)).
     pub fn feasible(&self, m: &CostModel) -> bool {
         (0..self.n()).all(|c| {
             m.dag.succs[c]

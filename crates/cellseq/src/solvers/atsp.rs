@@ -1,10 +1,13 @@
 //! `atsp`: for asymmetric costs with little or no precedence — the assignment problem's cycles
-//! patched into a path, candidate lists from its reduced costs, then an iterated Or-3opt
-//! search with block-swap kicks ([`crate::engine::atsp`]).
+//! patched into a path, candidate lists from its reduced costs, an iterated Or-3opt search with
+//! block-swap kicks, then depth-first branch and bound on the assignment relaxation
+//! ([`crate::engine::atsp`]).
 
 use super::Build;
 use super::start::{greedy_solution, outcome};
 use super::{Caps, Context, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo};
+use crate::bound::assignment::Assignment;
+use crate::engine::atsp::bnb::{ApState, Bnb, End};
 use crate::engine::atsp::cands::{Rank, candidates};
 use crate::engine::atsp::or3::Or3;
 use crate::engine::atsp::patch::{ApGraph, construct_until};
@@ -18,7 +21,7 @@ use rand_chacha::ChaCha8Rng;
 /// Registry entry.
 pub static INFO: SolverInfo = SolverInfo {
     name: "atsp",
-    summary: "asymmetric costs with little or no precedence: assignment cycles patched into a path, reduced-cost candidates, iterated Or-3opt with block-swap kicks",
+    summary: "asymmetric costs with little or no precedence: assignment cycles patched into a path, reduced-cost candidates, iterated Or-3opt with block-swap kicks, then branch and bound on the assignment",
     description: "For asymmetric costs with little or no precedence (an asymmetric TSP as an open path).
 
 - **Start**: the better of `greedy` and the assignment problem's solution (a dummy node \
@@ -31,6 +34,14 @@ lists ranked by the assignment's reduced costs (`cand=reduced`, ties by raw cost
 cell), precedence checked on every move; kicks swap two blocks across a third (`kick=far`) \
 or two adjacent blocks (`near`), of up to `kick-len` cells; equal-or-better results are \
 accepted.
+- **Branch and bound**: once `bnb-after` kicks per cell in a row bring no improvement (or no \
+kick is allowed), an instance with one mode per cell turns to a depth-first branch and bound on \
+the assignment relaxation (Carpaneto and Toth's subtour elimination: the smallest cycle's arcs \
+are excluded one per child, the ones before it forced; each child is one augmenting path from \
+its parent, lowest bound first; children at or above the best tour are pruned). Every node's \
+cycles are also patched into a tour, descended by Or-3opt when within `polish` of the best. \
+When the tree is exhausted (and every one-cycle leaf kept the precedence) the result is \
+reported as proven optimal, with the optimum as its lower bound.
 - `auto` runs it (the built-in portfolio's `free` rule) on asymmetric matrix instances whose \
 `free_density` (the closure density apart from cells ordered against every other: a fixed \
 start and end) is at most 0.001; notes/atsp.md has the measurements.",
@@ -66,6 +77,18 @@ start and end) is at most 0.001; notes/atsp.md has the measurements.",
             help: "greedy: the cheapest join of any two assignment cycles first; karp: cycles joined into the largest one, largest first",
         },
         ParamSpec {
+            name: "bnb-after",
+            default: "1",
+            kind: ParamKind::int(0, 1_000_000),
+            help: "after this many kicks per cell without improvement the search turns to branch and bound on the assignment (0: never)",
+        },
+        ParamSpec {
+            name: "polish",
+            default: "0.05",
+            kind: ParamKind::float(0.0, 10.0),
+            help: "branch and bound: a patched tour is descended by Or-3opt when at most this fraction above the best",
+        },
+        ParamSpec {
             name: "ap-max-cells",
             default: "3000",
             kind: ParamKind::int(0, 20_000),
@@ -85,6 +108,8 @@ start and end) is at most 0.001; notes/atsp.md has the measurements.",
             ap_max_cells: p.int("ap-max-cells") as usize,
             far: p.word("kick") == "far",
             greedy_patch: p.word("patch") == "greedy",
+            bnb_after: p.int("bnb-after") as usize,
+            polish: p.float("polish"),
         }))
     }),
 };
@@ -103,6 +128,10 @@ pub struct Atsp {
     pub far: bool,
     /// Greedy patching (else Karp's order).
     pub greedy_patch: bool,
+    /// Kicks per cell without improvement before branch and bound (0: never).
+    pub bnb_after: usize,
+    /// Patched tours within this fraction of the best are descended.
+    pub polish: f64,
 }
 
 impl Atsp {
@@ -111,7 +140,7 @@ impl Atsp {
     /// patched path be repaired, greedy is descended as well and the cheaper local optimum
     /// wins (the repair moves every cell that must wait for a predecessor next to it, across
     /// arcs the assignment did not choose).
-    fn start(&self, ctx: &mut Context, c: &Costs) -> (Solution, Neighbours) {
+    fn start(&self, ctx: &mut Context, c: &Costs) -> (Solution, Neighbours, Option<Relaxation>) {
         let m = ctx.model;
         let greedy = greedy_solution(ctx, c);
         if ctx.deadline().passed() {
@@ -120,16 +149,16 @@ impl Atsp {
                 out: none.clone(),
                 inn: none,
             };
-            return (greedy, nb);
+            return (greedy, nb, None);
         }
         if m.n() < 2 || m.n() > self.ap_max_cells || ctx.exhausted() {
-            return (greedy, Neighbours::new_until(m, self.k, ctx.deadline()));
+            return (greedy, Neighbours::new_until(m, self.k, ctx.deadline()), None);
         }
         let modes: Vec<u32> = (0..m.n()).map(|c| greedy.mode[c]).collect();
         let g = ApGraph::new(m, &modes);
         let Some((order, ap, evals)) = construct_until(m, &g, self.greedy_patch, ctx.deadline())
         else {
-            return (greedy, Neighbours::new_until(m, self.k, ctx.deadline()));
+            return (greedy, Neighbours::new_until(m, self.k, ctx.deadline()), None);
         };
         ctx.count(evals);
         let seq: Vec<Visit> = order
@@ -146,7 +175,7 @@ impl Atsp {
         }
         ctx.report(patched.cost.min(greedy.cost) + m.constant());
         if m.dag.succs.iter().all(|s| s.is_empty()) {
-            return (patched, nb);
+            return (patched, nb, Some((g, ap)));
         }
         let descended = |mut s: Solution, ctx: &mut Context| {
             let mut or3 = Or3::new(*c, &nb);
@@ -157,7 +186,85 @@ impl Atsp {
         let a = descended(patched, ctx);
         let b = descended(greedy, ctx);
         let s = if a.cost <= b.cost { a } else { b };
-        (s, nb)
+        (s, nb, Some((g, ap)))
+    }
+}
+
+/// The assignment graph and its optimal assignment, when the start solved one.
+type Relaxation = (ApGraph, Assignment);
+
+impl Atsp {
+    /// Depth-first branch and bound on the assignment relaxation ([`Bnb`]) from the best
+    /// order `best`, until the budget runs out or the tree is exhausted; every tour it meets
+    /// is descended by Or-3opt (a patched one only when within `polish` of the best) and
+    /// replaces `best` when cheaper. True when the tree was exhausted and every one-cycle
+    /// leaf kept the precedence: then `best` is optimal for the cells' fixed modes.
+    fn branch_and_bound(
+        &self,
+        ctx: &mut Context,
+        c: &Costs,
+        nb: &Neighbours,
+        g: &ApGraph,
+        ap: &Assignment,
+        best: &mut Solution,
+    ) -> bool {
+        let m = ctx.model;
+        let tol = 1e-9 * best.cost.abs().max(1.0);
+        let mut bnb = Bnb::new(g);
+        let mut or3 = Or3::new(*c, nb);
+        let mut counted = 0u64;
+        let polish = self.polish;
+        let mut leaves = 0u64;
+        let mut rejected = false;
+        let mut nodes = 0u64;
+        let ub = best.cost;
+        let ctx_cell = std::cell::RefCell::new(ctx);
+        let best_cell = std::cell::RefCell::new(best);
+        let end = bnb.search(
+            ApState::of(ap),
+            ub,
+            tol,
+            |order, value| {
+                let mut ctx = ctx_cell.borrow_mut();
+                let mut best = best_cell.borrow_mut();
+                let leaf = value.is_some();
+                leaves += u64::from(leaf);
+                let seq: Vec<Visit> = order
+                    .iter()
+                    .map(|&x| Visit::new(x as usize, best.mode[x as usize] as usize))
+                    .collect();
+                let mut s = Solution::new(c, &seq);
+                if !s.feasible(m) {
+                    rejected |= leaf;
+                    return best.cost;
+                }
+                if !leaf && s.cost > best.cost * (1.0 + polish) + tol {
+                    return best.cost;
+                }
+                or3.push_all(&s);
+                or3.descend(&mut s, &mut ctx);
+                if s.cost < best.cost - tol {
+                    best.clone_from(&s);
+                    ctx.report(best.cost + m.constant());
+                    if super::trace_enabled() {
+                        eprintln!("atsp: branch and bound {} after {:.2} s", best.cost, ctx.elapsed());
+                    }
+                }
+                best.cost
+            },
+            |work| {
+                nodes += 1;
+                let mut ctx = ctx_cell.borrow_mut();
+                let d = (g.n + 1) as u64;
+                ctx.count((work - counted) / d + 1);
+                counted = work;
+                ctx.exhausted()
+            },
+        );
+        if super::trace_enabled() {
+            eprintln!("atsp: branch and bound {end:?}, {nodes} nodes, {leaves} one-cycle leaves");
+        }
+        end == End::Exhausted && !rejected
     }
 }
 
@@ -165,7 +272,7 @@ impl Solver for Atsp {
     fn solve(&self, ctx: &mut Context) -> Result<Outcome> {
         let m = ctx.model;
         let c = Costs::open(m);
-        let (mut s, nb) = self.start(ctx, &c);
+        let (mut s, nb, relax) = self.start(ctx, &c);
         if ctx.deadline().passed() {
             return Ok(outcome(m, &s));
         }
@@ -176,6 +283,10 @@ impl Solver for Atsp {
         let mut best = s.clone();
         let mut rng = ChaCha8Rng::seed_from_u64(ctx.seed ^ 0xa75b);
         let max_len = self.kick_len.min(s.n() / 3).max(1);
+        // the assignment graph is a relaxation of the instance only with one mode per cell
+        // (else it holds the start's modes)
+        let bnb = self.bnb_after > 0 && relax.is_some() && !m.multimode();
+        let mut stalled = 0usize;
         while !ctx.exhausted() {
             ctx.count(1);
             if !or3.kick(&mut s, &mut rng, max_len, 20, self.far) {
@@ -183,17 +294,34 @@ impl Solver for Atsp {
             }
             or3.descend(&mut s, ctx);
             let tol = 1e-9 * best.cost.abs().max(1.0);
+            stalled += 1;
             if s.cost < best.cost - tol {
                 best.clone_from(&s);
                 ctx.report(best.cost + m.constant());
+                stalled = 0;
             } else if s.cost > best.cost + tol {
                 s.clone_from(&best);
             }
+            if bnb && stalled >= self.bnb_after * s.n() {
+                break;
+            }
+        }
+        let mut proven = false;
+        if let Some((g, ap)) = relax.as_ref().filter(|_| bnb)
+            && !ctx.exhausted()
+        {
+            proven = self.branch_and_bound(ctx, &c, &nb, g, ap, &mut best);
         }
         if m.multimode() {
             ctx.count(mode_dp(&c, &mut best));
+            proven = false;
         }
-        Ok(outcome(m, &best))
+        let mut out = outcome(m, &best);
+        if proven {
+            out.proven_optimal = true;
+            out.lower_bound = Some(out.cost);
+        }
+        Ok(out)
     }
 }
 
@@ -281,6 +409,41 @@ mod tests {
             assert_eq!(cost, opt, "seed {seed}: atsp {cost}, exact {opt}");
         }
         assert!(one_cycle > 0, "no instance had a one-cycle assignment");
+    }
+
+    /// Where `atsp`'s branch and bound exhausts its tree it claims optimality, with the
+    /// optimum as its lower bound; the claim agrees with the DP on every instance that makes
+    /// it, and it is made on every instance without precedence.
+    #[test]
+    fn exhausted_branch_and_bound_proves_the_optimum() {
+        let mut proofs = 0;
+        for seed in 0..40u64 {
+            let n = 6 + (seed as usize % 5);
+            let inst = tiny(n, 1000 + seed);
+            let (opt, _) = solve("exact", &inst, None);
+            let r = run(
+                "atsp",
+                &inst,
+                Objective::Matrix,
+                &BTreeMap::new(),
+                seed,
+                Budget {
+                    time_limit: None,
+                    max_evals: Some(1_000_000),
+                },
+                &mut NoObserver,
+            )
+            .unwrap();
+            if inst.precedence.is_empty() && inst.first.is_none() {
+                assert!(r.outcome.proven_optimal, "seed {seed}: no proof");
+            }
+            if r.outcome.proven_optimal {
+                proofs += 1;
+                assert_eq!(r.report.cost, opt, "seed {seed}");
+                assert_eq!(r.outcome.lower_bound, Some(r.outcome.cost), "seed {seed}");
+            }
+        }
+        assert!(proofs > 0);
     }
 
     /// The same seed and evaluation budget give the same sequence.

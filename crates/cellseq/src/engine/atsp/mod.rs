@@ -14,7 +14,11 @@
 //!   their orientation (segment insertion without reversal), driven by the candidate lists
 //!   with don't-look queues and checked against the precedence, inside an iterated local
 //!   search whose kicks swap two nearby blocks (the double bridge of a path).
+//! - [`bnb`]: depth-first branch and bound on the assignment relaxation (subtour elimination
+//!   with one augmenting path per child), whose nodes' patched tours feed the Or-3opt search
+//!   and whose exhausted tree proves the best tour optimal.
 
+pub mod bnb;
 pub mod cands;
 pub mod or3;
 pub mod patch;

@@ -406,6 +406,9 @@ impl Solver for Auto {
                 twin: on,
             };
             let o = self.phase(ctx, run)?;
+            if o.proven_optimal && !ph.reversed {
+                return Ok(o);
+            }
             keep(&mut best, o.clone());
             last = Some(o);
         }
