@@ -216,7 +216,6 @@ impl Atsp {
         let polish = self.polish;
         let mut leaves = 0u64;
         let mut rejected = false;
-        let mut nodes = 0u64;
         let ub = best.cost;
         let ctx_cell = std::cell::RefCell::new(ctx);
         let best_cell = std::cell::RefCell::new(best);
@@ -253,7 +252,6 @@ impl Atsp {
                 best.cost
             },
             |work| {
-                nodes += 1;
                 let mut ctx = ctx_cell.borrow_mut();
                 let d = (g.n + 1) as u64;
                 ctx.count((work - counted) / d + 1);
@@ -262,7 +260,10 @@ impl Atsp {
             },
         );
         if super::trace_enabled() {
-            eprintln!("atsp: branch and bound {end:?}, {nodes} nodes, {leaves} one-cycle leaves");
+            eprintln!(
+                "atsp: branch and bound {end:?}, {} nodes, {leaves} one-cycle leaves",
+                bnb.nodes
+            );
         }
         end == End::Exhausted && !rejected
     }

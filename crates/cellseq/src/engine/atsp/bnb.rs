@@ -105,6 +105,8 @@ pub struct Bnb<'a> {
     scanned: Vec<u32>,
     /// Arc costs looked at so far.
     pub work: u64,
+    /// Nodes searched so far.
+    pub nodes: u64,
 }
 
 impl<'a> Bnb<'a> {
@@ -126,6 +128,7 @@ impl<'a> Bnb<'a> {
             done: vec![false; d],
             scanned: Vec::with_capacity(d),
             work: 0,
+            nodes: 0,
         }
     }
 
@@ -229,8 +232,15 @@ impl<'a> Bnb<'a> {
     }
 
     /// The frame that breaks the smallest cycle of `s` (by free arcs), with the children
-    /// whose bound is below `ub`; `None` when a cycle is all forced arcs (no tour keeps them).
-    fn branch(&mut self, s: &ApState, ub: f64, tol: f64) -> Option<Frame> {
+    /// whose bound is below `ub`; `None` when a cycle is all forced arcs (no tour keeps them)
+    /// or when `stop` (asked before each child's augmenting path) says so.
+    fn branch(
+        &mut self,
+        s: &ApState,
+        ub: f64,
+        tol: f64,
+        stop: &mut impl FnMut(u64) -> bool,
+    ) -> Option<Frame> {
         let mut best: Option<Vec<(u32, u32)>> = None;
         for cyc in cycles(&s.succ()) {
             let arcs: Vec<(u32, u32)> = cyc
@@ -248,6 +258,9 @@ impl<'a> Bnb<'a> {
         let arcs = best?;
         let mut children = Vec::with_capacity(arcs.len());
         for t in 0..arcs.len() {
+            if stop(self.work) {
+                return None;
+            }
             self.enter(&arcs, t);
             let mut c = s.clone();
             let (i, j) = (arcs[t].0 as usize, arcs[t].1 as usize);
@@ -274,8 +287,9 @@ impl<'a> Bnb<'a> {
     /// Searches from the root assignment `root` with the best tour's cost `ub`. Every node's
     /// tour (its own cycle when it has one, else its patched cycles) goes to `tour` as a cell
     /// order with the value of a one-cycle node (`None` for a patched tour); `tour` returns
-    /// the best cost known after it, which becomes the pruning bound. `stop` is asked before
-    /// each node.
+    /// the best cost known after it, which becomes the pruning bound. `stop`, given the work
+    /// so far, is asked before each node and each child's augmenting path, so that one node
+    /// of a large instance does not outlast a deadline.
     pub fn search(
         &mut self,
         root: ApState,
@@ -291,6 +305,7 @@ impl<'a> Bnb<'a> {
                 if stop(self.work) {
                     return End::Stopped;
                 }
+                self.nodes += 1;
                 let succ = s.succ();
                 if cycles(&succ).len() == 1 {
                     ub = ub.min(tour(&path_of(&succ), Some(s.value)));
@@ -299,10 +314,12 @@ impl<'a> Bnb<'a> {
                         self.work += w;
                         ub = ub.min(tour(&path_of(&t), None));
                     }
-                    if s.value < ub - tol
-                        && let Some(f) = self.branch(&s, ub, tol)
-                    {
-                        stack.push(f);
+                    if s.value < ub - tol {
+                        match self.branch(&s, ub, tol, &mut stop) {
+                            Some(f) => stack.push(f),
+                            None if stop(self.work) => return End::Stopped,
+                            None => {}
+                        }
                     }
                 }
             }
