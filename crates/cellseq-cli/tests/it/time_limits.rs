@@ -209,8 +209,9 @@ fn every_solver_keeps_a_one_second_limit_on_degenerate_instances() {
 }
 
 /// The command as a user runs it on the defect's regime (400 cells, costs 0–100, no inner
-/// precedence): `solve --time-limit 1` with the default `auto` and with `beam` (which ran
-/// 25.6 s and 635 MB there) ends within the limit and the margin, reading the file and the
+/// precedence): `solve --time-limit 1` with the default `auto`, with `beam` (which ran
+/// 25.6 s and 635 MB there) and with `atsp` (whose branch and bound checks the clock before
+/// each augmenting path) ends within the limit and the margin, reading the file and the
 /// lower bound after the solve included, and reports a checked result.
 #[test]
 fn solve_keeps_its_limit_on_a_free_small_cost_instance() {
@@ -232,7 +233,7 @@ fn solve_keeps_its_limit_on_a_free_small_cost_instance() {
         s(&file),
     ]);
     assert!(g.status.success(), "{}", stderr(&g));
-    for solver in ["auto", "beam"] {
+    for solver in ["auto", "beam", "atsp"] {
         let t0 = Instant::now();
         let o = cellseq()
             .args([

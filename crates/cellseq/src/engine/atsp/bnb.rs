@@ -107,6 +107,8 @@ pub struct Bnb<'a> {
     pub work: u64,
     /// Nodes searched so far.
     pub nodes: u64,
+    /// Augmenting-path searches so far.
+    pub augments: u64,
 }
 
 impl<'a> Bnb<'a> {
@@ -129,6 +131,7 @@ impl<'a> Bnb<'a> {
             scanned: Vec::with_capacity(d),
             work: 0,
             nodes: 0,
+            augments: 0,
         }
     }
 
@@ -136,6 +139,7 @@ impl<'a> Bnb<'a> {
     /// updates the potentials; false when no finite path exists (then `s` is unusable).
     fn augment(&mut self, s: &mut ApState, r0: usize) -> bool {
         let d = self.d;
+        self.augments += 1;
         self.dist.fill(f64::INFINITY);
         self.done.fill(false);
         self.scanned.clear();
@@ -410,6 +414,49 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// The stop condition is asked before every augmenting path, so that a deadline is
+    /// checked at least once per O(d²) of work however long the broken cycle; a search whose
+    /// stop condition holds ends at once as stopped.
+    #[test]
+    fn stop_is_asked_before_every_augmenting_path() {
+        let mut deep = 0;
+        for seed in 0..12u64 {
+            let n = 20 + seed as usize * 3;
+            let inst = random_matrix_instance(n, 900 + seed, 1000, &[]);
+            let m = CostModel::new(&inst, Objective::Matrix);
+            let c = Costs::open(&m);
+            let g = ApGraph::new(&m, &vec![0; n]);
+            let ap = g.assignment().unwrap();
+            let mut best = f64::INFINITY;
+            let mut tour = |order: &[u32], _: Option<f64>| {
+                let seq: Vec<Visit> = order.iter().map(|&x| Visit::new(x as usize, 0)).collect();
+                best = best.min(Solution::new(&c, &seq).cost);
+                best
+            };
+            let mut b = Bnb::new(&g);
+            let mut asked = 0u64;
+            let end = b.search(ApState::of(&ap), f64::INFINITY, 1e-9, &mut tour, |_| {
+                asked += 1;
+                false
+            });
+            assert_eq!(end, End::Exhausted, "seed {seed}");
+            assert!(asked >= b.augments, "seed {seed}: {asked} asks, {} paths", b.augments);
+            if asked <= 3 {
+                continue;
+            }
+            deep += 1;
+            let mut b = Bnb::new(&g);
+            let mut asked = 0u64;
+            let end = b.search(ApState::of(&ap), f64::INFINITY, 1e-9, &mut tour, |_| {
+                asked += 1;
+                asked > 2
+            });
+            assert_eq!(end, End::Stopped, "seed {seed}");
+            assert!(b.augments <= 2, "seed {seed}: {} paths after the stop", b.augments);
+        }
+        assert!(deep > 0, "every tree was too small to stop inside");
     }
 
     /// Searched to the end, the tree finds the exact optimum (the DP's) on small instances.
