@@ -1,7 +1,8 @@
 //! Engine benchmarks: delta evaluations per second, one local-search pass on 10k cells, the
 //! two-level descent on 10k points (with and without 3-opt), the Lin–Kernighan descent on a
 //! symmetric matrix with precedence, the two-way SOP-3-exchange descent on a symmetric matrix
-//! with sparse precedence, one SA chain, one tabu iteration, one ant construction.
+//! with sparse precedence, one SA chain, one tabu iteration, one ant construction; `atsp` to
+//! its branch-and-bound proof on a 300-cell random matrix with costs 0–100.
 
 use cellseq::cost::CostModel;
 use cellseq::engine::large::Large;
@@ -15,7 +16,7 @@ use cellseq::model::Instance;
 use cellseq::solvers::aco::{Aco, Pheromone};
 use cellseq::solvers::sa::Anneal;
 use cellseq::solvers::tabu::{TabuList, tabu_step};
-use cellseq::solvers::{Budget, Context, NoObserver, greedy};
+use cellseq::solvers::{Budget, Context, NoObserver, greedy, run};
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -229,6 +230,32 @@ fn benches(cr: &mut Criterion) {
             let mut obs = NoObserver;
             let mut ctx = Context::new(&inst, &m, 1, Budget::default(), &mut obs);
             black_box(aco.construct(&mut ctx, &mut tau, 1e-6, &mut rng).len())
+        })
+    });
+    g.finish();
+
+    // the atsp solver to its proof on a tie-rich asymmetric matrix: assignment, patching, the
+    // Or-3opt walk until it stalls, then the branch and bound until its tree is exhausted
+    let free = generated("random-sop", &[("n", "300"), ("c", "100"), ("p", "0")]);
+    let mut g = cr.benchmark_group("atsp");
+    g.sample_size(10);
+    g.bench_function("atsp to a proof (random-sop n = 300, costs 0-100)", |b| {
+        b.iter(|| {
+            let r = run(
+                "atsp",
+                &free,
+                free.default_objective(),
+                &BTreeMap::new(),
+                1,
+                Budget {
+                    time_limit: None,
+                    max_evals: Some(1_000_000_000),
+                },
+                &mut NoObserver,
+            )
+            .unwrap();
+            assert!(r.outcome.proven_optimal);
+            black_box(r.report.cost)
         })
     });
     g.finish();
