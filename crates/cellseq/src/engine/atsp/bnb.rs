@@ -17,7 +17,9 @@
 //! The search is a heuristic under a budget: every node also patches its cycles into a tour
 //! ([`super::patch::patch`]), and every tour found goes to a caller's callback (which may
 //! improve it) whose result tightens the pruning bound. When the tree is exhausted within the
-//! budget and every tour found kept the precedence, the best tour is optimal.
+//! budget and every tour found kept the precedence, the best tour is optimal up to the
+//! pruning tolerance the caller gives (`atsp`: 10⁻⁹ of the best cost, the engine's measure of
+//! an improvement).
 
 use super::patch::{ApGraph, cycles, patch, path_of};
 use crate::bound::assignment::Assignment;
