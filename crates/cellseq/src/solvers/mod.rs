@@ -430,6 +430,14 @@ pub fn run_until(
             ),
         });
     }
+    // a result at the model's floor (a lower bound on every sequence) is optimal, whichever
+    // solver found it (a search stops there without a proof of its own)
+    let mut outcome = outcome;
+    let floor = crate::context::floor(&model);
+    if !outcome.proven_optimal && report.cost <= floor + 1e-9 * floor.abs().max(1.0) {
+        outcome.proven_optimal = true;
+        outcome.lower_bound = Some(outcome.lower_bound.map_or(floor, |b| b.max(floor)));
+    }
     Ok(RunResult {
         outcome,
         report,
@@ -449,6 +457,28 @@ mod tests {
         let text = "TYPE: SOP\nDIMENSION: 5\nEDGE_WEIGHT_SECTION\n5\n\
                     0 4 1 9 9\n-1 0 3 2 8\n-1 1 0 -1 6\n-1 -1 1 0 1\n-1 -1 -1 -1 0\nEOF\n";
         parse_instance("tiny.sop", text, Format::Sop).unwrap()
+    }
+
+    /// A result at the model's floor is reported as proven optimal with the floor as its
+    /// lower bound, whichever solver found it; one above it is not.
+    #[test]
+    fn a_result_at_the_floor_is_proven() {
+        let zeros = "TYPE: SOP\nDIMENSION: 4\nEDGE_WEIGHT_SECTION\n4\n\
+                     0 0 0 0\n-1 0 0 0\n-1 0 0 0\n-1 -1 -1 0\nEOF\n";
+        let inst = parse_instance("zeros.sop", zeros, Format::Sop).unwrap();
+        let go = |inst: &Instance| {
+            let obj = inst.default_objective();
+            run("greedy", inst, obj, &BTreeMap::new(), 1, Budget::default(), &mut NoObserver)
+                .unwrap()
+        };
+        let r = go(&inst);
+        assert_eq!(r.report.cost, 0.0);
+        assert!(r.outcome.proven_optimal);
+        assert_eq!(r.outcome.lower_bound, Some(0.0));
+        let r = go(&tiny());
+        let floor = crate::context::floor(&CostModel::new(&tiny(), tiny().default_objective()));
+        assert!(r.report.cost > floor, "the tiny instance's optimum is above its floor");
+        assert!(!r.outcome.proven_optimal);
     }
 
     #[test]
