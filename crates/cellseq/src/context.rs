@@ -154,15 +154,16 @@ impl<'a> Context<'a> {
     /// True when the best reported cost meets the model's [`floor`]: it is optimal.
     #[inline]
     pub fn solved(&self) -> bool {
-        self.floor
-            .is_some_and(|f| self.best <= f + 1e-9 * f.abs().max(1.0))
+        self.floor.is_some_and(|f| meets_floor(self.best, f))
+    }
+    /// The model's [`floor`], computed once per run (on the first report or here).
+    pub fn floor(&mut self) -> f64 {
+        *self.floor.get_or_insert_with(|| floor(self.model))
     }
     /// Reports a solution cost; the observer hears of it when it improves the best.
     pub fn report(&mut self, cost: f64) {
         if cost < self.best - 1e-9 * cost.abs().max(1.0) {
-            if self.floor.is_none() {
-                self.floor = Some(floor(self.model));
-            }
+            self.floor();
             self.best = cost;
             let p = Progress {
                 evaluations: self.evaluations,
@@ -177,6 +178,13 @@ impl<'a> Context<'a> {
     pub fn best(&self) -> f64 {
         self.best
     }
+}
+
+/// True when `cost` meets the floor `f` (within 10⁻⁹ of it): a sequence of that cost is
+/// optimal.
+#[inline]
+pub fn meets_floor(cost: f64, f: f64) -> bool {
+    cost <= f + 1e-9 * f.abs().max(1.0)
 }
 
 /// A lower bound on the cost of every sequence that costs O(nodes) given the model's cheapest

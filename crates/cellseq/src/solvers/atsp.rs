@@ -218,15 +218,14 @@ impl Atsp {
         let mut leaves = 0u64;
         let mut rejected = false;
         let ub = best.cost;
+        // both callbacks count and report through the context
         let ctx_cell = std::cell::RefCell::new(ctx);
-        let best_cell = std::cell::RefCell::new(best);
         let end = bnb.search(
             ApState::of(ap),
             ub,
             tol,
             |order, value| {
                 let mut ctx = ctx_cell.borrow_mut();
-                let mut best = best_cell.borrow_mut();
                 let leaf = value.is_some();
                 leaves += u64::from(leaf);
                 let seq: Vec<Visit> = order

@@ -433,8 +433,8 @@ pub fn run_until(
     // a result at the model's floor (a lower bound on every sequence) is optimal, whichever
     // solver found it (a search stops there without a proof of its own)
     let mut outcome = outcome;
-    let floor = crate::context::floor(&model);
-    if !outcome.proven_optimal && report.cost <= floor + 1e-9 * floor.abs().max(1.0) {
+    let floor = ctx.floor();
+    if !outcome.proven_optimal && crate::context::meets_floor(report.cost, floor) {
         outcome.proven_optimal = true;
         outcome.lower_bound = Some(outcome.lower_bound.map_or(floor, |b| b.max(floor)));
     }

@@ -27,7 +27,7 @@ use crate::bound::assignment::Assignment;
 const NONE: u32 = u32::MAX;
 
 /// An assignment with its potentials, as the search keeps it per node.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, Default)]
 pub struct ApState {
     /// Column of each row.
     col: Vec<u32>,
@@ -56,11 +56,6 @@ impl ApState {
             v: ap.v.clone(),
             value: ap.value,
         }
-    }
-
-    /// The assignment's value.
-    pub fn value(&self) -> f64 {
-        self.value
     }
 
     fn succ(&self) -> Vec<usize> {
@@ -237,18 +232,19 @@ impl<'a> Bnb<'a> {
         }
     }
 
-    /// The frame that breaks the smallest cycle of `s` (by free arcs), with the children
-    /// whose bound is below `ub`; `None` when a cycle is all forced arcs (no tour keeps them)
-    /// or when `stop` (asked before each child's augmenting path) says so.
+    /// The frame that breaks the smallest of `s`'s cycles `cyc` (by free arcs), with the
+    /// children whose bound is below `ub`; `None` when a cycle is all forced arcs (no tour
+    /// keeps them) or when `stop` (asked before each child's augmenting path) says so.
     fn branch(
         &mut self,
         s: &ApState,
+        cyc: &[Vec<usize>],
         ub: f64,
         tol: f64,
         stop: &mut impl FnMut(u64) -> bool,
     ) -> Option<Frame> {
         let mut best: Option<Vec<(u32, u32)>> = None;
-        for cyc in cycles(&s.succ()) {
+        for cyc in cyc {
             let arcs: Vec<(u32, u32)> = cyc
                 .iter()
                 .map(|&i| (i as u32, s.col[i]))
@@ -313,7 +309,8 @@ impl<'a> Bnb<'a> {
                 }
                 self.nodes += 1;
                 let succ = s.succ();
-                if cycles(&succ).len() == 1 {
+                let cyc = cycles(&succ);
+                if cyc.len() == 1 {
                     ub = ub.min(tour(&path_of(&succ), Some(s.value)));
                 } else {
                     if let Some((t, w)) = patch(self.g, &succ) {
@@ -321,7 +318,7 @@ impl<'a> Bnb<'a> {
                         ub = ub.min(tour(&path_of(&t), None));
                     }
                     if s.value < ub - tol {
-                        match self.branch(&s, ub, tol, &mut stop) {
+                        match self.branch(&s, &cyc, ub, tol, &mut stop) {
                             Some(f) => stack.push(f),
                             None if stop(self.work) => return End::Stopped,
                             None => {}
@@ -342,16 +339,7 @@ impl<'a> Bnb<'a> {
             let k = top.next;
             top.next += 1;
             let t = top.children[k].t;
-            let state = std::mem::replace(
-                &mut top.children[k].state,
-                ApState {
-                    col: Vec::new(),
-                    row: Vec::new(),
-                    u: Vec::new(),
-                    v: Vec::new(),
-                    value: 0.0,
-                },
-            );
+            let state = std::mem::take(&mut top.children[k].state);
             top.entered = Some(t);
             self.enter(&top.arcs, t);
             next = Some(state);
