@@ -2,8 +2,10 @@
 //! two-level descent on 10k points (with and without 3-opt), the Lin–Kernighan descent on a
 //! symmetric matrix with precedence, the two-way SOP-3-exchange descent on a symmetric matrix
 //! with sparse precedence, one SA chain, one tabu iteration, one ant construction; `atsp` to
-//! its branch-and-bound proof on a 300-cell random matrix with costs 0–100.
+//! its branch-and-bound proof on a 300-cell random matrix with costs 0–100; 50 subgradient steps
+//! of the position-indexed path bound on a 100-cell symmetric matrix.
 
+use cellseq::bound::qpath::QPath;
 use cellseq::cost::CostModel;
 use cellseq::engine::large::Large;
 use cellseq::engine::lk::Lk;
@@ -256,6 +258,20 @@ fn benches(cr: &mut Criterion) {
             .unwrap();
             assert!(r.outcome.proven_optimal);
             black_box(r.report.cost)
+        })
+    });
+    g.finish();
+
+    // the position-indexed path relaxation's subgradient steps (one O(n · arcs) DP each),
+    // the set-up of every beam run, on a symmetric matrix with sparse precedence
+    let sym = generated("symmetric", &[("n", "98"), ("c", "500"), ("p", "1")]);
+    let ms = CostModel::new(&sym, sym.default_objective());
+    let mut g = cr.benchmark_group("bound");
+    g.sample_size(10);
+    g.bench_function("qpath 50 subgradient steps (symmetric n = 98)", |b| {
+        b.iter(|| {
+            let q = QPath::new(&ms, None, 50).expect("acyclic");
+            black_box(q.root)
         })
     });
     g.finish();

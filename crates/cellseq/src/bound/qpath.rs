@@ -37,24 +37,46 @@ pub struct QPath {
     pub iterations: usize,
 }
 
-/// Layered graph: successor arcs per node (node, cell, cost) and the windows.
+/// Layered graph: successor arcs in compressed rows (node, cell, cost per arc; the arcs of
+/// node `a` are `first[a]..first[a + 1]`) and the windows.
 struct Graph {
     n: usize,
     nodes: usize,
     cell: Vec<u32>,
-    succ: Vec<Vec<(u32, u32, f64)>>,
+    first: Vec<usize>,
+    to: Vec<u32>,
+    to_cell: Vec<u32>,
+    cost: Vec<f64>,
     start: Vec<f64>,
     finish: Vec<f64>,
     /// per cell: first and last allowed position (1-based)
     window: Vec<(usize, usize)>,
 }
 
-/// One DP pass: best and second-best (different next cell) completion per (position, node).
+/// One DP pass: best and second-best (different next cell) completion per (position, node),
+/// with the cell of the best next node (`c1`, [`NONE`] when there is none) kept beside it so
+/// that the pass reads it without a lookup. `arc` is scratch: every arc's cost net of the
+/// multiplier of the cell it enters.
 struct Dp {
     h1: Vec<f64>,
     n1: Vec<u32>,
+    c1: Vec<u32>,
     h2: Vec<f64>,
     n2: Vec<u32>,
+    arc: Vec<f64>,
+}
+
+impl Dp {
+    fn new(size: usize, arcs: usize) -> Dp {
+        Dp {
+            h1: vec![0.0; size],
+            n1: vec![NONE; size],
+            c1: vec![NONE; size],
+            h2: vec![0.0; size],
+            n2: vec![NONE; size],
+            arc: vec![0.0; arcs],
+        }
+    }
 }
 
 impl Graph {
@@ -63,10 +85,12 @@ impl Graph {
         let n = m.n();
         let nodes = m.nodes();
         let cell: Vec<u32> = (0..nodes).map(|nd| m.cell_mode(nd).0 as u32).collect();
-        let mut succ = vec![Vec::new(); nodes];
+        let mut first = Vec::with_capacity(nodes + 1);
+        let (mut to, mut to_cell, mut cost) = (Vec::new(), Vec::new(), Vec::new());
         let mut start = vec![f64::INFINITY; nodes];
         let mut finish = vec![f64::INFINITY; nodes];
-        for (a, out) in succ.iter_mut().enumerate() {
+        for a in 0..nodes {
+            first.push(to.len());
             let (ca, ma) = m.cell_mode(a);
             if cl.can_be_first(ca) {
                 start[a] = m.start(ca, ma);
@@ -81,11 +105,14 @@ impl Graph {
                 for mb in 0..m.modes(cb) {
                     let c = m.arc(ca, ma, cb, mb) - shift(ca, cb);
                     if c.is_finite() {
-                        out.push((m.node(cb, mb) as u32, cb as u32, c));
+                        to.push(m.node(cb, mb) as u32);
+                        to_cell.push(cb as u32);
+                        cost.push(c);
                     }
                 }
             }
         }
+        first.push(to.len());
         let window = (0..n)
             .map(|j| (cl.ancestors(j) + 1, n - cl.descendants(j)))
             .collect();
@@ -93,7 +120,10 @@ impl Graph {
             n,
             nodes,
             cell,
-            succ,
+            first,
+            to,
+            to_cell,
+            cost,
             start,
             finish,
             window,
@@ -105,12 +135,22 @@ impl Graph {
         lo <= p && p <= hi
     }
 
+    /// The completion tables for multipliers `lambda`: per (position, node) the cheapest
+    /// walk to home and the cheapest one whose next cell differs from the first's (a walk
+    /// never returns at once to the cell it just left). O(n · arcs). Every arc's cost net of
+    /// its multiplier is computed once per pass, before the layers, and the cell of each
+    /// best next node is stored beside it: the layers then read only the arc's target and
+    /// its net cost.
     fn dp(&self, lambda: &[f64], dp: &mut Dp) {
         let (n, nn) = (self.n, self.nodes);
         dp.h1.fill(f64::INFINITY);
         dp.h2.fill(f64::INFINITY);
         dp.n1.fill(NONE);
+        dp.c1.fill(NONE);
         dp.n2.fill(NONE);
+        for ((a, &c), &cb) in dp.arc.iter_mut().zip(&self.cost).zip(&self.to_cell) {
+            *a = c - lambda[cb as usize];
+        }
         for a in 0..nn {
             if self.in_window(self.cell[a] as usize, n) {
                 dp.h1[(n - 1) * nn + a] = self.finish[a];
@@ -118,34 +158,38 @@ impl Graph {
         }
         for p in (1..n).rev() {
             let (row, next) = ((p - 1) * nn, p * nn);
+            // the layer written (row) lies before the one read (next)
+            let (h1w, h1) = dp.h1.split_at_mut(next);
+            let (c1w, c1) = dp.c1.split_at_mut(next);
+            let (h2w, h2) = dp.h2.split_at_mut(next);
             for a in 0..nn {
                 let ca = self.cell[a];
                 if !self.in_window(ca as usize, p) {
                     continue;
                 }
-                let (mut b1, mut x1, mut b2, mut x2) = (f64::INFINITY, NONE, f64::INFINITY, NONE);
-                for &(b, cb, c) in &self.succ[a] {
-                    let k = next + b as usize;
-                    let h = if dp.n1[k] == NONE || self.cell[dp.n1[k] as usize] != ca {
-                        dp.h1[k]
-                    } else {
-                        dp.h2[k]
-                    };
-                    if !h.is_finite() {
-                        continue;
-                    }
-                    let v = c - lambda[cb as usize] + h;
+                let (mut b1, mut x1, mut y1) = (f64::INFINITY, NONE, NONE);
+                let (mut b2, mut x2) = (f64::INFINITY, NONE);
+                let arcs = self.first[a]..self.first[a + 1];
+                for ((&b, &cb), &c) in self.to[arcs.clone()]
+                    .iter()
+                    .zip(&self.to_cell[arcs.clone()])
+                    .zip(&dp.arc[arcs])
+                {
+                    let b = b as usize;
+                    // an unreachable completion (∞) never enters: ∞ < b1 and ∞ < b2 fail
+                    let v = c + if c1[b] != ca { h1[b] } else { h2[b] };
                     if v < b1 {
-                        if x1 == NONE || self.cell[x1 as usize] != cb {
+                        if y1 != cb {
                             (b2, x2) = (b1, x1);
                         }
-                        (b1, x1) = (v, b);
-                    } else if v < b2 && self.cell[x1 as usize] != cb {
-                        (b2, x2) = (v, b);
+                        (b1, x1, y1) = (v, b as u32, cb);
+                    } else if v < b2 && y1 != cb {
+                        (b2, x2) = (v, b as u32);
                     }
                 }
                 let k = row + a;
-                (dp.h1[k], dp.n1[k], dp.h2[k], dp.n2[k]) = (b1, x1, b2, x2);
+                (h1w[k], c1w[k], h2w[k]) = (b1, y1, b2);
+                (dp.n1[k], dp.n2[k]) = (x1, x2);
             }
         }
     }
@@ -221,13 +265,7 @@ impl QPath {
         };
         let base = shift.map_or(0.0, |s| s.1);
         let nn = g.nodes;
-        let size = n * nn;
-        let mut dp = Dp {
-            h1: vec![0.0; size],
-            n1: vec![NONE; size],
-            h2: vec![0.0; size],
-            n2: vec![NONE; size],
-        };
+        let mut dp = Dp::new(n * nn, g.to.len());
         let constant = m.constant() + base;
         let upper = upper.map(|u| u - constant);
         let mut lambda = match shift {
@@ -321,4 +359,112 @@ pub fn affordable_iterations(m: &CostModel, work: f64, max: usize) -> usize {
     let nodes = m.nodes() as f64;
     let per = (n * nodes * nodes).max(1.0);
     ((work / per) as usize).min(max)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::generate::generate;
+    use rand::{RngExt, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+    use std::collections::BTreeMap;
+
+    /// The completion tables straight from the definition: per (position, node), over every
+    /// allowed (cell, mode) after it in its window, the cheapest `arc − λ + completion`,
+    /// never back to the node's own cell at once; ties to the first in (cell, mode) order.
+    fn reference(m: &CostModel, lambda: &[f64]) -> (Vec<f64>, Vec<u32>, Vec<f64>, Vec<u32>) {
+        let (n, nn) = (m.n(), m.nodes());
+        let cl = Closure::new(&m.dag).unwrap();
+        let window = |c: usize, p: usize| cl.ancestors(c) < p && p <= n - cl.descendants(c);
+        let (mut h1, mut n1) = (vec![f64::INFINITY; n * nn], vec![NONE; n * nn]);
+        let (mut h2, mut n2) = (vec![f64::INFINITY; n * nn], vec![NONE; n * nn]);
+        for a in 0..nn {
+            let (ca, ma) = m.cell_mode(a);
+            if window(ca, n) && cl.can_be_last(ca) {
+                h1[(n - 1) * nn + a] = m.finish(ca, ma);
+            }
+        }
+        for p in (1..n).rev() {
+            for a in 0..nn {
+                let (ca, ma) = m.cell_mode(a);
+                if !window(ca, p) {
+                    continue;
+                }
+                let mut cands: Vec<(f64, u32, usize)> = Vec::new();
+                for cb in (0..n).filter(|&cb| cl.arc_allowed(ca, cb)) {
+                    for mb in 0..m.modes(cb) {
+                        let b = m.node(cb, mb);
+                        let c = m.arc(ca, ma, cb, mb);
+                        let k = p * nn + b;
+                        let back = n1[k] != NONE && m.cell_mode(n1[k] as usize).0 == ca;
+                        let h = if back { h2[k] } else { h1[k] };
+                        if c.is_finite() && h.is_finite() {
+                            cands.push((c - lambda[cb] + h, b as u32, cb));
+                        }
+                    }
+                }
+                let k = (p - 1) * nn + a;
+                // the first minimum, then the first minimum among the other cells
+                if let Some((v, b, cb)) = first_min(cands.iter()) {
+                    (h1[k], n1[k]) = (v, b);
+                    if let Some((v2, b2, _)) = first_min(cands.iter().filter(|x| x.2 != cb)) {
+                        (h2[k], n2[k]) = (v2, b2);
+                    }
+                }
+            }
+        }
+        (h1, n1, h2, n2)
+    }
+
+    /// The first candidate of least value.
+    fn first_min<'a>(
+        it: impl Iterator<Item = &'a (f64, u32, usize)>,
+    ) -> Option<(f64, u32, usize)> {
+        it.fold(None, |best, &x| match best {
+            Some(y) if y.0 <= x.0 => Some(y),
+            _ => Some(x),
+        })
+    }
+
+    fn instance(kind: &str, params: &[(&str, &str)], seed: u64) -> CostModel {
+        let kv: BTreeMap<String, String> = params
+            .iter()
+            .map(|(k, v)| (k.to_string(), v.to_string()))
+            .collect();
+        let inst = generate(kind, &kv, seed).unwrap();
+        CostModel::new(&inst, inst.default_objective())
+    }
+
+    #[test]
+    fn the_layered_pass_matches_the_definition() {
+        let mut rng = ChaCha8Rng::seed_from_u64(7);
+        for seed in 1..=4 {
+            let models = [
+                instance("symmetric", &[("n", "30"), ("c", "20"), ("p", "5")], seed),
+                instance("random-sop", &[("n", "25"), ("c", "10"), ("p", "40")], seed),
+                instance("generalized", &[("n", "14"), ("modes", "3"), ("open", "0.5")], seed),
+                instance("time-window", &[("n", "30"), ("w", "4")], seed),
+            ];
+            for m in &models {
+                let cl = Closure::new(&m.dag).unwrap();
+                let g = Graph::new(m, &cl, &|_, _| 0.0);
+                let mut dp = Dp::new(m.n() * m.nodes(), g.to.len());
+                for round in 0..3 {
+                    // multipliers of the size the subgradient steps reach, zero in round 0
+                    let lambda: Vec<f64> = (0..m.n())
+                        .map(|_| if round == 0 { 0.0 } else { rng.random_range(-30.0..30.0) })
+                        .collect();
+                    g.dp(&lambda, &mut dp);
+                    let (h1, n1, h2, n2) = reference(m, &lambda);
+                    assert_eq!(dp.n1, n1, "best next nodes, seed {seed}");
+                    assert_eq!(dp.n2, n2, "second next nodes, seed {seed}");
+                    let same = |a: &[f64], b: &[f64]| {
+                        a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits())
+                    };
+                    assert!(same(&dp.h1, &h1), "best completions, seed {seed}");
+                    assert!(same(&dp.h2, &h2), "second completions, seed {seed}");
+                }
+            }
+        }
+    }
 }
