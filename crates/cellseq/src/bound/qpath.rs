@@ -38,7 +38,8 @@ pub struct QPath {
 }
 
 /// Layered graph: successor arcs in compressed rows (node, cell, cost per arc; the arcs of
-/// node `a` are `first[a]..first[a + 1]`) and the windows.
+/// node `a` are `first[a]..first[a + 1]`, by increasing cost, `rank` their place in (cell,
+/// mode) order) and the windows.
 struct Graph {
     n: usize,
     nodes: usize,
@@ -47,6 +48,9 @@ struct Graph {
     to: Vec<u32>,
     to_cell: Vec<u32>,
     cost: Vec<f64>,
+    rank: Vec<u32>,
+    /// largest |cost| of an arc, start or finish (for the early end's rounding margin)
+    scale: f64,
     start: Vec<f64>,
     finish: Vec<f64>,
     /// per cell: first and last allowed position (1-based)
@@ -87,6 +91,8 @@ impl Graph {
         let cell: Vec<u32> = (0..nodes).map(|nd| m.cell_mode(nd).0 as u32).collect();
         let mut first = Vec::with_capacity(nodes + 1);
         let (mut to, mut to_cell, mut cost) = (Vec::new(), Vec::new(), Vec::new());
+        let mut row: Vec<(f64, u32, u32, u32)> = Vec::new();
+        let mut rank = Vec::new();
         let mut start = vec![f64::INFINITY; nodes];
         let mut finish = vec![f64::INFINITY; nodes];
         for a in 0..nodes {
@@ -98,6 +104,7 @@ impl Graph {
             if cl.can_be_last(ca) {
                 finish[a] = m.finish(ca, ma) - shift(ca, n);
             }
+            row.clear();
             for cb in 0..n {
                 if !cl.arc_allowed(ca, cb) {
                     continue;
@@ -105,14 +112,25 @@ impl Graph {
                 for mb in 0..m.modes(cb) {
                     let c = m.arc(ca, ma, cb, mb) - shift(ca, cb);
                     if c.is_finite() {
-                        to.push(m.node(cb, mb) as u32);
-                        to_cell.push(cb as u32);
-                        cost.push(c);
+                        row.push((c, row.len() as u32, m.node(cb, mb) as u32, cb as u32));
                     }
                 }
             }
+            row.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
+            for &(c, r, b, cb) in &row {
+                cost.push(c);
+                rank.push(r);
+                to.push(b);
+                to_cell.push(cb);
+            }
         }
         first.push(to.len());
+        let scale = cost
+            .iter()
+            .chain(&start)
+            .chain(&finish)
+            .filter(|c| c.is_finite())
+            .fold(0.0f64, |s, c| s.max(c.abs()));
         let window = (0..n)
             .map(|j| (cl.ancestors(j) + 1, n - cl.descendants(j)))
             .collect();
@@ -124,6 +142,8 @@ impl Graph {
             to,
             to_cell,
             cost,
+            rank,
+            scale,
             start,
             finish,
             window,
@@ -156,35 +176,56 @@ impl Graph {
                 dp.h1[(n - 1) * nn + a] = self.finish[a];
             }
         }
+        // every computed value lies within a few roundings of its exact value, each at most
+        // 2⁻⁵² of the magnitudes summed: this margin keeps the early end below exact
+        let lmax = lambda.iter().fold(0.0f64, |s, l| s.max(l.abs()));
         for p in (1..n).rev() {
             let (row, next) = ((p - 1) * nn, p * nn);
             // the layer written (row) lies before the one read (next)
             let (h1w, h1) = dp.h1.split_at_mut(next);
             let (c1w, c1) = dp.c1.split_at_mut(next);
             let (h2w, h2) = dp.h2.split_at_mut(next);
+            // the least completion net of its cell's multiplier: an arc of cost c then
+            // costs at least c + low, and the arcs of a row come by increasing cost
+            let (mut low, mut hmax) = (f64::INFINITY, 0.0f64);
+            for (b, &h) in h1[..nn].iter().enumerate() {
+                if h.is_finite() {
+                    low = low.min(h - lambda[self.cell[b] as usize]);
+                    hmax = hmax.max(h.abs());
+                }
+            }
+            let margin = 1e-9 * (self.scale + lmax + hmax + 1.0);
             for a in 0..nn {
                 let ca = self.cell[a];
                 if !self.in_window(ca as usize, p) {
                     continue;
                 }
-                let (mut b1, mut x1, mut y1) = (f64::INFINITY, NONE, NONE);
-                let (mut b2, mut x2) = (f64::INFINITY, NONE);
+                // best and second best (another cell) by value, then by (cell, mode) order:
+                // the choice a scan in that order with strict comparisons makes (rank 0 while
+                // unset: an unreachable ∞ never ties its way in)
+                let (mut b1, mut x1, mut y1, mut r1) = (f64::INFINITY, NONE, NONE, 0);
+                let (mut b2, mut x2, mut r2) = (f64::INFINITY, NONE, 0);
                 let arcs = self.first[a]..self.first[a + 1];
-                for ((&b, &cb), &c) in self.to[arcs.clone()]
+                for (((&b, &cb), &c), (&raw, &r)) in self.to[arcs.clone()]
                     .iter()
                     .zip(&self.to_cell[arcs.clone()])
-                    .zip(&dp.arc[arcs])
+                    .zip(&dp.arc[arcs.clone()])
+                    .zip(self.cost[arcs.clone()].iter().zip(&self.rank[arcs]))
                 {
+                    if raw + low > b2 + margin {
+                        // this arc and every later one end above the second best
+                        break;
+                    }
                     let b = b as usize;
                     // an unreachable completion (∞) never enters: ∞ < b1 and ∞ < b2 fail
                     let v = c + if c1[b] != ca { h1[b] } else { h2[b] };
-                    if v < b1 {
+                    if v < b1 || (v == b1 && r < r1) {
                         if y1 != cb {
-                            (b2, x2) = (b1, x1);
+                            (b2, x2, r2) = (b1, x1, r1);
                         }
-                        (b1, x1, y1) = (v, b as u32, cb);
-                    } else if v < b2 && y1 != cb {
-                        (b2, x2) = (v, b as u32);
+                        (b1, x1, y1, r1) = (v, b as u32, cb, r);
+                    } else if (v < b2 || (v == b2 && r < r2)) && y1 != cb {
+                        (b2, x2, r2) = (v, b as u32, r);
                     }
                 }
                 let k = row + a;
