@@ -157,10 +157,11 @@ impl Graph {
 
     /// The completion tables for multipliers `lambda`: per (position, node) the cheapest
     /// walk to home and the cheapest one whose next cell differs from the first's (a walk
-    /// never returns at once to the cell it just left). O(n · arcs). Every arc's cost net of
-    /// its multiplier is computed once per pass, before the layers, and the cell of each
-    /// best next node is stored beside it: the layers then read only the arc's target and
-    /// its net cost.
+    /// never returns at once to the cell it just left). O(n · arcs) at most. Every arc's cost
+    /// net of its multiplier is computed once per pass, before the layers, and the cell of
+    /// each best next node is stored beside it; a row's arcs come by increasing cost, so its
+    /// scan ends once no later arc can beat the second best (on random costs most rows end
+    /// after a few arcs).
     fn dp(&self, lambda: &[f64], dp: &mut Dp) {
         let (n, nn) = (self.n, self.nodes);
         dp.h1.fill(f64::INFINITY);
