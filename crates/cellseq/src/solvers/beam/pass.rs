@@ -298,23 +298,37 @@ impl<const W: usize> Level<'_, W> {
         let mut sample = Sample::default();
         if self.beam.refine && cands.len() > width && !self.beam.by_cost {
             // refine lazily in order of the incremental bound until more than `width`
-            // survive: the rest is discarded (and the level counts as truncated)
-            cands.sort_unstable_by(rank);
+            // survive: the rest is discarded (and the level counts as truncated). Only the
+            // order's head is needed, so it is sorted a chunk at a time: each chunk is the
+            // least of what is left (`rank` is a total order, so this is the full sort's
+            // order) and twice what may still be kept.
             let mut kept = Vec::with_capacity(width + 1);
-            for mut c in cands.drain(..) {
-                if sample.on() {
-                    if self.may_abort && sample.done % 4096 == 4095 && ctx.exhausted() {
-                        return None;
+            let mut from = 0;
+            'chunks: while from < cands.len() {
+                let want = (2 * (width + 1 - kept.len())).max(64);
+                let rest = &mut cands[from..];
+                let chunk = want.min(rest.len());
+                if chunk < rest.len() {
+                    rest.select_nth_unstable_by(chunk - 1, rank);
+                }
+                rest[..chunk].sort_unstable_by(rank);
+                for &c in &rest[..chunk] {
+                    let mut c = c;
+                    if sample.on() {
+                        if self.may_abort && sample.done % 4096 == 4095 && ctx.exhausted() {
+                            return None;
+                        }
+                        c.f = c.f.max(refined(m, t, &c, scratch));
+                        if !sample.record(c.f <= self.cut) {
+                            continue;
+                        }
                     }
-                    c.f = c.f.max(refined(m, t, &c, scratch));
-                    if !sample.record(c.f <= self.cut) {
-                        continue;
+                    kept.push(c);
+                    if kept.len() > width {
+                        break 'chunks;
                     }
                 }
-                kept.push(c);
-                if kept.len() > width {
-                    break;
-                }
+                from += chunk;
             }
             charge(ctx, sample.done);
             cands = kept;
