@@ -8,7 +8,6 @@ use super::refine::refined;
 use super::tables::Tables;
 use crate::bound::qpath::QPath;
 use crate::context::Context;
-use crate::cost::CostModel;
 use crate::model::{Sequence, Visit};
 use rustc_hash::FxHashMap;
 
@@ -100,6 +99,10 @@ impl Beam {
     }
 }
 
+/// Per parent Σ μ_S, per cell the parents it may extend, and the number of such pairs
+/// ([`Level::parent_lists`]).
+type ParentLists = (Vec<f64>, Vec<Vec<u32>>, usize);
+
 /// The fixed inputs of one pass (see [`Beam::iteration`]).
 struct Level<'a, const W: usize> {
     beam: &'a Beam,
@@ -178,12 +181,28 @@ impl<const W: usize> Level<'_, W> {
 
     /// Per parent: Σ μ_S over the sets its children must still leave; per cell: the parents
     /// it may extend (all its predecessors visited, itself not), and how many such pairs.
-    fn parent_lists(&self, m: &CostModel, prev: &[Prefix<W>]) -> (Vec<f64>, Vec<Vec<u32>>, usize) {
-        let t = self.t;
+    /// A wide level holds millions of parents: the budget and the memory cap (with `stored`
+    /// trail entries so far) are asked every 4096 parents, `Err` when they stop the pass.
+    fn parent_lists(
+        &self,
+        ctx: &mut Context,
+        prev: &[Prefix<W>],
+        stored: u64,
+    ) -> Result<ParentLists, Pass> {
+        let (m, t) = (ctx.model, self.t);
         let mut acts: Vec<f64> = Vec::with_capacity(prev.len());
         let mut by_cell: Vec<Vec<u32>> = vec![Vec::new(); m.n()];
         let mut listed = 0usize;
         for (pi, p) in prev.iter().enumerate() {
+            if pi % 4096 == 4095 {
+                if self.may_abort && ctx.exhausted() {
+                    return Err(Pass::aborted());
+                }
+                // the lists count as stored prefixes, as in `children`
+                if self.overflow(stored + (listed / 2 + pi) as u64, prev.len(), 0) {
+                    return Err(Pass::overflow());
+                }
+            }
             let a = m.cell_mode(p.node as usize).0;
             // every child leaves the same sets: the parent's, less those that `a` closes
             acts.push(p.act - t.closing_mu(&p.bits, a));
@@ -201,7 +220,7 @@ impl<const W: usize> Level<'_, W> {
                 }
             }
         }
-        (acts, by_cell, listed)
+        Ok((acts, by_cell, listed))
     }
 
     /// The children of the level `prev` (prefixes of `cells` cells), pruned by the bound and
@@ -222,7 +241,7 @@ impl<const W: usize> Level<'_, W> {
         // children grouped by their new cell, so the dominance map holds one cell's
         // children at a time: small enough to stay in cache (on p43.2 a whole level's map
         // had millions of entries and its cache misses took ~40 % of the time)
-        let (acts, by_cell, listed) = self.parent_lists(m, prev);
+        let (acts, by_cell, listed) = self.parent_lists(ctx, prev, stored)?;
         // the parent lists and their Σ μ count as stored prefixes (8 bytes each)
         let lists = (listed / 2 + acts.len()) as u64;
         let mut done = 0usize;
@@ -333,14 +352,24 @@ impl<const W: usize> Level<'_, W> {
             charge(ctx, sample.done);
             cands = kept;
         } else if self.beam.refine {
+            // an unbounded level may hold millions of candidates: the time limit is asked
+            // here too
+            let mut stopped = false;
             cands.retain_mut(|c| {
-                if !sample.on() {
+                if stopped || !sample.on() {
+                    return true;
+                }
+                if self.may_abort && sample.done % 4096 == 4095 && ctx.exhausted() {
+                    stopped = true;
                     return true;
                 }
                 c.f = c.f.max(refined(m, t, c, scratch));
                 sample.record(c.f <= self.cut)
             });
             charge(ctx, sample.done);
+            if stopped {
+                return None;
+            }
         }
         Some(cands)
     }
@@ -436,6 +465,64 @@ impl Pass {
             truncated: true,
             aborted: false,
             overflow: true,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::tables::tables;
+    use super::*;
+    use crate::clock::Deadline;
+    use crate::cost::CostModel;
+    use crate::generate::generate;
+    use crate::params::Params;
+    use crate::solvers::{Budget, NoObserver};
+    use std::collections::BTreeMap;
+
+    /// A wide level's parent lists ask the budget as they go (a 5-million-prefix level took
+    /// 3 s there, past a 12 s limit by 3.4 s), and only when the pass may abort.
+    #[test]
+    fn parent_lists_ask_the_budget() {
+        let params: BTreeMap<String, String> = [("n", "98"), ("c", "500"), ("p", "1")]
+            .iter()
+            .map(|(k, v)| (k.to_string(), v.to_string()))
+            .collect();
+        let inst = generate("symmetric", &params, 1).unwrap();
+        let m = CostModel::new(&inst, inst.default_objective());
+        let t = tables(&m, true, true, true, None, Deadline::NONE)
+            .unwrap()
+            .unwrap();
+        let beam = super::super::from_params(
+            &Params::new("beam", super::super::INFO.params, &BTreeMap::new()).unwrap(),
+        );
+        let firsts: Vec<Prefix<2>> = first_prefixes(&m, &t, 0.0, |_| 0.0);
+        let prev: Vec<Prefix<2>> = firsts.iter().copied().cycle().take(10_000).collect();
+        for may_abort in [true, false] {
+            let lv = Level::<2> {
+                beam: &beam,
+                t: &t,
+                qp: None,
+                width: usize::MAX,
+                cut: f64::INFINITY,
+                may_abort,
+                mem_cap: None,
+            };
+            let mut obs = NoObserver;
+            // an evaluation budget of 0: spent from the start
+            let budget = Budget {
+                time_limit: None,
+                max_evals: Some(0),
+            };
+            let mut ctx = Context::new(&inst, &m, 1, budget, &mut obs);
+            match lv.parent_lists(&mut ctx, &prev, 0) {
+                Err(pass) => assert!(may_abort && pass.aborted),
+                Ok((acts, _, listed)) => {
+                    assert!(!may_abort);
+                    assert_eq!(acts.len(), prev.len());
+                    assert!(listed > 0);
+                }
+            }
         }
     }
 }
