@@ -3,7 +3,8 @@
 //! symmetric matrix with precedence, the two-way SOP-3-exchange descent on a symmetric matrix
 //! with sparse precedence, one SA chain, one tabu iteration, one ant construction; `atsp` to
 //! its branch-and-bound proof on a 300-cell random matrix with costs 0–100; 50 subgradient steps
-//! of the position-indexed path bound on a 100-cell symmetric matrix.
+//! of the position-indexed path bound on a 100-cell symmetric matrix, and the beam to width 256
+//! there.
 
 use cellseq::bound::qpath::QPath;
 use cellseq::cost::CostModel;
@@ -272,6 +273,34 @@ fn benches(cr: &mut Criterion) {
         b.iter(|| {
             let q = QPath::new(&ms, None, 50).expect("acyclic");
             black_box(q.root)
+        })
+    });
+    g.finish();
+
+    // the beam on the same instance up to width 256: its warm start, the sec and qpath
+    // tables, then passes of width 1, 2, …, 256 (truncated levels sort only their head)
+    let narrow: BTreeMap<String, String> = [("max_width", "256"), ("warm_evals", "100000")]
+        .iter()
+        .map(|(k, v)| (k.to_string(), v.to_string()))
+        .collect();
+    let mut g = cr.benchmark_group("beam");
+    g.sample_size(10);
+    g.bench_function("beam to width 256 (symmetric n = 98)", |b| {
+        b.iter(|| {
+            let r = run(
+                "beam",
+                &sym,
+                sym.default_objective(),
+                &narrow,
+                1,
+                Budget {
+                    time_limit: None,
+                    max_evals: Some(1_000_000_000_000),
+                },
+                &mut NoObserver,
+            )
+            .unwrap();
+            black_box(r.report.cost)
         })
     });
     g.finish();

@@ -324,7 +324,9 @@ impl<const W: usize> Level<'_, W> {
             let mut kept = Vec::with_capacity(width + 1);
             let mut from = 0;
             'chunks: while from < cands.len() {
-                let want = (2 * (width + 1 - kept.len())).max(64);
+                let want = (width.saturating_add(1) - kept.len())
+                    .saturating_mul(2)
+                    .max(64);
                 let rest = &mut cands[from..];
                 let chunk = want.min(rest.len());
                 if chunk < rest.len() {
