@@ -19,20 +19,47 @@ use cellseq::model::Instance;
 use cellseq::solvers::aco::{Aco, Pheromone};
 use cellseq::solvers::sa::Anneal;
 use cellseq::solvers::tabu::{TabuList, tabu_step};
-use cellseq::solvers::{Budget, Context, NoObserver, greedy, run};
+use cellseq::solvers::{Budget, Context, NoObserver, RunResult, greedy, run};
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::collections::BTreeMap;
 use std::hint::black_box;
 
+/// Key–value pairs as the owned map that generators and solvers take.
+fn strings(kv: &[(&str, &str)]) -> BTreeMap<String, String> {
+    kv.iter()
+        .map(|(k, v)| (k.to_string(), v.to_string()))
+        .collect()
+}
+
 /// A generated instance of `kind` with these parameters, seed 1.
 fn generated(kind: &str, params: &[(&str, &str)]) -> Instance {
-    let kv: BTreeMap<String, String> = params
-        .iter()
-        .map(|(k, v)| (k.to_string(), v.to_string()))
-        .collect();
-    generate(kind, &kv, 1).unwrap()
+    generate(kind, &strings(params), 1).unwrap()
+}
+
+/// `solver` with `params` on `inst`, seed 1, under an evaluation budget of `evals` (large
+/// enough that the solver ends on its own).
+fn run_to_end(
+    solver: &str,
+    inst: &Instance,
+    params: &BTreeMap<String, String>,
+    evals: u64,
+) -> RunResult {
+    let budget = Budget {
+        time_limit: None,
+        max_evals: Some(evals),
+    };
+    run(
+        solver,
+        inst,
+        inst.default_objective(),
+        params,
+        1,
+        budget,
+        &mut NoObserver,
+    )
+    .unwrap()
 }
 
 fn uniform(n: usize, extra: &[(&str, &str)]) -> Instance {
@@ -244,19 +271,7 @@ fn benches(cr: &mut Criterion) {
     g.sample_size(10);
     g.bench_function("atsp to a proof (random-sop n = 300, costs 0-100)", |b| {
         b.iter(|| {
-            let r = run(
-                "atsp",
-                &free,
-                free.default_objective(),
-                &BTreeMap::new(),
-                1,
-                Budget {
-                    time_limit: None,
-                    max_evals: Some(1_000_000_000),
-                },
-                &mut NoObserver,
-            )
-            .unwrap();
+            let r = run_to_end("atsp", &free, &BTreeMap::new(), 1_000_000_000);
             assert!(r.outcome.proven_optimal);
             black_box(r.report.cost)
         })
@@ -279,27 +294,12 @@ fn benches(cr: &mut Criterion) {
 
     // the beam on the same instance up to width 256: its warm start, the sec and qpath
     // tables, then passes of width 1, 2, …, 256 (truncated levels sort only their head)
-    let narrow: BTreeMap<String, String> = [("max_width", "256"), ("warm_evals", "100000")]
-        .iter()
-        .map(|(k, v)| (k.to_string(), v.to_string()))
-        .collect();
+    let narrow = strings(&[("max_width", "256"), ("warm_evals", "100000")]);
     let mut g = cr.benchmark_group("beam");
     g.sample_size(10);
     g.bench_function("beam to width 256 (symmetric n = 98)", |b| {
         b.iter(|| {
-            let r = run(
-                "beam",
-                &sym,
-                sym.default_objective(),
-                &narrow,
-                1,
-                Budget {
-                    time_limit: None,
-                    max_evals: Some(1_000_000_000_000),
-                },
-                &mut NoObserver,
-            )
-            .unwrap();
+            let r = run_to_end("beam", &sym, &narrow, 1_000_000_000_000);
             black_box(r.report.cost)
         })
     });

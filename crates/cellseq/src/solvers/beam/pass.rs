@@ -139,6 +139,11 @@ impl<const W: usize> Level<'_, W> {
         p.g + (h_in.max(h_out) + act).max(h)
     }
 
+    /// Whether the budget stops this pass now (only a pass that may abort is stopped).
+    fn out_of_budget(&self, ctx: &mut Context) -> bool {
+        self.may_abort && ctx.exhausted()
+    }
+
     /// The path relaxation's multiplier of cell `c` (0 without it).
     #[inline]
     fn lam(&self, c: usize) -> f64 {
@@ -195,7 +200,7 @@ impl<const W: usize> Level<'_, W> {
         let mut listed = 0usize;
         for (pi, p) in prev.iter().enumerate() {
             if pi % 4096 == 4095 {
-                if self.may_abort && ctx.exhausted() {
+                if self.out_of_budget(ctx) {
                     return Err(Pass::aborted());
                 }
                 // the lists count as stored prefixes, as in `children`
@@ -253,7 +258,7 @@ impl<const W: usize> Level<'_, W> {
                 // deterministic)
                 done += 1;
                 if done % 1024 == 1023 {
-                    if self.may_abort && ctx.exhausted() {
+                    if self.out_of_budget(ctx) {
                         return Err(Pass::aborted());
                     }
                     if self.overflow(stored + lists, prev.len() + cands.len(), index.len()) {
@@ -333,10 +338,9 @@ impl<const W: usize> Level<'_, W> {
                     rest.select_nth_unstable_by(chunk - 1, rank);
                 }
                 rest[..chunk].sort_unstable_by(rank);
-                for &c in &rest[..chunk] {
-                    let mut c = c;
+                for mut c in rest[..chunk].iter().copied() {
                     if sample.on() {
-                        if self.may_abort && sample.done % 4096 == 4095 && ctx.exhausted() {
+                        if sample.done % 4096 == 4095 && self.out_of_budget(ctx) {
                             return None;
                         }
                         c.f = c.f.max(refined(m, t, &c, scratch));
@@ -361,7 +365,7 @@ impl<const W: usize> Level<'_, W> {
                 if stopped || !sample.on() {
                     return true;
                 }
-                if self.may_abort && sample.done % 4096 == 4095 && ctx.exhausted() {
+                if sample.done % 4096 == 4095 && self.out_of_budget(ctx) {
                     stopped = true;
                     return true;
                 }
