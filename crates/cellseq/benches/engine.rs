@@ -6,7 +6,9 @@
 //! of the position-indexed path bound on a 100-cell symmetric matrix, and the beam to width 256
 //! there.
 
+use cellseq::bound::cells::CellGraph;
 use cellseq::bound::qpath::QPath;
+use cellseq::bound::sec::sec_bound;
 use cellseq::cost::CostModel;
 use cellseq::engine::large::Large;
 use cellseq::engine::lk::Lk;
@@ -16,6 +18,7 @@ use cellseq::engine::vnd::Search;
 use cellseq::engine::{Costs, Neighbours, Solution};
 use cellseq::generate::generate;
 use cellseq::model::Instance;
+use cellseq::precedence::closure::Closure;
 use cellseq::solvers::aco::{Aco, Pheromone};
 use cellseq::solvers::sa::Anneal;
 use cellseq::solvers::tabu::{TabuList, tabu_step};
@@ -288,6 +291,16 @@ fn benches(cr: &mut Criterion) {
         b.iter(|| {
             let q = QPath::new(&ms, None, 50).expect("acyclic");
             black_box(q.root)
+        })
+    });
+    // the subtour-elimination bound's subgradient steps (one dense assignment each): the
+    // first half of the beam's set-up on the same instance
+    let cl = Closure::new(&ms.dag).expect("acyclic");
+    let cg = CellGraph::new(&ms, &cl);
+    g.bench_function("sec 50 subgradient steps (symmetric n = 98)", |b| {
+        b.iter(|| {
+            let s = sec_bound(&cg, Some(&cl), None, 50, 4 * cg.n + 16).expect("finite");
+            black_box(s.value)
         })
     });
     g.finish();

@@ -55,6 +55,10 @@ pub fn hungarian_duals_until(
 /// The dense Hungarian method (the e-maxx formulation), O(d³): each of the d augmentations
 /// scans every column per step. `None` once `deadline` passes (checked before each
 /// augmentation) or when no finite assignment exists.
+///
+/// `cost` is read once per entry into a row-major matrix (forbidden entries replaced by a
+/// penalty larger than any finite assignment), so the O(d³) scans read memory, not the
+/// caller's closure.
 pub fn dense_until(
     d: usize,
     cost: impl Fn(usize, usize) -> f64,
@@ -68,43 +72,85 @@ pub fn dense_until(
             v: Vec::new(),
         });
     }
-    // Replace forbidden entries by a penalty larger than any finite assignment.
+    let mut m = Vec::with_capacity(d * d);
     let mut finite_max = 0.0f64;
+    let mut forbidden = false;
     for i in 0..d {
         for j in 0..d {
             let c = cost(i, j);
             if c.is_finite() {
                 finite_max = finite_max.max(c.abs());
+            } else {
+                forbidden = true;
             }
+            m.push(c);
         }
     }
-    let big = (finite_max + 1.0) * (d as f64 + 1.0) * 4.0;
-    let a = |i: usize, j: usize| {
+    if forbidden {
+        let big = (finite_max + 1.0) * (d as f64 + 1.0) * 4.0;
+        for c in m.iter_mut().filter(|c| !c.is_finite()) {
+            *c = big;
+        }
+    }
+    let Potentials { u, v, p } = augment_all(d, &m, deadline)?;
+    let mut col = vec![0usize; d];
+    for j in 1..=d {
+        col[p[j] - 1] = j - 1;
+    }
+    let mut total = 0.0;
+    for (i, &j) in col.iter().enumerate() {
         let c = cost(i, j);
-        if c.is_finite() { c } else { big }
-    };
-    // e-maxx formulation, 1-based with a virtual column 0.
+        if !c.is_finite() {
+            return None;
+        }
+        total += c;
+    }
+    Some(Assignment {
+        value: total,
+        col,
+        u: u[1..].to_vec(),
+        v: v[1..].to_vec(),
+    })
+}
+
+/// The result of [`augment_all`], 1-based with a virtual column 0.
+struct Potentials {
+    /// Row potentials.
+    u: Vec<f64>,
+    /// Column potentials.
+    v: Vec<f64>,
+    /// The row matched to each column.
+    p: Vec<usize>,
+}
+
+/// The e-maxx augmentations on the row-major `d × d` matrix `m`. `None` once `deadline`
+/// passes (checked before each augmentation).
+fn augment_all(d: usize, m: &[f64], deadline: Deadline) -> Option<Potentials> {
     let inf = f64::INFINITY;
     let mut u = vec![0.0; d + 1];
     let mut v = vec![0.0; d + 1];
     let mut p = vec![0usize; d + 1];
     let mut way = vec![0usize; d + 1];
+    let mut minv = vec![inf; d + 1];
+    let mut used = vec![false; d + 1];
     for i in 1..=d {
         if deadline.passed() {
             return None;
         }
         p[0] = i;
         let mut j0 = 0usize;
-        let mut minv = vec![inf; d + 1];
-        let mut used = vec![false; d + 1];
+        minv.fill(inf);
+        used.fill(false);
         loop {
             used[j0] = true;
             let i0 = p[j0];
+            let row = &m[(i0 - 1) * d..i0 * d];
+            let ui = u[i0];
             let mut delta = inf;
             let mut j1 = 0usize;
             for j in 1..=d {
                 if !used[j] {
-                    let cur = a(i0 - 1, j - 1) - u[i0] - v[j];
+                    let cur = row[j - 1] - ui - v[j];
                     if cur < minv[j] {
                         minv[j] = cur;
                         way[j] = j0;
@@ -137,24 +183,7 @@ pub fn dense_until(
             }
         }
     }
-    let mut col = vec![0usize; d];
-    for j in 1..=d {
-        col[p[j] - 1] = j - 1;
-    }
-    let mut total = 0.0;
-    for (i, &j) in col.iter().enumerate() {
-        let c = cost(i, j);
-        if !c.is_finite() {
-            return None;
-        }
-        total += c;
-    }
-    Some(Assignment {
-        value: total,
-        col,
-        u: u[1..].to_vec(),
-        v: v[1..].to_vec(),
-    })
+    Some(Potentials { u, v, p })
 }
 
 /// The assignment bound on the arc part of the cost (without the model's constant).
