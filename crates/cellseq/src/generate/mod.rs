@@ -80,9 +80,9 @@ pub static KINDS: &[GeneratorInfo] = &[
     },
     GeneratorInfo {
         name: "symmetric",
-        summary: "symmetric integer costs uniform in [0, c], precedence of closure density p %",
+        summary: "symmetric integer costs uniform in [0, c], precedence of closure density p % or disjoint pairs (pairs)",
         params: families::matrix::SYMMETRIC_SPECS,
-        check: |p| families::cells_of(p, 2),
+        check: families::matrix::symmetric_check,
         generate: families::matrix::symmetric,
     },
     GeneratorInfo {

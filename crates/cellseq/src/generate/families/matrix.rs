@@ -23,7 +23,17 @@ pub static ATSP_SPECS: &[ParamSpec] = &[
 ];
 
 /// `symmetric` parameters.
-pub static SYMMETRIC_SPECS: &[ParamSpec] = &[n_spec("200", super::MAX_N), C_SPEC, p_spec("0")];
+pub static SYMMETRIC_SPECS: &[ParamSpec] = &[
+    n_spec("200", super::MAX_N),
+    C_SPEC,
+    p_spec("0"),
+    ParamSpec {
+        name: "pairs",
+        default: "0",
+        kind: ParamKind::int(0, super::MAX_N / 2),
+        help: "precedence of this many disjoint pairs of cells (one before the other, as pickups before their deliveries) instead of p; at most n / 2, and only with p = 0",
+    },
+];
 
 /// `near-symmetric` parameters.
 pub static NEAR_SYMMETRIC_SPECS: &[ParamSpec] = &[
@@ -113,15 +123,62 @@ pub fn atsp(p: &Params, seed: u64) -> Result<Instance> {
     Ok(sop_shaped(name, &vec![1; n], |u, v| m[u * n + v], &[]))
 }
 
-/// `symmetric`: symmetric costs uniform in [0, c], precedence of closure density p %.
+/// Checks `symmetric`'s parameters together (`pairs` fit in `n` and exclude `p`); the number
+/// of cells.
+pub fn symmetric_check(p: &Params) -> Result<u64> {
+    let (n, pairs) = (p.int("n"), p.int("pairs"));
+    if pairs > 0 && 2 * pairs > n {
+        return Err(Error::Param(format!(
+            "symmetric: pairs must be at most n / 2 = {}, got {pairs}",
+            n / 2
+        )));
+    }
+    if pairs > 0 && p.float("p") > 0.0 {
+        return Err(Error::Param(
+            "symmetric: give either p (a random precedence DAG) or pairs (disjoint pairs), not both"
+                .to_string(),
+        ));
+    }
+    Ok(n + 2)
+}
+
+/// `k` disjoint precedence pairs among `n` cells, each cell in at most one pair: the first
+/// `2k` cells of a random permutation, taken two by two (the first of each two before the
+/// second).
+fn disjoint_pairs(n: usize, k: usize, rng: &mut ChaCha8Rng) -> Vec<(usize, usize)> {
+    let mut cells: Vec<usize> = (0..n).collect();
+    for i in (1..n).rev() {
+        let j = rng.random_range(0..=i);
+        cells.swap(i, j);
+    }
+    cells[..2 * k]
+        .chunks_exact(2)
+        .map(|w| (w[0], w[1]))
+        .collect()
+}
+
+/// `symmetric`: symmetric costs uniform in [0, c], precedence of closure density p % or, with
+/// `pairs` = k > 0, k disjoint pairs (the shape of TSPLIB's pickup-and-delivery-like
+/// instances: each pair one cell before another, no other precedence).
 pub fn symmetric(p: &Params, seed: u64) -> Result<Instance> {
+    symmetric_check(p)?;
     let n = p.int("n") as usize;
     let c = p.int("c");
+    let pairs = p.int("pairs") as usize;
     let density = p.float("p") / 100.0;
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let m = symmetric_costs(n, c, &mut rng);
-    let edges = random_dag(n, density, &mut rng);
-    let name = format!("symmetric-n{n}-c{c}-p{}-s{seed}", p.float("p"));
+    let (edges, name) = if pairs > 0 {
+        (
+            disjoint_pairs(n, pairs, &mut rng),
+            format!("symmetric-n{n}-c{c}-pairs{pairs}-s{seed}"),
+        )
+    } else {
+        (
+            random_dag(n, density, &mut rng),
+            format!("symmetric-n{n}-c{c}-p{}-s{seed}", p.float("p")),
+        )
+    };
     Ok(sop_shaped(name, &vec![1; n], |u, v| m[u * n + v], &edges))
 }
 

@@ -272,3 +272,34 @@ fn bad_parameters_are_refused() {
         );
     }
 }
+
+#[test]
+fn symmetric_pairs_are_disjoint_and_the_only_precedence() {
+    let inst = gen_(
+        "symmetric",
+        &[("n", "98"), ("c", "500"), ("pairs", "41")],
+        7,
+    );
+    let (n, e) = free_edges(&inst);
+    assert_eq!((n, e.len()), (98, 41));
+    let mut seen = vec![false; n];
+    for &(a, b) in &e {
+        assert!(!seen[a] && !seen[b], "cell in two pairs");
+        seen[a] = true;
+        seen[b] = true;
+    }
+    // the closure adds nothing: 41 pairs of 98 · 97 / 2
+    let d = closure_density(&Dag::new(n, &e));
+    assert!((d - 41.0 / 4753.0).abs() < 1e-12, "closure density {d}");
+    assert!(inst.name.contains("pairs41"));
+    // without pairs the instance is the one generated before the parameter existed
+    let plain = gen_("symmetric", &[("n", "40"), ("p", "5")], 3);
+    assert_eq!(plain.name, "symmetric-n40-c100-p5-s3");
+    for bad in [
+        &[("n", "10"), ("pairs", "6")][..],
+        &[("n", "10"), ("pairs", "2"), ("p", "5")],
+    ] {
+        let err = generate("symmetric", &kv(bad), 1).expect_err("refused");
+        assert!(err.to_string().contains("symmetric: "), "{err}");
+    }
+}
