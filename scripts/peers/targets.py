@@ -31,7 +31,7 @@ import random
 import statistics
 import sys
 
-from sop_common import cellseq_solve
+from sop_common import cellseq_solve, gap_pct
 
 EXTS = (".sop", ".pcglns", ".pcgtsp")
 
@@ -75,7 +75,8 @@ def at_best(cost, best):
 
 
 def gap(cost, best):
-    return 100.0 * (cost - best) / best if best else 0.0
+    """The gap in percent (sop_common.gap_pct), 0 against a best known of 0 as before."""
+    return gap_pct(cost, best) if best else 0.0
 
 
 def group(records):
