@@ -75,7 +75,16 @@ pub struct Context<'a> {
     /// A cheap lower bound on the optimum ([`floor`]), computed on the first report: a run
     /// whose best meets it is done.
     floor: Option<f64>,
+    /// Calls of [`Context::exhausted_polled`] and the evaluation count when it last read
+    /// the clock.
+    polls: u32,
+    polled_at: u64,
 }
+
+/// [`Context::exhausted_polled`] reads the clock at least every this many calls …
+const POLL_CALLS: u32 = 16;
+/// … and after this many counted evaluations.
+const POLL_EVALS: u64 = 4096;
 
 impl<'a> Context<'a> {
     /// Builds a context; the clock starts now.
@@ -97,6 +106,8 @@ impl<'a> Context<'a> {
             evaluations: 0,
             best: f64::INFINITY,
             floor: None,
+            polls: 0,
+            polled_at: 0,
         }
     }
     /// The same context, also stopped as soon as `stop` is set (from another thread: a user's
@@ -150,6 +161,27 @@ impl<'a> Context<'a> {
             return true;
         }
         false
+    }
+    /// [`Context::exhausted`] for the hot loops of the local search, where every call does a
+    /// little counted work (one cell looked at): the clock is read only every
+    /// [`POLL_CALLS`] calls or [`POLL_EVALS`] counted evaluations, whichever comes first, since
+    /// a clock read costs as much as dozens of move evaluations. The budget, the stop flag
+    /// and the floor are checked on every call; the time limit is overrun by at most that
+    /// much work.
+    #[inline]
+    pub fn exhausted_polled(&mut self) -> bool {
+        if self.budget.time_limit.is_some() {
+            self.polls += 1;
+            if self.polls < POLL_CALLS && self.evaluations.saturating_sub(self.polled_at) < POLL_EVALS {
+                let evals_out = self.budget.max_evals.is_some_and(|m| self.evaluations >= m);
+                return evals_out
+                    || self.stop.is_some_and(|s| s.load(Ordering::Relaxed))
+                    || self.solved();
+            }
+            self.polls = 0;
+            self.polled_at = self.evaluations;
+        }
+        self.exhausted()
     }
     /// True when the best reported cost meets the model's [`floor`]: it is optimal.
     #[inline]
@@ -237,5 +269,63 @@ pub fn outcome_of(model: &CostModel, sequence: Sequence) -> Outcome {
         cost,
         proven_optimal: false,
         lower_bound: None,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::Objective;
+
+    fn instance() -> (Instance, CostModel) {
+        let kv = [("n", "20")]
+            .iter()
+            .map(|(k, v)| (k.to_string(), v.to_string()))
+            .collect();
+        let inst = crate::generate::generate("random-sop", &kv, 1).expect("generated");
+        let m = CostModel::new(&inst, Objective::Matrix);
+        (inst, m)
+    }
+
+    /// The polled check reads the clock within `POLL_CALLS` calls (a spent time limit ends
+    /// the loop that soon) and sees the evaluation budget and the stop flag at once.
+    #[test]
+    fn polled_check_ends_as_the_plain_one() {
+        let (inst, m) = instance();
+        let mut obs = NoObserver;
+        let spent = Budget {
+            time_limit: Some(Duration::ZERO),
+            max_evals: None,
+        };
+        let mut ctx = Context::new(&inst, &m, 1, spent, &mut obs);
+        assert!(ctx.exhausted());
+        let calls = (1..=POLL_CALLS).find(|_| ctx.exhausted_polled());
+        assert!(calls.is_some(), "the clock was not read in {POLL_CALLS} calls");
+        // counted work makes it read the clock on the next call
+        let mut obs = NoObserver;
+        let mut ctx = Context::new(&inst, &m, 1, spent, &mut obs);
+        ctx.count(POLL_EVALS);
+        assert!(ctx.exhausted_polled());
+
+        let budget = Budget {
+            time_limit: Some(Duration::from_secs(3600)),
+            max_evals: Some(10),
+        };
+        let mut obs = NoObserver;
+        let mut ctx = Context::new(&inst, &m, 1, budget, &mut obs);
+        assert!(!ctx.exhausted_polled());
+        ctx.count(10);
+        assert!(ctx.exhausted_polled());
+
+        let stop = AtomicBool::new(false);
+        let budget = Budget {
+            time_limit: Some(Duration::from_secs(3600)),
+            max_evals: None,
+        };
+        let mut obs = NoObserver;
+        let mut ctx = Context::new(&inst, &m, 1, budget, &mut obs).with_stop(Some(&stop));
+        assert!(!ctx.exhausted_polled());
+        stop.store(true, Ordering::Relaxed);
+        assert!(ctx.exhausted_polled());
     }
 }

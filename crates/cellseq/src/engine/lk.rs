@@ -480,7 +480,7 @@ impl Lk {
         let mut improved = false;
         while let Some(x) = queue.pop_front() {
             on[x as usize] = false;
-            if ctx.exhausted() {
+            if ctx.exhausted_polled() {
                 break;
             }
             let mut evals = 0;

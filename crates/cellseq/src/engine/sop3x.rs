@@ -363,7 +363,7 @@ pub fn sop3_two_way(
     let mut improved = false;
     while let Some(x) = w.stack.pop() {
         w.on[x as usize] = false;
-        if ctx.exhausted() {
+        if ctx.exhausted_polled() {
             break;
         }
         let mut evals = 0u64;

@@ -124,7 +124,7 @@ impl<'a> Search<'a> {
         let n = s.n();
         let mut improved = false;
         while let Some(x) = queue.pop() {
-            if ctx.exhausted() {
+            if ctx.exhausted_polled() {
                 break;
             }
             let i = s.pos[x as usize] as usize;
@@ -218,7 +218,7 @@ impl<'a> Search<'a> {
         let mut queue = Queue::all(n);
         let mut improved = false;
         while let Some(x) = queue.pop() {
-            if ctx.exhausted() {
+            if ctx.exhausted_polled() {
                 break;
             }
             let q = s.pos[x as usize] as usize;
@@ -288,7 +288,7 @@ impl<'a> Search<'a> {
         let cl = c.m.closure();
         let mut improved = false;
         while let Some(x) = queue.pop() {
-            if ctx.exhausted() {
+            if ctx.exhausted_polled() {
                 break;
             }
             let mut evals = 0u64;
