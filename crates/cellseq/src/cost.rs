@@ -75,6 +75,8 @@ pub struct CostModel {
     objective: Objective,
     /// node offset of each cell; `offsets[n]` = number of nodes
     offsets: Vec<u32>,
+    /// every cell has exactly one mode: node = cell, read without `offsets` in the hot paths
+    one_mode: bool,
     /// cell of each node
     node_cell: Vec<u32>,
     /// tool index of each cell
@@ -213,9 +215,11 @@ impl CostModel {
         } else {
             None
         };
+        let one_mode = offsets.iter().enumerate().all(|(i, &o)| o as usize == i);
         let mut cm = CostModel {
             objective,
             return_node,
+            one_mode,
             offsets,
             node_cell,
             tools,
@@ -345,11 +349,17 @@ impl CostModel {
     /// Number of modes of a cell.
     #[inline]
     pub fn modes(&self, cell: usize) -> usize {
+        if self.one_mode {
+            return 1;
+        }
         (self.offsets[cell + 1] - self.offsets[cell]) as usize
     }
     /// Node index of (cell, mode).
     #[inline]
     pub fn node(&self, cell: usize, mode: usize) -> usize {
+        if self.one_mode {
+            return cell + mode;
+        }
         self.offsets[cell] as usize + mode
     }
     /// Cell and mode of a node.
@@ -634,4 +644,36 @@ fn link_blocked(keep_out: &[[f64; 5]], a: Point3, b: Point3) -> bool {
         }
         t0 < t1
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `node` and `modes` (read without the offsets when every cell has one mode) agree with
+    /// `cell_mode` on one-mode and several-mode instances.
+    #[test]
+    fn nodes_and_modes_agree_with_the_offsets() {
+        for (kind, params) in [
+            ("random-sop", vec![("n", "30")]),
+            ("generalized", vec![("n", "30"), ("modes", "4")]),
+        ] {
+            let kv = params
+                .iter()
+                .map(|(k, v)| (k.to_string(), v.to_string()))
+                .collect();
+            let inst = crate::generate::generate(kind, &kv, 3).expect("generated");
+            let m = CostModel::new(&inst, Objective::Matrix);
+            assert_eq!(m.one_mode, !m.multimode(), "{kind}");
+            let mut next = 0;
+            for cell in 0..m.n() {
+                for md in 0..m.modes(cell) {
+                    assert_eq!(m.node(cell, md), next, "{kind}");
+                    assert_eq!(m.cell_mode(next), (cell, md), "{kind}");
+                    next += 1;
+                }
+            }
+            assert_eq!(next, m.nodes(), "{kind}");
+        }
+    }
 }
