@@ -15,6 +15,8 @@ pub struct Solution {
     pub mode: Vec<u32>,
     /// Cost under the [`Costs`] it was last evaluated with (cutting constant excluded).
     pub cost: f64,
+    /// Every cell of the instance has one mode: [`Solution::at`] does not read `mode`.
+    one_mode: bool,
 }
 
 impl Solution {
@@ -26,6 +28,7 @@ impl Solution {
             pos: vec![0; n],
             mode: vec![0; n],
             cost: 0.0,
+            one_mode: !c.m.multimode() && (0..n).all(|x| c.m.modes(x) == 1),
         };
         for (p, v) in seq.iter().enumerate() {
             s.pos[v.cell] = p as u32;
@@ -53,6 +56,9 @@ impl Solution {
             None
         } else {
             let c = self.order[p as usize] as usize;
+            if self.one_mode {
+                return Some((c, 0));
+            }
             Some((c, self.mode[c] as usize))
         }
     }
