@@ -4,7 +4,7 @@
 //! with sparse precedence, one SA chain, one tabu iteration, one ant construction; `atsp` to
 //! its branch-and-bound proof on a 300-cell random matrix with costs 0–100; 50 subgradient steps
 //! of the position-indexed path bound on a 100-cell symmetric matrix, and the beam to width 256
-//! there.
+//! there; `ils` for 10^7 evaluations on a dense 340-cell `time-window` instance.
 
 use cellseq::bound::cells::CellGraph;
 use cellseq::bound::qpath::QPath;
@@ -313,6 +313,21 @@ fn benches(cr: &mut Criterion) {
     g.bench_function("beam to width 256 (symmetric n = 98)", |b| {
         b.iter(|| {
             let r = run_to_end("beam", &sym, &narrow, 1_000_000_000_000);
+            black_box(r.report.cost)
+        })
+    });
+    g.finish();
+
+    // the dense rule's walk: `ils` with kicks of up to 45 cells, from the greedy start, for
+    // 10^7 evaluations (Or-opt and two-way SOP-3-exchange repairs of every kick) on a
+    // generated `time-window` instance (340 cells, precedence closure density about 0.9)
+    let tw = generated("time-window", &[("n", "340"), ("w", "10"), ("c", "100")]);
+    let walk = strings(&[("max-seg", "45")]);
+    let mut g = cr.benchmark_group("ils");
+    g.sample_size(10);
+    g.bench_function("ils 10^7 evaluations (time-window n = 340, w = 10)", |b| {
+        b.iter(|| {
+            let r = run_to_end("ils", &tw, &walk, 10_000_000);
             black_box(r.report.cost)
         })
     });
