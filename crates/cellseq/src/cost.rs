@@ -215,11 +215,10 @@ impl CostModel {
         } else {
             None
         };
-        let one_mode = offsets.iter().enumerate().all(|(i, &o)| o as usize == i);
         let mut cm = CostModel {
             objective,
             return_node,
-            one_mode,
+            one_mode: offsets.iter().enumerate().all(|(i, &o)| o as usize == i),
             offsets,
             node_cell,
             tools,
