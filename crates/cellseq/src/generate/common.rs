@@ -4,7 +4,21 @@
 use super::toolsel::{ToolLibrary, ToolSpec};
 use crate::geom::Point3;
 use crate::model::{Cell, Mode, Visit};
+use rand::RngExt;
+use rand_chacha::ChaCha8Rng;
 use std::collections::{BTreeMap, BTreeSet};
+
+/// A uniformly random permutation of `0..n` (Fisher–Yates from the back, one
+/// `random_range(0..=i)` per position): every generator that draws a hidden order uses this one
+/// sequence of draws, so the same seed gives the same instance as before it was shared.
+pub fn random_permutation(n: usize, rng: &mut ChaCha8Rng) -> Vec<usize> {
+    let mut order: Vec<usize> = (0..n).collect();
+    for i in (1..n).rev() {
+        let j = rng.random_range(0..=i);
+        order.swap(i, j);
+    }
+    order
+}
 
 /// The library's tools that `cells` use, larger first (ties by id), and every cell's rank in
 /// that list: the procedure order of the as-programmed sequence ("larger tool first").

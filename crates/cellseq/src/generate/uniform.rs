@@ -180,11 +180,7 @@ pub fn generate(p: &Params, seed: u64) -> Result<Instance> {
         cells.push(c);
     }
     // precedence over a hidden random order
-    let mut hidden: Vec<usize> = (0..n).collect();
-    for i in (1..n).rev() {
-        let j = rng.random_range(0..=i);
-        hidden.swap(i, j);
-    }
+    let hidden = super::common::random_permutation(n, &mut rng);
     let mut precedence = Vec::new();
     if density > 0.0 {
         for a in 0..n {

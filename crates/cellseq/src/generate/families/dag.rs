@@ -97,11 +97,7 @@ pub fn random_dag(n: usize, density: f64, rng: &mut ChaCha8Rng) -> Vec<(usize, u
     let target = ((density.min(1.0) * all as f64).round() as usize).min(all);
     let slack = n.max(all / 200);
     let ceiling = (target + slack).min(all);
-    let mut hidden: Vec<usize> = (0..n).collect();
-    for i in (1..n).rev() {
-        let j = rng.random_range(0..=i);
-        hidden.swap(i, j);
-    }
+    let hidden = crate::generate::common::random_permutation(n, rng);
     let mut clo = Closure::new(n);
     let mut edges = Vec::new();
     let max_draws = 64 * n * n + 1000;

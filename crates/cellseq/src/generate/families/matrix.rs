@@ -146,11 +146,7 @@ pub fn symmetric_check(p: &Params) -> Result<u64> {
 /// `2k` cells of a random permutation, taken two by two (the first of each two before the
 /// second).
 fn disjoint_pairs(n: usize, k: usize, rng: &mut ChaCha8Rng) -> Vec<(usize, usize)> {
-    let mut cells: Vec<usize> = (0..n).collect();
-    for i in (1..n).rev() {
-        let j = rng.random_range(0..=i);
-        cells.swap(i, j);
-    }
+    let cells = crate::generate::common::random_permutation(n, rng);
     cells[..2 * k]
         .chunks_exact(2)
         .map(|w| (w[0], w[1]))
