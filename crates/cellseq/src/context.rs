@@ -147,12 +147,7 @@ impl<'a> Context<'a> {
     /// True when the budget is used up, the stop flag is set, or when the best reported cost meets the model's
     /// [`floor`] (it is optimal: nothing is left to search for).
     pub fn exhausted(&self) -> bool {
-        if self.stop.is_some_and(|s| s.load(Ordering::Relaxed)) || self.solved() {
-            return true;
-        }
-        if let Some(m) = self.budget.max_evals
-            && self.evaluations >= m
-        {
+        if self.exhausted_but_the_clock() {
             return true;
         }
         if let Some(t) = self.budget.time_limit
@@ -161,6 +156,14 @@ impl<'a> Context<'a> {
             return true;
         }
         false
+    }
+    /// The checks of [`Context::exhausted`] that do not read the clock: the stop flag, the
+    /// floor and the evaluation budget.
+    #[inline]
+    fn exhausted_but_the_clock(&self) -> bool {
+        self.stop.is_some_and(|s| s.load(Ordering::Relaxed))
+            || self.solved()
+            || self.budget.max_evals.is_some_and(|m| self.evaluations >= m)
     }
     /// [`Context::exhausted`] for the hot loops of the local search, where every call does a
     /// little counted work (one cell looked at): the clock is read only every
@@ -173,10 +176,7 @@ impl<'a> Context<'a> {
         if self.budget.time_limit.is_some() {
             self.polls += 1;
             if self.polls < POLL_CALLS && self.evaluations.saturating_sub(self.polled_at) < POLL_EVALS {
-                let evals_out = self.budget.max_evals.is_some_and(|m| self.evaluations >= m);
-                return evals_out
-                    || self.stop.is_some_and(|s| s.load(Ordering::Relaxed))
-                    || self.solved();
+                return self.exhausted_but_the_clock();
             }
             self.polls = 0;
             self.polled_at = self.evaluations;
