@@ -345,6 +345,11 @@ impl CostModel {
     pub fn multimode(&self) -> bool {
         self.nodes() > self.n()
     }
+    /// True when every cell has exactly one mode (node = cell; every SOP instance).
+    #[inline]
+    pub fn one_mode(&self) -> bool {
+        self.one_mode
+    }
     /// Number of modes of a cell.
     #[inline]
     pub fn modes(&self, cell: usize) -> usize {

@@ -28,7 +28,7 @@ impl Solution {
             pos: vec![0; n],
             mode: vec![0; n],
             cost: 0.0,
-            one_mode: !c.m.multimode() && (0..n).all(|x| c.m.modes(x) == 1),
+            one_mode: c.m.one_mode(),
         };
         for (p, v) in seq.iter().enumerate() {
             s.pos[v.cell] = p as u32;
