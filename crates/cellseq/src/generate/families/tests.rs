@@ -149,6 +149,65 @@ fn time_window_precedence_is_a_closed_interval_order_denser_for_shorter_windows(
 }
 
 #[test]
+fn time_window_station_jobs_give_free_empty_moves_and_loaded_moves_shift_every_order_alike() {
+    let p = |io: &str, loaded: &str| {
+        gen_(
+            "time-window",
+            &[
+                ("n", "150"),
+                ("c", "20"),
+                ("w", "10"),
+                ("io", io),
+                ("loaded", loaded),
+            ],
+            4,
+        )
+    };
+    let zero_arcs = |inst: &Instance| {
+        let m = inst.matrix.as_ref().unwrap();
+        let n = inst.n();
+        (1..n - 1)
+            .flat_map(|i| (1..n - 1).map(move |j| (i, j)))
+            .filter(|&(i, j)| i != j && m.get(i, j) == 0.0)
+            .count()
+    };
+    // io = 0 draws what the generator drew before the parameter (same matrix and order)
+    let before = gen_("time-window", &[("n", "150"), ("c", "20"), ("w", "10")], 4);
+    let plain = p("0", "true");
+    assert_eq!(before.matrix, plain.matrix);
+    assert_eq!(before.precedence, plain.precedence);
+    // a retrieval (set down at the station) then a storage (picked up there): a free empty
+    // move, so with the station the instance has many more zero-cost links
+    let (empty0, empty_io) = (p("0", "false"), p("0.5", "false"));
+    assert!(
+        zero_arcs(&empty_io) > 3 * zero_arcs(&empty0).max(1),
+        "{} zero arcs with the station, {} without",
+        zero_arcs(&empty_io),
+        zero_arcs(&empty0)
+    );
+    // with the loaded moves, every order costs the sum of the loaded moves of all jobs but
+    // the first more (the dummy start links to the first job for nothing): two orders with
+    // the same first job
+    let (with, without) = (p("0.5", "true"), p("0.5", "false"));
+    let cost = |inst: &Instance, order: &[usize]| {
+        let m = inst.matrix.as_ref().unwrap();
+        order.windows(2).map(|w| m.get(w[0], w[1])).sum::<f64>()
+    };
+    // the numbering is a schedule; a second one swaps the first two neighbours left unordered
+    // after the first job
+    let a: Vec<usize> = (0..with.n()).collect();
+    let k = (2..with.n() - 2)
+        .find(|&k| !with.precedence.contains(&(k, k + 1)))
+        .expect("two unordered neighbours");
+    let mut b = a.clone();
+    b.swap(k, k + 1);
+    let shift_a = cost(&with, &a) - cost(&without, &a);
+    let shift_b = cost(&with, &b) - cost(&without, &b);
+    assert!(shift_a > 0.0);
+    assert_eq!(shift_a, shift_b);
+}
+
+#[test]
 fn generalized_open_features_cut_either_way_with_asymmetric_costs() {
     let inst = gen_("generalized", &[("n", "30"), ("open", "1"), ("p", "0")], 3);
     let m = inst.matrix.as_ref().unwrap();
@@ -265,6 +324,9 @@ fn bad_parameters_are_refused() {
         ("time-window", vec![("w", "0")]),
         ("time-window", vec![("n", "20"), ("w", "21")]),
         ("time-window", vec![("c", "0")]),
+        ("time-window", vec![("io", "1.5")]),
+        ("time-window", vec![("io", "-0.1")]),
+        ("time-window", vec![("loaded", "maybe")]),
     ] {
         assert!(
             generate(kind, &kv(&pairs), 1).is_err(),

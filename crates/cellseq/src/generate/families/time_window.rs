@@ -9,6 +9,11 @@
 //! as fast: asymmetric, with the triangle inequality on the empty moves. Unlike
 //! `random-sop`, whose dense precedence is a random DAG over uniform costs, the orders here
 //! come in overlapping windows of about `w` jobs, and nearby jobs are cheap to chain.
+//!
+//! `io` sends a share of the jobs through the input/output station (storage: picked up
+//! there; retrieval: set down there), so that a retrieval followed by a storage links for
+//! nothing: the zero-cost links and ties of TSPLIB's stacker-crane instances. `loaded=false`
+//! leaves the loaded moves out of the costs, as those instances do.
 
 use super::{C_SPEC, sop_shaped};
 use crate::error::{Error, Result};
@@ -28,7 +33,28 @@ pub static SPECS: &[ParamSpec] = &[
         help: "mean window length in jobs: releases are uniform over a horizon of n jobs, \
                window lengths uniform in [0, 2w] (0 < w <= n)",
     },
+    ParamSpec {
+        name: "io",
+        default: "0",
+        kind: ParamKind::float(0.0, 1.0),
+        help: "share of jobs that pass through the input/output station at the rack's \
+               corner: half of them store a load (picked up there), half retrieve one (set \
+               down there); a retrieval followed by a storage moves the crane empty for \
+               nothing (0 <= io <= 1; 0: every pick-up and drop-off is a random slot)",
+    },
+    ParamSpec {
+        name: "loaded",
+        default: "true",
+        kind: ParamKind::Bool,
+        help: "the cost of a job includes its loaded move (false: only the empty move to its \
+               pick-up, as in TSPLIB's stacker-crane instances; the loaded moves add to a \
+               sequence the sum over all jobs but the first, so among sequences that start \
+               with the same job the order by cost is the same)",
+    },
 ];
+
+/// The input/output station: column 0, level 0.
+const STATION: Slot = (0, 0);
 
 /// A rack slot: column and level.
 type Slot = (i64, i64);
@@ -56,14 +82,27 @@ pub fn generate(p: &Params, seed: u64) -> Result<Instance> {
     let n = p.int("n") as usize;
     let c = p.int("c");
     let w = p.float("w");
+    let io = p.float("io");
+    let loaded = p.bool("loaded");
     let (cols, levels) = (c as i64, (c as i64 / 4).max(1));
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let mut jobs: Vec<(f64, f64, Slot, Slot)> = (0..n)
         .map(|_| {
             let open = rng.random_range(0.0..n as f64);
             let close = open + rng.random_range(0.0..=2.0 * w);
-            let pick = (rng.random_range(0..=cols), rng.random_range(0..=levels));
-            let drop = (rng.random_range(0..=cols), rng.random_range(0..=levels));
+            // drawn only when the station is used, so io = 0 keeps the draws of before
+            let kind = if io > 0.0 {
+                rng.random_range(0.0..1.0)
+            } else {
+                1.0
+            };
+            let mut pick = (rng.random_range(0..=cols), rng.random_range(0..=levels));
+            let mut drop = (rng.random_range(0..=cols), rng.random_range(0..=levels));
+            if kind < io / 2.0 {
+                pick = STATION;
+            } else if kind < io {
+                drop = STATION;
+            }
             (open, close, pick, drop)
         })
         .collect();
@@ -78,8 +117,16 @@ pub fn generate(p: &Params, seed: u64) -> Result<Instance> {
     let cost = |u: usize, v: usize| {
         let (_, _, _, drop_u) = jobs[u];
         let (_, _, pick_v, drop_v) = jobs[v];
-        (travel(drop_u, pick_v) + travel(pick_v, drop_v)) as f64
+        let load = if loaded { travel(pick_v, drop_v) } else { 0 };
+        (travel(drop_u, pick_v) + load) as f64
     };
-    let name = format!("time-window-n{n}-c{c}-w{w}-s{seed}");
+    let mut name = format!("time-window-n{n}-c{c}-w{w}");
+    if io > 0.0 {
+        name += &format!("-io{io}");
+    }
+    if !loaded {
+        name += "-empty";
+    }
+    name += &format!("-s{seed}");
     Ok(sop_shaped(name, &vec![1; n], cost, &edges))
 }
