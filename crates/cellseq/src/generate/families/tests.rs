@@ -4,7 +4,7 @@
 use super::sop::to_sop_text;
 use crate::formats::json::instance_to_json;
 use crate::generate::generate;
-use crate::model::{Instance, Objective};
+use crate::model::{CostMatrix, Instance, Objective};
 use crate::precedence::{Dag, closure_density, closure_size, topological_order};
 use std::collections::BTreeMap;
 
@@ -205,6 +205,66 @@ fn time_window_station_jobs_give_free_empty_moves_and_loaded_moves_shift_every_o
     let shift_b = cost(&with, &b) - cost(&without, &b);
     assert!(shift_a > 0.0);
     assert_eq!(shift_a, shift_b);
+    // with a start-and-stop time, an empty move costs nothing or at least that time, and
+    // the links that stay put are the same as without it
+    let setup = gen_(
+        "time-window",
+        &[
+            ("n", "150"),
+            ("c", "20"),
+            ("w", "10"),
+            ("io", "0.5"),
+            ("loaded", "false"),
+            ("setup", "10"),
+        ],
+        4,
+    );
+    let (ms, m0) = (
+        setup.matrix.as_ref().unwrap(),
+        without.matrix.as_ref().unwrap(),
+    );
+    for i in 1..setup.n() - 1 {
+        for j in (1..setup.n() - 1).filter(|&j| j != i) {
+            let (x, y) = (ms.get(i, j), m0.get(i, j));
+            if y >= CostMatrix::FORBIDDEN {
+                // against the precedence: forbidden in both
+                assert_eq!(x, y, "{i}->{j}");
+                continue;
+            }
+            assert_eq!(x == 0.0, y == 0.0, "{i}->{j}: {x} against {y}");
+            assert!(x == 0.0 || x == y + 10.0, "{i}->{j}: {x} against {y}");
+        }
+    }
+    assert!(zero_arcs(&setup) > 0);
+}
+
+#[test]
+fn exponential_windows_keep_an_interval_order_and_let_a_few_jobs_go_further() {
+    // the most positions a job may take: the cells neither before nor after it
+    let widest_freedom = |windows: &str| {
+        let inst = gen_(
+            "time-window",
+            &[("n", "300"), ("w", "10"), ("windows", windows)],
+            7,
+        );
+        let (n, e) = free_edges(&inst);
+        assert_eq!(closure_size(n, &e), e.len(), "{windows}: not closed");
+        let mut related = vec![0usize; n];
+        for &(a, b) in &e {
+            related[a] += 1;
+            related[b] += 1;
+        }
+        let d = closure_density(&Dag::new(n, &e));
+        (related.iter().map(|r| n - 1 - r).max().unwrap(), d)
+    };
+    let (uniform, du) = widest_freedom("uniform");
+    let (exponential, de) = widest_freedom("exponential");
+    // the same mean window: about as dense, with a longer tail
+    assert!((du - de).abs() < 0.03, "densities {du} and {de}");
+    assert!(
+        exponential > uniform + 10,
+        "widest freedom {exponential} against {uniform}"
+    );
 }
 
 #[test]
@@ -327,6 +387,8 @@ fn bad_parameters_are_refused() {
         ("time-window", vec![("io", "1.5")]),
         ("time-window", vec![("io", "-0.1")]),
         ("time-window", vec![("loaded", "maybe")]),
+        ("time-window", vec![("setup", "-1")]),
+        ("time-window", vec![("windows", "normal")]),
     ] {
         assert!(
             generate(kind, &kv(&pairs), 1).is_err(),

@@ -13,7 +13,10 @@
 //! `io` sends a share of the jobs through the input/output station (storage: picked up
 //! there; retrieval: set down there), so that a retrieval followed by a storage links for
 //! nothing: the zero-cost links and ties of TSPLIB's stacker-crane instances. `loaded=false`
-//! leaves the loaded moves out of the costs, as those instances do.
+//! leaves the loaded moves out of the costs, as those instances do, and `setup` charges every
+//! move between two different slots a fixed time to start and stop (their costs are 0 or at
+//! least 10). `windows=exponential` draws window lengths with a long tail, so that a few
+//! jobs may go almost anywhere, as a few of theirs do.
 
 use super::{C_SPEC, sop_shaped};
 use crate::error::{Error, Result};
@@ -34,6 +37,13 @@ pub static SPECS: &[ParamSpec] = &[
                window lengths uniform in [0, 2w] (0 < w <= n)",
     },
     ParamSpec {
+        name: "windows",
+        default: "uniform",
+        kind: ParamKind::Choice(&["uniform", "exponential"]),
+        help: "window lengths: uniform in [0, 2w], or exponential with mean w (a long tail: a \
+               few jobs may go almost anywhere, as in TSPLIB's stacker-crane instances)",
+    },
+    ParamSpec {
         name: "io",
         default: "0",
         kind: ParamKind::float(0.0, 1.0),
@@ -50,6 +60,14 @@ pub static SPECS: &[ParamSpec] = &[
                pick-up, as in TSPLIB's stacker-crane instances; the loaded moves add to a \
                sequence the sum over all jobs but the first, so among sequences that start \
                with the same job the order by cost is the same)",
+    },
+    ParamSpec {
+        name: "setup",
+        default: "0",
+        kind: ParamKind::int(0, 1_000_000),
+        help: "time the crane takes to start and stop: a move between two different slots \
+               costs this much on top of its travel, a move that stays put nothing (TSPLIB's \
+               stacker-crane costs are 0 or at least 10)",
     },
 ];
 
@@ -84,12 +102,23 @@ pub fn generate(p: &Params, seed: u64) -> Result<Instance> {
     let w = p.float("w");
     let io = p.float("io");
     let loaded = p.bool("loaded");
+    let exponential = p.word("windows") == "exponential";
+    let setup = p.int("setup") as i64;
+    // a move between two different slots: its travel and the start and stop
+    let travel = |a: Slot, b: Slot| {
+        if a == b { 0 } else { travel(a, b) + setup }
+    };
     let (cols, levels) = (c as i64, (c as i64 / 4).max(1));
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let mut jobs: Vec<(f64, f64, Slot, Slot)> = (0..n)
         .map(|_| {
             let open = rng.random_range(0.0..n as f64);
-            let close = open + rng.random_range(0.0..=2.0 * w);
+            let close = open
+                + if exponential {
+                    -w * (1.0 - rng.random_range(0.0..1.0f64)).ln()
+                } else {
+                    rng.random_range(0.0..=2.0 * w)
+                };
             // drawn only when the station is used, so io = 0 keeps the draws of before
             let kind = if io > 0.0 {
                 rng.random_range(0.0..1.0)
@@ -121,11 +150,17 @@ pub fn generate(p: &Params, seed: u64) -> Result<Instance> {
         (travel(drop_u, pick_v) + load) as f64
     };
     let mut name = format!("time-window-n{n}-c{c}-w{w}");
+    if exponential {
+        name += "-exp";
+    }
     if io > 0.0 {
         name += &format!("-io{io}");
     }
     if !loaded {
         name += "-empty";
+    }
+    if setup > 0 {
+        name += &format!("-setup{setup}");
     }
     name += &format!("-s{seed}");
     Ok(sop_shaped(name, &vec![1; n], cost, &edges))
