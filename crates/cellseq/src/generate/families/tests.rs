@@ -268,6 +268,36 @@ fn exponential_windows_keep_an_interval_order_and_let_a_few_jobs_go_further() {
 }
 
 #[test]
+fn bursts_keep_an_interval_order_with_wider_levels() {
+    // the most cells at one depth of the precedence (longest chain of predecessors)
+    let widest_level = |bursts: &str| {
+        let inst = gen_(
+            "time-window",
+            &[("n", "300"), ("w", "8"), ("bursts", bursts)],
+            7,
+        );
+        let (n, mut e) = free_edges(&inst);
+        assert_eq!(closure_size(n, &e), e.len(), "bursts={bursts}: not closed");
+        // cells are numbered by release, so every pair goes forwards
+        e.sort_unstable_by_key(|&(a, b)| (b, a));
+        let mut depth = vec![0usize; n];
+        for &(a, b) in &e {
+            depth[b] = depth[b].max(depth[a] + 1);
+        }
+        let mut count = vec![0usize; n];
+        for &d in &depth {
+            count[d] += 1;
+        }
+        *count.iter().max().unwrap()
+    };
+    let (uniform, bursty) = (widest_level("0"), widest_level("35"));
+    assert!(
+        bursty >= 2 * uniform,
+        "widest level {bursty} against {uniform}"
+    );
+}
+
+#[test]
 fn generalized_open_features_cut_either_way_with_asymmetric_costs() {
     let inst = gen_("generalized", &[("n", "30"), ("open", "1"), ("p", "0")], 3);
     let m = inst.matrix.as_ref().unwrap();
@@ -389,6 +419,7 @@ fn bad_parameters_are_refused() {
         ("time-window", vec![("loaded", "maybe")]),
         ("time-window", vec![("setup", "-1")]),
         ("time-window", vec![("windows", "normal")]),
+        ("time-window", vec![("bursts", "-1")]),
     ] {
         assert!(
             generate(kind, &kv(&pairs), 1).is_err(),

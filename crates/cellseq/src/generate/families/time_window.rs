@@ -16,7 +16,8 @@
 //! leaves the loaded moves out of the costs, as those instances do, and `setup` charges every
 //! move between two different slots a fixed time to start and stop (their costs are 0 or at
 //! least 10). `windows=exponential` draws window lengths with a long tail, so that a few
-//! jobs may go almost anywhere, as a few of theirs do.
+//! jobs may go almost anywhere, as a few of theirs do, and `bursts` releases the jobs in
+//! bursts, which gives the wide levels of mutually unordered jobs theirs have.
 
 use super::{C_SPEC, sop_shaped};
 use crate::error::{Error, Result};
@@ -42,6 +43,15 @@ pub static SPECS: &[ParamSpec] = &[
         kind: ParamKind::Choice(&["uniform", "exponential"]),
         help: "window lengths: uniform in [0, 2w], or exponential with mean w (a long tail: a \
                few jobs may go almost anywhere, as in TSPLIB's stacker-crane instances)",
+    },
+    ParamSpec {
+        name: "bursts",
+        default: "0",
+        kind: ParamKind::int(0, super::MAX_N),
+        help: "releases come in this many bursts at random times over the horizon, each job \
+               released within one job's time after its burst (wide levels of mutually \
+               unordered jobs, as in TSPLIB's stacker-crane instances); 0: releases uniform \
+               over the horizon",
     },
     ParamSpec {
         name: "io",
@@ -104,15 +114,24 @@ pub fn generate(p: &Params, seed: u64) -> Result<Instance> {
     let loaded = p.bool("loaded");
     let exponential = p.word("windows") == "exponential";
     let setup = p.int("setup") as i64;
-    // a move between two different slots: its travel and the start and stop
-    let travel = |a: Slot, b: Slot| {
+    // a crane move: nothing when it stays put, else its travel and the start and stop
+    let crane_move = |a: Slot, b: Slot| {
         if a == b { 0 } else { travel(a, b) + setup }
     };
     let (cols, levels) = (c as i64, (c as i64 / 4).max(1));
+    let bursts = p.int("bursts") as usize;
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    // burst times, drawn only with bursts, so bursts = 0 keeps the draws of before
+    let times: Vec<f64> = (0..bursts)
+        .map(|_| rng.random_range(0.0..n as f64))
+        .collect();
     let mut jobs: Vec<(f64, f64, Slot, Slot)> = (0..n)
         .map(|_| {
-            let open = rng.random_range(0.0..n as f64);
+            let open = if bursts > 0 {
+                times[rng.random_range(0..bursts)] + rng.random_range(0.0..1.0)
+            } else {
+                rng.random_range(0.0..n as f64)
+            };
             let close = open
                 + if exponential {
                     -w * (1.0 - rng.random_range(0.0..1.0f64)).ln()
@@ -146,10 +165,17 @@ pub fn generate(p: &Params, seed: u64) -> Result<Instance> {
     let cost = |u: usize, v: usize| {
         let (_, _, _, drop_u) = jobs[u];
         let (_, _, pick_v, drop_v) = jobs[v];
-        let load = if loaded { travel(pick_v, drop_v) } else { 0 };
-        (travel(drop_u, pick_v) + load) as f64
+        let load = if loaded {
+            crane_move(pick_v, drop_v)
+        } else {
+            0
+        };
+        (crane_move(drop_u, pick_v) + load) as f64
     };
     let mut name = format!("time-window-n{n}-c{c}-w{w}");
+    if bursts > 0 {
+        name += &format!("-b{bursts}");
+    }
     if exponential {
         name += "-exp";
     }
