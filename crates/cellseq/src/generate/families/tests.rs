@@ -150,7 +150,7 @@ fn time_window_precedence_is_a_closed_interval_order_denser_for_shorter_windows(
 
 #[test]
 fn time_window_station_jobs_give_free_empty_moves_and_loaded_moves_shift_every_order_alike() {
-    let p = |io: &str, loaded: &str| {
+    let p = |io: &str, loaded: &str, setup: &str| {
         gen_(
             "time-window",
             &[
@@ -159,6 +159,7 @@ fn time_window_station_jobs_give_free_empty_moves_and_loaded_moves_shift_every_o
                 ("w", "10"),
                 ("io", io),
                 ("loaded", loaded),
+                ("setup", setup),
             ],
             4,
         )
@@ -173,12 +174,12 @@ fn time_window_station_jobs_give_free_empty_moves_and_loaded_moves_shift_every_o
     };
     // io = 0 draws what the generator drew before the parameter (same matrix and order)
     let before = gen_("time-window", &[("n", "150"), ("c", "20"), ("w", "10")], 4);
-    let plain = p("0", "true");
+    let plain = p("0", "true", "0");
     assert_eq!(before.matrix, plain.matrix);
     assert_eq!(before.precedence, plain.precedence);
     // a retrieval (set down at the station) then a storage (picked up there): a free empty
     // move, so with the station the instance has many more zero-cost links
-    let (empty0, empty_io) = (p("0", "false"), p("0.5", "false"));
+    let (empty0, empty_io) = (p("0", "false", "0"), p("0.5", "false", "0"));
     assert!(
         zero_arcs(&empty_io) > 3 * zero_arcs(&empty0).max(1),
         "{} zero arcs with the station, {} without",
@@ -188,7 +189,7 @@ fn time_window_station_jobs_give_free_empty_moves_and_loaded_moves_shift_every_o
     // with the loaded moves, every order costs the sum of the loaded moves of all jobs but
     // the first more (the dummy start links to the first job for nothing): two orders with
     // the same first job
-    let (with, without) = (p("0.5", "true"), p("0.5", "false"));
+    let (with, without) = (p("0.5", "true", "0"), p("0.5", "false", "0"));
     let cost = |inst: &Instance, order: &[usize]| {
         let m = inst.matrix.as_ref().unwrap();
         order.windows(2).map(|w| m.get(w[0], w[1])).sum::<f64>()
@@ -207,18 +208,7 @@ fn time_window_station_jobs_give_free_empty_moves_and_loaded_moves_shift_every_o
     assert_eq!(shift_a, shift_b);
     // with a start-and-stop time, an empty move costs nothing or at least that time, and
     // the links that stay put are the same as without it
-    let setup = gen_(
-        "time-window",
-        &[
-            ("n", "150"),
-            ("c", "20"),
-            ("w", "10"),
-            ("io", "0.5"),
-            ("loaded", "false"),
-            ("setup", "10"),
-        ],
-        4,
-    );
+    let setup = p("0.5", "false", "10");
     let (ms, m0) = (
         setup.matrix.as_ref().unwrap(),
         without.matrix.as_ref().unwrap(),
@@ -238,17 +228,21 @@ fn time_window_station_jobs_give_free_empty_moves_and_loaded_moves_shift_every_o
     assert!(zero_arcs(&setup) > 0);
 }
 
+/// The free precedence edges of a `time-window` instance of 300 cells (seed 7) with `pairs`,
+/// checked to be transitively closed (an interval order is its own closure).
+fn closed_time_window(pairs: &[(&str, &str)]) -> (usize, Vec<(usize, usize)>) {
+    let mut all = vec![("n", "300")];
+    all.extend_from_slice(pairs);
+    let (n, e) = free_edges(&gen_("time-window", &all, 7));
+    assert_eq!(closure_size(n, &e), e.len(), "{pairs:?}: not closed");
+    (n, e)
+}
+
 #[test]
 fn exponential_windows_keep_an_interval_order_and_let_a_few_jobs_go_further() {
     // the most positions a job may take: the cells neither before nor after it
     let widest_freedom = |windows: &str| {
-        let inst = gen_(
-            "time-window",
-            &[("n", "300"), ("w", "10"), ("windows", windows)],
-            7,
-        );
-        let (n, e) = free_edges(&inst);
-        assert_eq!(closure_size(n, &e), e.len(), "{windows}: not closed");
+        let (n, e) = closed_time_window(&[("w", "10"), ("windows", windows)]);
         let mut related = vec![0usize; n];
         for &(a, b) in &e {
             related[a] += 1;
@@ -271,13 +265,7 @@ fn exponential_windows_keep_an_interval_order_and_let_a_few_jobs_go_further() {
 fn bursts_keep_an_interval_order_with_wider_levels() {
     // the most cells at one depth of the precedence (longest chain of predecessors)
     let widest_level = |bursts: &str| {
-        let inst = gen_(
-            "time-window",
-            &[("n", "300"), ("w", "8"), ("bursts", bursts)],
-            7,
-        );
-        let (n, mut e) = free_edges(&inst);
-        assert_eq!(closure_size(n, &e), e.len(), "bursts={bursts}: not closed");
+        let (n, mut e) = closed_time_window(&[("w", "8"), ("bursts", bursts)]);
         // cells are numbered by release, so every pair goes forwards
         e.sort_unstable_by_key(|&(a, b)| (b, a));
         let mut depth = vec![0usize; n];
