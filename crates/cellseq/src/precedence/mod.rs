@@ -169,6 +169,28 @@ pub fn closure_density(dag: &Dag) -> f64 {
     dag_closure_size(dag) as f64 / (n as f64 * (n as f64 - 1.0) / 2.0)
 }
 
+/// Cells in the largest level of the longest-path layering of `dag` (a cell's level: the
+/// most predecessors on one chain before it); 0 for an empty or cyclic graph.
+pub fn widest_level(dag: &Dag) -> usize {
+    let Ok(order) = topological_order(dag) else {
+        return 0;
+    };
+    let mut level = vec![0usize; dag.n()];
+    for &v in &order {
+        let v = v as usize;
+        for &s in &dag.succs[v] {
+            let s = s as usize;
+            level[s] = level[s].max(level[v] + 1);
+        }
+    }
+    let depth = level.iter().copied().max().unwrap_or(0);
+    let mut count = vec![0usize; depth + 1];
+    for &l in &level {
+        count[l] += 1;
+    }
+    count.into_iter().max().unwrap_or(0)
+}
+
 /// [`closure_size`] of a built [`Dag`].
 fn dag_closure_size(dag: &Dag) -> usize {
     let n = dag.n();

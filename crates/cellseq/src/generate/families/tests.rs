@@ -265,18 +265,8 @@ fn exponential_windows_keep_an_interval_order_and_let_a_few_jobs_go_further() {
 fn bursts_keep_an_interval_order_with_wider_levels() {
     // the most cells at one depth of the precedence (longest chain of predecessors)
     let widest_level = |bursts: &str| {
-        let (n, mut e) = closed_time_window(&[("w", "8"), ("bursts", bursts)]);
-        // cells are numbered by release, so every pair goes forwards
-        e.sort_unstable_by_key(|&(a, b)| (b, a));
-        let mut depth = vec![0usize; n];
-        for &(a, b) in &e {
-            depth[b] = depth[b].max(depth[a] + 1);
-        }
-        let mut count = vec![0usize; n];
-        for &d in &depth {
-            count[d] += 1;
-        }
-        *count.iter().max().unwrap()
+        let (n, e) = closed_time_window(&[("w", "8"), ("bursts", bursts)]);
+        crate::precedence::widest_level(&Dag::new(n, &e))
     };
     let (uniform, bursty) = (widest_level("0"), widest_level("35"));
     assert!(

@@ -176,21 +176,5 @@ fn widest_level(m: &CostModel) -> f64 {
     if n == 0 {
         return 0.0;
     }
-    let Ok(order) = crate::precedence::topological_order(&m.dag) else {
-        return 0.0;
-    };
-    let mut level = vec![0usize; n];
-    for &v in &order {
-        let v = v as usize;
-        for &s in &m.dag.succs[v] {
-            let s = s as usize;
-            level[s] = level[s].max(level[v] + 1);
-        }
-    }
-    let depth = level.iter().copied().max().unwrap_or(0);
-    let mut count = vec![0usize; depth + 1];
-    for &l in &level {
-        count[l] += 1;
-    }
-    count.into_iter().max().unwrap_or(0) as f64 / n as f64
+    crate::precedence::widest_level(&m.dag) as f64 / n as f64
 }
