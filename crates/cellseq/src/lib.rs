@@ -100,6 +100,8 @@ pub mod registry {
     };
     /// Largest portfolio file read, in bytes.
     pub const PORTFOLIO_MAX_BYTES: u64 = crate::solvers::auto::portfolio::MAX_FILE_BYTES;
+    /// Largest `beam.stretch` of a portfolio rule (the least is 1).
+    pub const PORTFOLIO_MAX_STRETCH: f64 = crate::solvers::auto::portfolio::MAX_STRETCH;
 }
 
 /// What most programs need, in one `use cellseq::prelude::*;`.

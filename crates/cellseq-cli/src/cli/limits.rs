@@ -156,10 +156,11 @@ the key); under these limits no cost of any sequence can overflow.\n\n",
     ]);
     rows.push(vec![
         "portfolio file".into(),
-        "size; `share`; `min_seconds`; conditions".into(),
+        "size; `share`; `min_seconds`; `beam.stretch`; conditions".into(),
         format!(
-            "at most {} bytes; [0, 1]; at least 0; finite numbers ([portfolio.md](portfolio.md))",
-            cellseq::registry::PORTFOLIO_MAX_BYTES
+            "at most {} bytes; [0, 1]; at least 0; [1, {}]; finite numbers ([portfolio.md](portfolio.md))",
+            cellseq::registry::PORTFOLIO_MAX_BYTES,
+            cellseq::registry::PORTFOLIO_MAX_STRETCH
         ),
     ]);
     table(out, &["file", "value", "accepts"], &rows);

@@ -798,3 +798,40 @@ fn zero_bounds_are_positive_zero() {
     assert_eq!(b.best.to_string(), "0");
     assert!(b.parts.iter().any(|p| p.name == "assignment"));
 }
+
+/// `soft`: every pass of the beam runs within that share of its budget, but the widest
+/// bounded pass (width `exhaustive_from`), which may use the whole budget when the pass before
+/// it predicts that it fits. Evaluation budgets make both runs deterministic, so the soft run
+/// is compared with the same beam given only the soft share.
+#[test]
+fn beam_soft_share_holds_every_pass_but_the_widest() {
+    let inst = crate::common::sop("prob.100");
+    let run = |soft: &str, evals: u64| {
+        let p: BTreeMap<String, String> = [
+            ("warm_evals", "20000"),
+            ("exhaustive_from", "512"),
+            ("soft", soft),
+        ]
+        .iter()
+        .map(|(k, v)| (k.to_string(), v.to_string()))
+        .collect();
+        let budget = Budget {
+            max_evals: Some(evals),
+            ..Budget::default()
+        };
+        solve_with("beam", &inst, Objective::Matrix, &p, budget).expect("beam solves")
+    };
+    // the pass of width 512 is predicted to fit in 32e6 evaluations: it runs past the soft
+    // half, and the beam ends within the whole budget
+    let (soft, half) = (run("0.5", 32_000_000), run("1", 16_000_000));
+    assert!(
+        soft.evaluations > 16_000_000 && soft.evaluations <= 32_000_000,
+        "the widest pass runs past the soft share: {} evaluations",
+        soft.evaluations
+    );
+    assert!(soft.report.cost <= half.report.cost);
+    // in 16e6 it is not: every pass stays within the soft half, as with that half alone
+    let (soft, half) = (run("0.5", 16_000_000), run("1", 8_000_000));
+    assert_eq!(soft.evaluations, half.evaluations);
+    assert_eq!(soft.report.cost, half.report.cost);
+}

@@ -488,6 +488,20 @@ fn bad_portfolios_are_refused_naming_the_file_and_the_entry() {
             ),
             "a plan cannot contain auto itself",
         ),
+        (
+            format!(
+                "{head}{}",
+                last.replace("share = 0.1 }", "share = 0.1, stretch = 0.5 }")
+            ),
+            "beam.stretch must be in [1, 10], got 0.5",
+        ),
+        (
+            format!(
+                "{head}{}",
+                last.replace("share = 0.1 }", "share = 0.1, stretch = 11 }")
+            ),
+            "beam.stretch must be in [1, 10], got 11",
+        ),
         (head.to_string(), "no [[rule]]"),
         (last.clone(), "missing field `beam`"),
         ("[[rule]\n".to_string(), "p.toml:1:"),

@@ -166,8 +166,15 @@ impl Choice<'_> {
             format!("rule       {}", self.rule),
             format!("features   {}", self.features.line()),
             format!(
-                "beam       share {} up to {} cells, budgets of at least {} s",
-                self.beam.share, self.beam.max_cells, self.beam.min_seconds
+                "beam       share {} up to {} cells, budgets of at least {} s{}",
+                self.beam.share,
+                self.beam.max_cells,
+                self.beam.min_seconds,
+                if self.beam.stretch > 1.0 {
+                    format!(", its widest pass up to {}× the share", self.beam.stretch)
+                } else {
+                    String::new()
+                }
             ),
             format!("phases     {}", plan_text(self.phases)),
         ];
@@ -344,10 +351,17 @@ impl Solver for Auto {
             .is_some_and(|t| t.as_secs_f64() < beam_cfg.min_seconds);
         let mut after_beam = false;
         if ctx.model.n() <= beam_cfg.max_cells && beam_cfg.share > 0.0 && !short {
-            let b = share(budget, 0, 0.0, beam_cfg.share);
+            // the widest bounded pass may stretch the share (the beam's `soft` share of its
+            // budget holds every other pass)
+            let hard = (beam_cfg.share * beam_cfg.stretch).min(1.0);
+            let b = share(budget, 0, 0.0, hard);
+            let mut given = BTreeMap::new();
+            if hard > beam_cfg.share {
+                given.insert("soft".to_string(), (beam_cfg.share / hard).to_string());
+            }
             let beam = Run {
                 name: "beam",
-                given: &BTreeMap::new(),
+                given: &given,
                 budget: b,
                 from: Start::Fresh,
                 start: None,
@@ -433,6 +447,8 @@ pub struct Explanation {
     pub beam_max_cells: usize,
     /// Shortest wall-clock budget that gets the beam phase (seconds).
     pub beam_min_seconds: f64,
+    /// Up to how many times its share the beam phase's widest bounded pass may take.
+    pub beam_stretch: f64,
     /// The phases, in plan syntax.
     pub phases: String,
     /// The phases after a beam phase that ran, when they differ.
@@ -469,6 +485,7 @@ pub fn explain(
         beam_share: c.beam.share,
         beam_max_cells: c.beam.max_cells,
         beam_min_seconds: c.beam.min_seconds,
+        beam_stretch: c.beam.stretch,
         phases: plan_text(c.phases),
         after_beam: c.after_beam.map(plan_text),
         features_seconds,

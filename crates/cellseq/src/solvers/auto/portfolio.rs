@@ -4,7 +4,7 @@
 //!
 //! A file has a `[beam]` table (the beam phase's default limits) and an ordered list of
 //! `[[rule]]` tables, each with a `name`, optional `when` conditions on features, the beam
-//! phase's `beam = { share, max_cells?, min_seconds? }`, `phases` and optional `after_beam`
+//! phase's `beam = { share, max_cells?, min_seconds?, stretch? }`, `phases` and optional `after_beam`
 //! phases. The first rule whose conditions all hold applies; the last must have none.
 //! The format is described for users in `docs/portfolio.md`.
 
@@ -58,6 +58,9 @@ pub struct Beam {
     pub max_cells: usize,
     /// Shortest wall-clock budget (seconds) that gets it; evaluation budgets always do.
     pub min_seconds: f64,
+    /// The beam's widest bounded pass may run up to `stretch` times the share when the pass
+    /// before it predicts that it fits (the beam's `soft`); 1: every pass within the share.
+    pub stretch: f64,
 }
 
 /// Conditions on features: each given one must hold.
@@ -215,6 +218,9 @@ impl When {
 
 // ---- the file as written ----
 
+/// Largest `beam.stretch`.
+pub const MAX_STRETCH: f64 = 10.0;
+
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct FileText {
@@ -248,6 +254,7 @@ struct BeamText {
     share: f64,
     max_cells: Option<usize>,
     min_seconds: Option<f64>,
+    stretch: Option<f64>,
 }
 
 #[derive(Deserialize)]
@@ -408,10 +415,17 @@ fn rule_of(r: &RuleText, d: &BeamDefaults) -> std::result::Result<Rule, String> 
     if !(min_seconds.is_finite() && min_seconds >= 0.0) {
         return Err("beam.min_seconds must be a number >= 0".into());
     }
+    let stretch = b.stretch.unwrap_or(1.0);
+    if !(stretch.is_finite() && (1.0..=MAX_STRETCH).contains(&stretch)) {
+        return Err(format!(
+            "beam.stretch must be in [1, {MAX_STRETCH}], got {stretch}"
+        ));
+    }
     let beam = Beam {
         share: b.share,
         max_cells: b.max_cells.unwrap_or(d.max_cells),
         min_seconds,
+        stretch,
     };
     let phases = phases_of(&r.phases).map_err(|m| format!("phases: {m}"))?;
     let after_beam = match &r.after_beam {

@@ -141,6 +141,16 @@ rbg109a, prob.42, p43.1–p43.4, ft53.4 and ry48p.4 (p43.2 the slowest, at about
                    memory_mb) before wider truncated passes; 0 = never",
         },
         ParamSpec {
+            name: "soft",
+            default: "1",
+            kind: ParamKind::float(0.01, 1.0),
+            help: "the passes run within this share of the budget (time and evaluations) \
+                   except the pass of width exhaustive_from, which may use the whole budget \
+                   when the pass before it, scaled by the width ratio, predicts that it ends in \
+                   time; the warm start and the bounds are sized by the whole budget (1: every \
+                   pass has the whole budget)",
+        },
+        ParamSpec {
             name: "warm_evals",
             default: "2000000",
             kind: ParamKind::int(0, 1_000_000_000_000),
@@ -169,6 +179,7 @@ pub fn from_params(p: &Params) -> Beam {
         growth: p.int("growth") as usize,
         twins: p.bool("twins"),
         exhaustive_from: p.int("exhaustive_from") as usize,
+        soft: p.float("soft"),
     }
 }
 
@@ -198,6 +209,10 @@ pub struct Beam {
     pub growth: usize,
     /// Width after which one unbounded pass is tried (0: never).
     pub exhaustive_from: usize,
+    /// Share of the budget the passes run within, but the pass of width
+    /// [`Beam::exhaustive_from`] when it is predicted to fit in the whole budget (the warm
+    /// start and the bounds are sized by the whole budget).
+    pub soft: f64,
 }
 
 /// Width from which the beam grows by the `growth` factor instead of doubling.
@@ -350,7 +365,14 @@ impl Beam {
             }
             root_lb = root_lb.max(r);
         }
-        let proven = self.widen::<W>(ctx, &t, qp.as_ref(), &mut best, &mut root_lb);
+        // the warm start and the bounds above are sized by the whole budget; the passes by
+        // the soft share of it, but for the widest (`Beam::soft`)
+        let full = ctx.budget;
+        if self.soft < 1.0 {
+            ctx.budget = scaled(full, self.soft);
+        }
+        let proven = self.widen::<W>(ctx, (&t, qp.as_ref()), full, &mut best, &mut root_lb);
+        ctx.budget = full;
         let (cost, sequence) = best.ok_or_else(|| Error::Solver {
             solver: "beam".into(),
             msg: "no feasible sequence found".into(),
@@ -388,24 +410,29 @@ impl Beam {
     /// ends without truncation, or `root_lb` meets the incumbent) or the budget, `max_width`
     /// or `memory_mb` stops them. Returns whether the incumbent is proven optimal; `best` is
     /// the incumbent, `root_lb` rises with the Lagrangian root bound after the first pass.
+    /// With [`Beam::soft`] below 1, `ctx.budget` is the soft share of `full`, and only the
+    /// pass of width [`Beam::exhaustive_from`] may run under `full`.
     fn widen<const W: usize>(
         &self,
         ctx: &mut Context,
-        t: &Tables,
-        qp: Option<&QPath>,
+        (t, qp): (&Tables, Option<&QPath>),
+        full: Budget,
         best: &mut Option<(f64, Sequence)>,
         root_lb: &mut f64,
     ) -> bool {
         let m = ctx.model;
+        let soft = ctx.budget;
         let mut width = 1usize;
         // the bounded width to go on from after the unbounded pass
         let mut resume = None;
         loop {
             let ub = best.as_ref().map(|b| b.0).unwrap_or(f64::INFINITY);
             let unbounded = width == usize::MAX;
+            let (t0, e0) = (ctx.elapsed(), ctx.evaluations());
             let cap = unbounded.then(|| self.memory_mb.saturating_mul(1 << 20));
             let pass =
                 self.iteration::<W>(ctx, t, qp, width, cut(ub, t.integral), best.is_some(), cap);
+            let spent = (ctx.elapsed() - t0, ctx.evaluations() - e0);
             if let Some((c, seq)) = pass.found
                 && best
                     .as_ref()
@@ -459,10 +486,19 @@ impl Beam {
             if pass.aborted || ctx.exhausted() {
                 return false;
             }
-            match self.next_width::<W>(width, &mut resume, m.n()) {
-                Some(w) => width = w,
+            let next = match self.next_width::<W>(width, &mut resume, m.n()) {
+                Some(w) => w,
                 None => return false,
+            };
+            if self.soft < 1.0 {
+                let widest = next == self.exhaustive_from
+                    && fits(ctx, full, spent, growth_between(width, next, self.growth));
+                ctx.budget = if widest { full } else { soft };
+                if ctx.exhausted() {
+                    return false;
+                }
             }
+            width = next;
         }
     }
 
@@ -520,4 +556,35 @@ impl Beam {
         let cost = ctx.model.evaluate(&out.sequence);
         Ok(Some((cost, out.sequence)))
     }
+}
+
+/// How many times the pass of width `next` is predicted to cost the pass of `width`: the
+/// width ratio (the work of a pass grows about linearly in its width), `growth` when either
+/// is the unbounded pass (`usize::MAX`).
+fn growth_between(width: usize, next: usize, growth: usize) -> f64 {
+    if width == usize::MAX || next == usize::MAX {
+        growth as f64
+    } else {
+        next as f64 / width.max(1) as f64
+    }
+}
+
+/// `b` scaled by `frac` (time and evaluations).
+fn scaled(b: Budget, frac: f64) -> Budget {
+    Budget {
+        time_limit: b.time_limit.map(|t| t.mul_f64(frac)),
+        max_evals: b.max_evals.map(|e| (e as f64 * frac) as u64),
+    }
+}
+
+/// Whether a pass predicted to cost `factor` times `spent` (seconds, evaluations) of the pass
+/// before fits in what is left of `budget` on `ctx`'s clock and count.
+fn fits(ctx: &Context, budget: Budget, spent: (f64, u64), factor: f64) -> bool {
+    let time_ok = budget
+        .time_limit
+        .is_none_or(|t| ctx.elapsed() + spent.0 * factor <= t.as_secs_f64());
+    let evals_ok = budget
+        .max_evals
+        .is_none_or(|b| ctx.evaluations() as f64 + spent.1 as f64 * factor <= b as f64);
+    time_ok && evals_ok
 }
