@@ -223,8 +223,13 @@ fn auto_picks_its_rule_by_symmetry_and_precedence_density() {
             assert_eq!(plan_text(c.plan(after_beam)), own);
         }
     }
-    // beam-share replaces the rule's share
+    // beam-share replaces the rule's share, and no pass stretches it
     assert_eq!(auto(&[("beam-share", "0")]).choose(&p42).beam.share, 0.0);
+    assert_eq!(auto(&[]).choose(&p42).beam.stretch, 2.0);
+    assert_eq!(
+        auto(&[("beam-share", "0.3")]).choose(&p42).beam.stretch,
+        1.0
+    );
     // geometric instances: without precedence and with links that cost the same both ways,
     // the two-level local search; with precedence, the catch-all rule
     let generated = |kind: &str, pairs: &[(&str, &str)], seed: u64| {

@@ -114,7 +114,7 @@ rules were chosen: [notes/portfolio.md](../notes/portfolio.md).",
             name: "beam-share",
             default: FROM_RULE,
             kind: ParamKind::Text,
-            help: "share of the budget given to the beam proof attempt, in [0, 1] (0: none); rule: the chosen rule's",
+            help: "share of the budget given to the beam proof attempt, in [0, 1] (0: none), without the rule's stretch; rule: the chosen rule's share and stretch",
         },
     ],
     caps: Caps { ..Caps::NONE },
@@ -265,7 +265,9 @@ impl Auto {
             }
         };
         if let Some(s) = self.beam_share {
+            // the share given is the whole beam phase: no pass stretches it
             beam.share = s;
+            beam.stretch = 1.0;
         }
         Choice {
             rule,
