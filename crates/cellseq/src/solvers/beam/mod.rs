@@ -145,7 +145,8 @@ rbg109a, prob.42, p43.1–p43.4, ft53.4 and ry48p.4 (p43.2 the slowest, at about
             default: "1",
             kind: ParamKind::float(0.01, 1.0),
             help: "the passes run within this share of the budget (time and evaluations) \
-                   except the pass of width exhaustive_from, which may use the whole budget \
+                   except the widest bounded one (the last before the unbounded pass: width \
+                   exhaustive_from when the widths reach it), which may use the whole budget \
                    when the pass before it, scaled by the width ratio, predicts that it ends in \
                    time; the warm start and the bounds are sized by the whole budget (1: every \
                    pass has the whole budget)",
@@ -209,9 +210,9 @@ pub struct Beam {
     pub growth: usize,
     /// Width after which one unbounded pass is tried (0: never).
     pub exhaustive_from: usize,
-    /// Share of the budget the passes run within, but the pass of width
-    /// [`Beam::exhaustive_from`] when it is predicted to fit in the whole budget (the warm
-    /// start and the bounds are sized by the whole budget).
+    /// Share of the budget the passes run within, but the widest bounded one (the last before
+    /// the unbounded pass) when it is predicted to fit in the whole budget (the warm start and
+    /// the bounds are sized by the whole budget).
     pub soft: f64,
 }
 
@@ -411,7 +412,8 @@ impl Beam {
     /// or `memory_mb` stops them. Returns whether the incumbent is proven optimal; `best` is
     /// the incumbent, `root_lb` rises with the Lagrangian root bound after the first pass.
     /// With [`Beam::soft`] below 1, `ctx.budget` is the soft share of `full`, and only the
-    /// pass of width [`Beam::exhaustive_from`] may run under `full`.
+    /// widest bounded pass (the one the unbounded pass follows: width
+    /// [`Beam::exhaustive_from`] when that is a width of the ladder) may run under `full`.
     fn widen<const W: usize>(
         &self,
         ctx: &mut Context,
@@ -491,7 +493,10 @@ impl Beam {
                 None => return false,
             };
             if self.soft < 1.0 {
-                let widest = next == self.exhaustive_from
+                // the widest bounded pass: the one the unbounded pass follows
+                let mut after = resume;
+                let widest = next != usize::MAX
+                    && self.next_width::<W>(next, &mut after, m.n()) == Some(usize::MAX)
                     && fits(ctx, full, spent, growth_between(width, next, self.growth));
                 ctx.budget = if widest { full } else { soft };
                 if ctx.exhausted() {
