@@ -800,16 +800,17 @@ fn zero_bounds_are_positive_zero() {
 }
 
 /// `soft`: every pass of the beam runs within that share of its budget, but the widest
-/// bounded pass (width `exhaustive_from`), which may use the whole budget when the pass before
-/// it predicts that it fits. Evaluation budgets make both runs deterministic, so the soft run
-/// is compared with the same beam given only the soft share.
+/// bounded pass (the last before the unbounded one: width `exhaustive_from` when the widths
+/// reach it), which may use the whole budget when the pass before it predicts that it fits.
+/// Evaluation budgets make both runs deterministic, so the soft run is compared with the same
+/// beam given only the soft share.
 #[test]
 fn beam_soft_share_holds_every_pass_but_the_widest() {
     let inst = crate::common::sop("prob.100");
-    let run = |soft: &str, evals: u64| {
+    let run = |exhaustive_from: &str, soft: &str, evals: u64| {
         let p: BTreeMap<String, String> = [
             ("warm_evals", "20000"),
-            ("exhaustive_from", "512"),
+            ("exhaustive_from", exhaustive_from),
             ("soft", soft),
         ]
         .iter()
@@ -822,16 +823,23 @@ fn beam_soft_share_holds_every_pass_but_the_widest() {
         solve_with("beam", &inst, Objective::Matrix, &p, budget).expect("beam solves")
     };
     // the pass of width 512 is predicted to fit in 32e6 evaluations: it runs past the soft
-    // half, and the beam ends within the whole budget
-    let (soft, half) = (run("0.5", 32_000_000), run("1", 16_000_000));
-    assert!(
-        soft.evaluations > 16_000_000 && soft.evaluations <= 32_000_000,
-        "the widest pass runs past the soft share: {} evaluations",
-        soft.evaluations
-    );
-    assert!(soft.report.cost <= half.report.cost);
-    // in 16e6 it is not: every pass stays within the soft half, as with that half alone
-    let (soft, half) = (run("0.5", 16_000_000), run("1", 8_000_000));
+    // half, and the beam ends within the whole budget; with 300, not a width of the ladder,
+    // the widest bounded pass is the one of width 256, and it fits in 16e6
+    for (exhaustive_from, evals) in [("512", 32_000_000), ("300", 16_000_000)] {
+        let (soft, half) = (
+            run(exhaustive_from, "0.5", evals),
+            run(exhaustive_from, "1", evals / 2),
+        );
+        assert!(
+            soft.evaluations > evals / 2 && soft.evaluations <= evals,
+            "exhaustive_from {exhaustive_from}: the widest pass runs past the soft share: {} \
+             evaluations",
+            soft.evaluations
+        );
+        assert!(soft.report.cost <= half.report.cost);
+    }
+    // with 512 in 16e6 it is not: every pass stays within the soft half, as with that half
+    let (soft, half) = (run("512", "0.5", 16_000_000), run("512", "1", 8_000_000));
     assert_eq!(soft.evaluations, half.evaluations);
     assert_eq!(soft.report.cost, half.report.cost);
 }
