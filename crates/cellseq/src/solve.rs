@@ -83,6 +83,13 @@ impl Budget {
             max_evals: Some(n),
         }
     }
+    /// The share `frac` of this budget: its time limit and its evaluations scaled.
+    pub fn scaled(self, frac: f64) -> Budget {
+        Budget {
+            time_limit: self.time_limit.map(|t| t.mul_f64(frac)),
+            max_evals: self.max_evals.map(|e| (e as f64 * frac) as u64),
+        }
+    }
 }
 
 /// `seconds` as a duration when `0 < seconds ≤` [`MAX_SECONDS`]; otherwise an error naming

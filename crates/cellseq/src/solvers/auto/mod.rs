@@ -190,11 +190,10 @@ fn share(b: Budget, used_evals: u64, used_s: f64, frac: f64) -> Budget {
     Budget {
         time_limit: b
             .time_limit
-            .map(|t| Duration::from_secs_f64((t.as_secs_f64() - used_s).max(0.0) * frac)),
-        max_evals: b
-            .max_evals
-            .map(|m| ((m.saturating_sub(used_evals)) as f64 * frac) as u64),
+            .map(|t| Duration::from_secs_f64((t.as_secs_f64() - used_s).max(0.0))),
+        max_evals: b.max_evals.map(|m| m.saturating_sub(used_evals)),
     }
+    .scaled(frac)
 }
 
 /// One phase as it runs: what [`Phase`] says, resolved against the run so far.

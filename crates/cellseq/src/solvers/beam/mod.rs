@@ -370,7 +370,7 @@ impl Beam {
         // the soft share of it, but for the widest (`Beam::soft`)
         let full = ctx.budget;
         if self.soft < 1.0 {
-            ctx.budget = scaled(full, self.soft);
+            ctx.budget = full.scaled(self.soft);
         }
         let proven = self.widen::<W>(ctx, (&t, qp.as_ref()), full, &mut best, &mut root_lb);
         ctx.budget = full;
@@ -493,11 +493,13 @@ impl Beam {
                 None => return false,
             };
             if self.soft < 1.0 {
-                // the widest bounded pass: the one the unbounded pass follows
+                // the widest bounded pass: the one the unbounded pass follows (so both it and
+                // the pass before it are bounded); its work is predicted from that pass's by
+                // the width ratio (a pass's work grows about linearly in its width)
                 let mut after = resume;
                 let widest = next != usize::MAX
                     && self.next_width::<W>(next, &mut after, m.n()) == Some(usize::MAX)
-                    && fits(ctx, full, spent, growth_between(width, next, self.growth));
+                    && fits(ctx, full, spent, next as f64 / width as f64);
                 ctx.budget = if widest { full } else { soft };
                 if ctx.exhausted() {
                     return false;
@@ -563,24 +565,6 @@ impl Beam {
     }
 }
 
-/// How many times the pass of width `next` is predicted to cost the pass of `width`: the
-/// width ratio (the work of a pass grows about linearly in its width), `growth` when either
-/// is the unbounded pass (`usize::MAX`).
-fn growth_between(width: usize, next: usize, growth: usize) -> f64 {
-    if width == usize::MAX || next == usize::MAX {
-        growth as f64
-    } else {
-        next as f64 / width.max(1) as f64
-    }
-}
-
-/// `b` scaled by `frac` (time and evaluations).
-fn scaled(b: Budget, frac: f64) -> Budget {
-    Budget {
-        time_limit: b.time_limit.map(|t| t.mul_f64(frac)),
-        max_evals: b.max_evals.map(|e| (e as f64 * frac) as u64),
-    }
-}
 
 /// Whether a pass predicted to cost `factor` times `spent` (seconds, evaluations) of the pass
 /// before fits in what is left of `budget` on `ctx`'s clock and count.
