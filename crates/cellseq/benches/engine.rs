@@ -3,8 +3,8 @@
 //! symmetric matrix with precedence, the two-way SOP-3-exchange descent on a symmetric matrix
 //! with sparse precedence, one SA chain, one tabu iteration, one ant construction; `atsp` to
 //! its branch-and-bound proof on a 300-cell random matrix with costs 0–100; 50 subgradient steps
-//! of the position-indexed path bound on a 100-cell symmetric matrix, and the beam to width 256
-//! there; `ils` for 10^7 evaluations on a dense 340-cell `time-window` instance.
+//! of the position-indexed path bound on a 100-cell symmetric matrix, and the beam to widths 256
+//! and 4096 there; `ils` for 10^7 evaluations on a dense 340-cell `time-window` instance.
 
 use cellseq::bound::cells::CellGraph;
 use cellseq::bound::qpath::QPath;
@@ -313,6 +313,16 @@ fn benches(cr: &mut Criterion) {
     g.bench_function("beam to width 256 (symmetric n = 98)", |b| {
         b.iter(|| {
             let r = run_to_end("beam", &sym, &narrow, 1_000_000_000_000);
+            black_box(r.report.cost)
+        })
+    });
+    // the same up to width 4096: wide levels, where each cell's list of parents, the
+    // children's bounds and the dominance map take most of the time (the `symmetric` rule's
+    // stretched widest pass at 10 s is 16384 wide)
+    let wide = strings(&[("max_width", "4096"), ("warm_evals", "100000")]);
+    g.bench_function("beam to width 4096 (symmetric n = 98)", |b| {
+        b.iter(|| {
+            let r = run_to_end("beam", &sym, &wide, 1_000_000_000_000);
             black_box(r.report.cost)
         })
     });

@@ -3,13 +3,14 @@
 //! sequence read back from the trail.
 
 use super::Beam;
-use super::prefix::{Prefix, first_prefixes, keep_best, rank};
+use super::prefix::{Prefix, first_prefixes, keep_best, open_cells, rank};
 use super::refine::refined;
 use super::tables::Tables;
 use crate::bound::qpath::QPath;
 use crate::context::Context;
 use crate::model::{Sequence, Visit};
 use rustc_hash::FxHashMap;
+use std::collections::hash_map::Entry;
 
 /// Evaluations charged per generated child (and per refined candidate): a child copies a
 /// prefix, computes its bound and probes the dominance map, which takes about as long as 8
@@ -196,7 +197,8 @@ impl<const W: usize> Level<'_, W> {
     ) -> Result<ParentLists, Pass> {
         let (m, t) = (ctx.model, self.t);
         let mut acts: Vec<f64> = Vec::with_capacity(prev.len());
-        let mut by_cell: Vec<Vec<u32>> = vec![Vec::new(); m.n()];
+        let n = m.n();
+        let mut by_cell: Vec<Vec<u32>> = vec![Vec::new(); n];
         let mut listed = 0usize;
         for (pi, p) in prev.iter().enumerate() {
             if pi % 4096 == 4095 {
@@ -211,16 +213,13 @@ impl<const W: usize> Level<'_, W> {
             let a = m.cell_mode(p.node as usize).0;
             // every child leaves the same sets: the parent's, less those that `a` closes
             acts.push(p.act - t.closing_mu(&p.bits, a));
-            for (v, list) in by_cell.iter_mut().enumerate() {
-                if p.bits[v / 64] >> (v % 64) & 1 == 1 {
-                    continue;
-                }
+            for v in open_cells(&p.bits, n) {
                 let ready = t.pred_mask[v]
                     .iter()
                     .zip(p.bits.iter())
                     .all(|(need, have)| need & !have == 0);
                 if ready {
-                    list.push(pi as u32);
+                    by_cell[v].push(pi as u32);
                     listed += 1;
                 }
             }
@@ -288,15 +287,16 @@ impl<const W: usize> Level<'_, W> {
                     if c.f > self.cut {
                         continue;
                     }
-                    match index.get(&(bits, c.node)) {
-                        Some(&i) => {
-                            let e = &mut cands[i as usize];
+                    // one hash per child: the entry is looked up and filled in place
+                    match index.entry((bits, c.node)) {
+                        Entry::Occupied(o) => {
+                            let e = &mut cands[*o.get() as usize];
                             if c.g < e.g {
                                 *e = c;
                             }
                         }
-                        None => {
-                            index.insert((bits, c.node), cands.len() as u32);
+                        Entry::Vacant(slot) => {
+                            slot.insert(cands.len() as u32);
                             cands.push(c);
                         }
                     }

@@ -43,6 +43,24 @@ impl<const W: usize> Prefix<W> {
     }
 }
 
+/// The cells below `n` that are not in the set `bits`, in increasing order (a word of the
+/// set at a time: the visited cells cost nothing to skip).
+#[inline]
+pub(super) fn open_cells<const W: usize>(bits: &[u64; W], n: usize) -> impl Iterator<Item = usize> + '_ {
+    bits.iter().enumerate().flat_map(move |(w, &have)| {
+        let below = n.saturating_sub(w * 64);
+        let valid = if below >= 64 { u64::MAX } else { (1u64 << below) - 1 };
+        let mut open = !have & valid;
+        std::iter::from_fn(move || {
+            (open != 0).then(|| {
+                let b = open.trailing_zeros() as usize;
+                open &= open - 1;
+                w * 64 + b
+            })
+        })
+    })
+}
+
 /// Every one-cell prefix: each cell that may come first (no predecessor, twins included), in
 /// each mode; `lam_total` = Σ qpath multipliers, `lam(c)` the multiplier of cell `c`.
 pub(super) fn first_prefixes<const W: usize>(

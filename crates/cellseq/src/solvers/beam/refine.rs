@@ -1,7 +1,7 @@
 //! The refined node bound of one prefix (degree sums over the arcs still possible, cluster
 //! surcharges, subtour-elimination multipliers), and the bounds built on it.
 
-use super::prefix::{Prefix, first_prefixes};
+use super::prefix::{Prefix, first_prefixes, open_cells};
 use super::tables::Tables;
 use crate::cost::CostModel;
 
@@ -83,10 +83,7 @@ fn degree_sums<const W: usize>(
     let mut home_in = f64::INFINITY;
     let mut last_out = f64::INFINITY;
     let mut any = false;
-    for j in 0..n {
-        if !view.open(j) {
-            continue;
-        }
+    for j in open_cells(&view.p.bits, n) {
         any = true;
         pot += t.u[j] + t.v[j];
         let Some(i) = t.in_list[j]
