@@ -106,3 +106,28 @@ pub(super) fn keep_best<const W: usize>(
     c.truncate(width);
     true
 }
+
+#[cfg(test)]
+mod tests {
+    use super::open_cells;
+    use rand::{RngExt, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+
+    #[test]
+    fn open_cells_are_the_cells_below_n_not_in_the_set_in_order() {
+        let mut rng = ChaCha8Rng::seed_from_u64(7);
+        for n in [0, 1, 5, 63, 64, 65, 100, 127, 128] {
+            for _ in 0..50 {
+                let mut bits = [0u64; 2];
+                for v in 0..n {
+                    if rng.random_bool(0.5) {
+                        bits[v / 64] |= 1 << (v % 64);
+                    }
+                }
+                let want: Vec<usize> =
+                    (0..n).filter(|&v| bits[v / 64] >> (v % 64) & 1 == 0).collect();
+                assert_eq!(open_cells(&bits, n).collect::<Vec<_>>(), want, "n = {n}");
+            }
+        }
+    }
+}
