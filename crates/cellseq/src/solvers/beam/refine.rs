@@ -199,12 +199,10 @@ fn cluster_links<const W: usize>(
     };
     let mut max_in = home_in;
     let mut max_out = last_out;
-    for j in 0..n {
-        if view.open(j) {
-            let d = open_d(j);
-            max_in = max_in.max(io[j].0 + d.0);
-            max_out = max_out.max(io[j].1 + d.1);
-        }
+    for j in open_cells(&view.p.bits, n) {
+        let d = open_d(j);
+        max_in = max_in.max(io[j].0 + d.0);
+        max_out = max_out.max(io[j].1 + d.1);
     }
     for (s, cells) in t.clusters.iter().enumerate() {
         if dd[s].0.is_nan() {
