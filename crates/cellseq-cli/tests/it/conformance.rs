@@ -135,7 +135,8 @@ fn conforms_with(name: &str, params: &[(&str, &str)]) {
     assert!(f.is_empty(), "{} failures:\n{}", f.len(), f.join("\n"));
 }
 
-/// `ils` with several walks (their scattered starts, the turns and the per-walk records) and
+/// `ils` with several walks (their scattered starts, the turns, the per-walk records and the
+/// walks dropped by halves) and
 /// with a set SOP-3-exchange block length:
 /// the same checks as every solver's defaults.
 #[test]
@@ -144,6 +145,11 @@ fn ils_with_walks_conforms() {
     conforms_with(
         "ils",
         &[("walks", "4"), ("perturb", "swap"), ("accept", "0.01")],
+    );
+    // walks dropped by halves as the budget goes (the `symmetric` rule's setting)
+    conforms_with(
+        "ils",
+        &[("walks", "8"), ("halve", "0.15"), ("accept", "0.01")],
     );
     // a short SOP-3-exchange block, and a huge one (capped to the path)
     conforms_with("ils", &[("max-block", "3")]);

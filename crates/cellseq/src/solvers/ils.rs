@@ -12,8 +12,10 @@
 //! polish of a new best also run Lin–Kernighan chains of feasible reversals
 //! ([`crate::engine::lk`]). Without a budget it stops after `stall` kicks without a new
 //! best. With `walks` > 1 several such walks take kicks in turn, each in the band above its
-//! own record, and every repaired kick is crossed with the best of all walks (not in the
-//! built-in portfolio: notes/lab/ils-walks.md).
+//! own record, and every repaired kick is crossed with the best of all walks
+//! (notes/lab/ils-walks.md). With `halve` the worse half of the walks is dropped each time
+//! that share of the budget is used, down to one: the `symmetric` rule's plan without a beam
+//! runs eight walks so (notes/lab/halved-walks.md).
 
 use super::Build;
 use super::StartsFrom;
@@ -178,6 +180,12 @@ are re-chosen); `window-repair=true` runs them in every repair as well.",
             help: "record-to-record walks kicked in turn, each in its own band above its own record and restarted from its own record; every repaired kick is crossed with the best of all walks, so walks in different basins exchange segments (walks after the first start from the first's local optimum scattered by random feasible reorders over the whole path; at most 64, more count as 64)",
         },
         ParamSpec {
+            name: "halve",
+            default: "0",
+            kind: ParamKind::float(0.0, 0.5),
+            help: "with walks > 1: each time this share of the budget is used (of the evaluation budget when one is set, else of the time limit), the walks with the worse records are dropped, half at a time, down to one; early records pick the basin the rest of the budget deepens (0: every walk runs to the end)",
+        },
+        ParamSpec {
             name: "stall",
             default: "20000",
             kind: ParamKind::int(1, crate::params::MAX_ITERATIONS),
@@ -190,6 +198,21 @@ are re-chosen); `window-repair=true` runs them in every repair as well.",
     },
     build: Build::StartsFrom(|p: &Params| Ok(Box::new(from_params(p)))),
 };
+
+/// Kicks between two looks at whether walks are to be dropped (`halve`).
+const HALVE_EVERY: u64 = 16;
+
+/// The share of the budget used: of the evaluation budget when one is set (so that a run
+/// under an evaluation budget stays deterministic), else of the time limit, else none.
+fn used_share(ctx: &Context) -> f64 {
+    if let Some(m) = ctx.budget.max_evals {
+        ctx.evaluations() as f64 / m.max(1) as f64
+    } else if let Some(t) = ctx.budget.time_limit {
+        ctx.elapsed() / t.as_secs_f64().max(1e-9)
+    } else {
+        0.0
+    }
+}
 
 /// Most walks kept at once (each holds two solutions, so memory stays bounded).
 const MAX_WALKS: u64 = 64;
@@ -222,6 +245,7 @@ pub fn from_params(p: &Params) -> Ils {
         window_repair: p.bool("window-repair"),
         shift_repair: p.int("shift-repair") as usize,
         walks: p.int("walks") as usize,
+        halve: p.float("halve"),
     }
 }
 
@@ -269,6 +293,8 @@ pub struct Ils {
     pub shift_repair: usize,
     /// Record-to-record walks kicked in turn.
     pub walks: usize,
+    /// Share of the budget after which the worse half of the walks is dropped (0: never).
+    pub halve: f64,
 }
 
 /// One record-to-record walk of [`Ils`]: its current solution, its record and the kicks since
@@ -499,6 +525,9 @@ impl Ils {
             if !bounded && since_best >= self.stall {
                 break;
             }
+            if kicks_done.is_multiple_of(HALVE_EVERY) {
+                self.drop_walks(ctx, &mut walks);
+            }
             let at = (kicks_done % walks.len() as u64) as usize;
             let walk = &mut walks[at];
             trial.clone_from(&walk.cur);
@@ -585,6 +614,21 @@ impl Ils {
             );
         }
         Ok(outcome(m, &best))
+    }
+
+    /// With `halve` > 0, keeps the `walks >> stage` walks of the best records, where `stage`
+    /// counts the shares of `halve` of the budget used so far ([`used_share`]).
+    fn drop_walks(&self, ctx: &Context, walks: &mut Vec<Walk>) {
+        if self.halve <= 0.0 || walks.len() <= 1 {
+            return;
+        }
+        let stage = (used_share(ctx) / self.halve).floor().min(63.0) as u32;
+        let keep = (self.walks >> stage).max(1);
+        if keep < walks.len() {
+            // stable: among equal records the walk started first stays
+            walks.sort_by(|a, b| a.record.cost.total_cmp(&b.record.cost));
+            walks.truncate(keep);
+        }
     }
 
     /// The search engine and Lin–Kernighan (when it runs) with this solver's settings, and
@@ -685,5 +729,87 @@ impl Ils {
             }
         }
         gains
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::context::NoObserver;
+    use crate::cost::CostModel;
+    use crate::engine::atsp::random_matrix_instance;
+    use crate::model::Objective;
+    use crate::solvers::Budget;
+    use crate::solvers::start::greedy_solution;
+
+    /// `halve`: the walks are dropped half at a time, at each share of the evaluation budget,
+    /// down to one, keeping the best records (the first among equals), and never without it.
+    #[test]
+    fn halve_keeps_the_best_records_half_at_a_time() {
+        let inst = random_matrix_instance(12, 5, 100, &[]);
+        let m = CostModel::new(&inst, Objective::Matrix);
+        let budget = Budget {
+            time_limit: None,
+            max_evals: Some(1000),
+        };
+        let mut obs = NoObserver;
+        let mut ctx = Context::new(&inst, &m, 1, budget, &mut obs);
+        let s = greedy_solution(&mut ctx, &Costs::open(&m));
+        // records 7, 6, …, 0 with two walks at 3: walk i has record cost 7 - i (i = 3, 4 tie)
+        let costs = [7.0, 6.0, 5.0, 3.0, 3.0, 2.0, 1.0, 0.0];
+        let fresh = || -> Vec<Walk> {
+            costs
+                .iter()
+                .map(|&k| {
+                    let mut r = s.clone();
+                    r.cost = k;
+                    Walk {
+                        cur: r.clone(),
+                        record: r,
+                        since: 0,
+                    }
+                })
+                .collect()
+        };
+        let ils = |halve: f64| Ils {
+            halve,
+            walks: costs.len(),
+            ..from_params(&INFO.check_params(&Default::default()).unwrap())
+        };
+        let records = |w: &[Walk]| w.iter().map(|w| w.record.cost).collect::<Vec<_>>();
+        let mut walks = fresh();
+        // nothing used yet: all eight stay
+        ils(0.15).drop_walks(&ctx, &mut walks);
+        assert_eq!(walks.len(), 8);
+        // 0.15 of the budget used: the best four
+        ctx.count(150);
+        ils(0.15).drop_walks(&ctx, &mut walks);
+        assert_eq!(records(&walks), [0.0, 1.0, 2.0, 3.0]);
+        // 0.30: two; 0.45: one, the best; later shares keep that one
+        ctx.count(150);
+        ils(0.15).drop_walks(&ctx, &mut walks);
+        assert_eq!(records(&walks), [0.0, 1.0]);
+        ctx.count(150);
+        ils(0.15).drop_walks(&ctx, &mut walks);
+        assert_eq!(records(&walks), [0.0]);
+        ctx.count(500);
+        ils(0.15).drop_walks(&ctx, &mut walks);
+        assert_eq!(records(&walks), [0.0]);
+        // halve = 0 never drops a walk, however much is used
+        let mut walks = fresh();
+        ils(0.0).drop_walks(&ctx, &mut walks);
+        assert_eq!(walks.len(), 8);
+        // among equal records the earlier walk stays: at 0.45 of a budget with halve = 0.2
+        // (stage 2: two walks) from the records 3, 3, 7 the two walks of cost 3 stay in order
+        let mut walks = fresh();
+        walks.retain(|w| w.record.cost == 3.0 || w.record.cost == 7.0);
+        for (i, w) in walks.iter_mut().enumerate() {
+            w.since = i as u64;
+        }
+        let mut obs = NoObserver;
+        let mut ctx = Context::new(&inst, &m, 1, budget, &mut obs);
+        ctx.count(450);
+        ils(0.2).drop_walks(&ctx, &mut walks);
+        assert_eq!(walks.iter().map(|w| w.since).collect::<Vec<_>>(), [1, 2]);
     }
 }
