@@ -183,7 +183,7 @@ fn auto_picks_its_rule_by_symmetry_and_precedence_density() {
     assert!(c.features.symmetric && !c.features.geometric);
     assert_eq!(
         plan_text(c.plan(false)),
-        "local-search:0.1,ils[accept=0.01]*:1"
+        "local-search:0.1,ils[accept=0.01;halve=0.15;walks=8]*:1"
     );
     assert_eq!(plan_text(c.plan(true)), "ils[accept=0.01]*:1");
     assert_eq!(c.beam.share, 0.3);
@@ -254,6 +254,19 @@ fn auto_picks_its_rule_by_symmetry_and_precedence_density() {
     assert_eq!(c.rule, "default");
     assert!(c.features.geometric && c.features.free_density > 0.001);
     assert_eq!(plan_text(c.plan(true)), "local-search:0.3,eacs:0.5,ils*:1");
+    // a symmetric matrix of one mode per cell above the beam's 400 cells: `ils` alone, with
+    // the halved walks, and no beam phase; at 400 cells the `symmetric` rule
+    for (n, rule) in [("398", "symmetric"), ("399", "symmetric-large")] {
+        let c = a.choose(&generated("symmetric", &[("n", n), ("p", "1")], 1));
+        assert_eq!(c.rule, rule, "{n} cells and the two ends");
+    }
+    let c = a.choose(&generated("symmetric", &[("n", "450"), ("p", "1")], 1));
+    assert_eq!((c.rule, c.beam.share), ("symmetric-large", 0.0));
+    assert!(c.features.symmetric && c.features.modes == 1.0);
+    assert_eq!(
+        plan_text(c.plan(false)),
+        "ils[accept=0.01;halve=0.15;walks=8]:1"
+    );
     // a symmetric matrix with several modes per cell keeps the colony in its plan
     let c = a.choose(&generated("generalized", &[("n", "30"), ("modes", "3")], 1));
     assert_eq!((c.rule, c.beam.share), ("symmetric-modes", 0.3));
@@ -353,6 +366,7 @@ fn the_built_in_portfolio_parses_validates_and_ends_with_a_catch_all() {
     assert_eq!(
         names,
         [
+            "symmetric-large",
             "symmetric",
             "symmetric-modes",
             "free",
