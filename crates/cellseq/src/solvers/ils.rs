@@ -183,7 +183,7 @@ are re-chosen); `window-repair=true` runs them in every repair as well.",
             name: "halve",
             default: "0",
             kind: ParamKind::float(0.0, 0.5),
-            help: "with walks > 1: each time this share of the budget is used (of the evaluation budget when one is set, else of the time limit), the walks with the worse records are dropped, half at a time, down to one; early records pick the basin the rest of the budget deepens (0: every walk runs to the end)",
+            help: "with walks > 1: each time this share of the budget is used (of the evaluation budget when one is set, else of the time limit; without either none is dropped), the walks with the worse records are dropped, half at a time, down to one; early records pick the basin the rest of the budget deepens (0: every walk runs to the end)",
         },
         ParamSpec {
             name: "stall",
