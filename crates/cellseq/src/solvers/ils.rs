@@ -15,7 +15,9 @@
 //! own record, and every repaired kick is crossed with the best of all walks
 //! (notes/lab/ils-walks.md). With `halve` the worse half of the walks is dropped each time
 //! that share of the budget is used, down to one: the `symmetric` rule's plan without a beam
-//! runs eight walks so (notes/lab/halved-walks.md).
+//! runs eight walks so (notes/lab/halved-walks.md). Walks then start only within the first
+//! such share: on 1500 cells eight starts took a whole 10 s budget
+//! (notes/lab/large-symmetric-kicks.md).
 
 use super::Build;
 use super::StartsFrom;
@@ -177,13 +179,13 @@ are re-chosen); `window-repair=true` runs them in every repair as well.",
             name: "walks",
             default: "1",
             kind: ParamKind::int(1, MAX_WALKS),
-            help: "record-to-record walks kicked in turn, each in its own band above its own record and restarted from its own record; every repaired kick is crossed with the best of all walks, so walks in different basins exchange segments (walks after the first start from the first's local optimum scattered by random feasible reorders over the whole path; at most 64, more count as 64)",
+            help: "record-to-record walks kicked in turn, each in its own band above its own record and restarted from its own record; every repaired kick is crossed with the best of all walks, so walks in different basins exchange segments (walks after the first start from the first's local optimum scattered by random feasible reorders over the whole path, with halve > 0 only while its first share of the budget lasts; at most 64, more count as 64)",
         },
         ParamSpec {
             name: "halve",
             default: "0",
             kind: ParamKind::float(0.0, 0.5),
-            help: "with walks > 1: each time this share of the budget is used (of the evaluation budget when one is set, else of the time limit; without either none is dropped), the walks with the worse records are dropped, half at a time, down to one; early records pick the basin the rest of the budget deepens (0: every walk runs to the end)",
+            help: "with walks > 1: each time this share of the budget is used (of the evaluation budget when one is set, else of the time limit; without either none is dropped), the walks with the worse records are dropped, half at a time, down to one; early records pick the basin the rest of the budget deepens; no walk starts after the first such share, so on large instances, where a walk's start takes seconds, the rest is left to the kicks (0: every walk runs to the end)",
         },
         ParamSpec {
             name: "stall",
@@ -497,7 +499,7 @@ impl Ils {
             cur,
             since: 0,
         }];
-        while walks.len() < self.walks && !ctx.exhausted() {
+        while self.may_start_walk(ctx, walks.len()) {
             let mut s = walks[0].record.clone();
             self.scatter(ctx, (&mut search, lk.as_mut()), &mut s, &mut rng, max_seg);
             if cheaper(s.cost, best.cost) {
@@ -509,6 +511,9 @@ impl Ils {
                 cur: s,
                 since: 0,
             });
+        }
+        if super::trace_enabled() && self.walks > 1 {
+            eprintln!("ils: {} walks started, {:.2} s", walks.len(), ctx.elapsed());
         }
         let mut ruin = Ruin::new(self.ruin_size, self.ruin_string, 0.01);
         let mut w = TwoWay::default();
@@ -614,6 +619,15 @@ impl Ils {
             );
         }
         Ok(outcome(m, &best))
+    }
+
+    /// Whether another walk may start, `started` being under way: fewer than `walks`, budget
+    /// left, and with `halve` > 0 only within its first share of the budget (on large
+    /// instances, where a walk's descent takes seconds, the rest is left to the kicks).
+    fn may_start_walk(&self, ctx: &Context, started: usize) -> bool {
+        started < self.walks
+            && !ctx.exhausted()
+            && (self.halve <= 0.0 || used_share(ctx) < self.halve)
     }
 
     /// With `halve` > 0, keeps the `walks >> stage` walks of the best records, where `stage`
@@ -811,5 +825,34 @@ mod tests {
         ctx.count(450);
         ils(0.2).drop_walks(&ctx, &mut walks);
         assert_eq!(walks.iter().map(|w| w.since).collect::<Vec<_>>(), [1, 2]);
+    }
+
+    /// Walks start while fewer than `walks` are under way and, with `halve`, only within its
+    /// first share of the budget; without `halve` the share used does not matter.
+    #[test]
+    fn walks_start_only_within_the_first_share() {
+        let inst = random_matrix_instance(12, 5, 100, &[]);
+        let m = CostModel::new(&inst, Objective::Matrix);
+        let budget = Budget {
+            time_limit: None,
+            max_evals: Some(1000),
+        };
+        let mut obs = NoObserver;
+        let mut ctx = Context::new(&inst, &m, 1, budget, &mut obs);
+        let ils = |halve: f64| Ils {
+            halve,
+            walks: 8,
+            ..from_params(&INFO.check_params(&Default::default()).unwrap())
+        };
+        assert!(ils(0.15).may_start_walk(&ctx, 1));
+        assert!(!ils(0.15).may_start_walk(&ctx, 8));
+        ctx.count(149);
+        assert!(ils(0.15).may_start_walk(&ctx, 7));
+        ctx.count(1);
+        assert!(!ils(0.15).may_start_walk(&ctx, 1));
+        assert!(ils(0.0).may_start_walk(&ctx, 7));
+        assert!(!ils(0.0).may_start_walk(&ctx, 8));
+        ctx.count(850);
+        assert!(!ils(0.0).may_start_walk(&ctx, 1), "the budget is spent");
     }
 }
