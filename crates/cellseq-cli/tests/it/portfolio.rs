@@ -265,8 +265,19 @@ fn auto_picks_its_rule_by_symmetry_and_precedence_density() {
     assert!(c.features.symmetric && c.features.modes == 1.0);
     assert_eq!(
         plan_text(c.plan(false)),
+        "ils[accept=0.01;halve=0.15;max-seg=10;walks=8]:1"
+    );
+    // with dense precedence (closure density 0.2 and above) the kicks keep their longer
+    // windows
+    let c = a.choose(&generated("compiler-dag", &[("n", "450")], 1));
+    assert!(c.features.closure_density >= 0.2);
+    assert_eq!((c.rule, c.beam.share), ("symmetric-large-dense", 0.0));
+    assert_eq!(
+        plan_text(c.plan(false)),
         "ils[accept=0.01;halve=0.15;walks=8]:1"
     );
+    let c = a.choose(&generated("symmetric", &[("n", "450"), ("p", "30")], 1));
+    assert_eq!(c.rule, "symmetric-large-dense");
     // a symmetric matrix with several modes per cell keeps the colony in its plan
     let c = a.choose(&generated("generalized", &[("n", "30"), ("modes", "3")], 1));
     assert_eq!((c.rule, c.beam.share), ("symmetric-modes", 0.3));
@@ -367,6 +378,7 @@ fn the_built_in_portfolio_parses_validates_and_ends_with_a_catch_all() {
         names,
         [
             "symmetric-large",
+            "symmetric-large-dense",
             "symmetric",
             "symmetric-modes",
             "free",

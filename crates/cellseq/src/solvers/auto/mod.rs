@@ -69,7 +69,9 @@ its `max_cells` cells and, under a wall-clock budget, only when that budget is a
 built-in rules: **symmetric** cost matrices with one mode per cell (a short `local-search`, \
 then `ils` with Lin–Kernighan chains in a 1 % acceptance band, eight walks of which the worse \
 half is dropped at 15, 30 and 45 % of its budget, or one walk from the beam's sequence when \
-the beam ran; above 400 cells **symmetric-large**, that `ils` alone without the local search) \
+the beam ran; above 400 cells **symmetric-large**, that `ils` alone without the local search, \
+its kicks reordering at most 10 cells under sparse precedence, and **symmetric-large-dense**, \
+with the longer kicks, from closure density 0.2) \
 and **symmetric-modes**, several modes per cell (a colony before `ils`); \
 **free** asymmetric matrices with no precedence apart from a fixed start and end (`atsp`); \
 **sparse** precedence (a short `local-search`, a colony run backwards, `ils` in a 1 % then a 3 \
