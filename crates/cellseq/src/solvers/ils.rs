@@ -752,22 +752,39 @@ mod tests {
     use crate::context::NoObserver;
     use crate::cost::CostModel;
     use crate::engine::atsp::random_matrix_instance;
-    use crate::model::Objective;
+    use crate::model::{Instance, Objective};
     use crate::solvers::Budget;
     use crate::solvers::start::greedy_solution;
+
+    /// A 12-cell random matrix instance and its model, for the walk tests.
+    fn small() -> (Instance, CostModel) {
+        let inst = random_matrix_instance(12, 5, 100, &[]);
+        let m = CostModel::new(&inst, Objective::Matrix);
+        (inst, m)
+    }
+
+    /// An evaluation budget whose shares the tests count out exactly.
+    const THOUSAND: Budget = Budget {
+        time_limit: None,
+        max_evals: Some(1000),
+    };
+
+    /// The default `ils` with `walks` walks and `halve`.
+    fn walker(walks: usize, halve: f64) -> Ils {
+        Ils {
+            halve,
+            walks,
+            ..from_params(&INFO.check_params(&Default::default()).unwrap())
+        }
+    }
 
     /// `halve`: the walks are dropped half at a time, at each share of the evaluation budget,
     /// down to one, keeping the best records (the first among equals), and never without it.
     #[test]
     fn halve_keeps_the_best_records_half_at_a_time() {
-        let inst = random_matrix_instance(12, 5, 100, &[]);
-        let m = CostModel::new(&inst, Objective::Matrix);
-        let budget = Budget {
-            time_limit: None,
-            max_evals: Some(1000),
-        };
+        let (inst, m) = small();
         let mut obs = NoObserver;
-        let mut ctx = Context::new(&inst, &m, 1, budget, &mut obs);
+        let mut ctx = Context::new(&inst, &m, 1, THOUSAND, &mut obs);
         let s = greedy_solution(&mut ctx, &Costs::open(&m));
         // records 7, 6, …, 0 with two walks at 3: walk i has record cost 7 - i (i = 3, 4 tie)
         let costs = [7.0, 6.0, 5.0, 3.0, 3.0, 2.0, 1.0, 0.0];
@@ -785,11 +802,7 @@ mod tests {
                 })
                 .collect()
         };
-        let ils = |halve: f64| Ils {
-            halve,
-            walks: costs.len(),
-            ..from_params(&INFO.check_params(&Default::default()).unwrap())
-        };
+        let ils = |halve: f64| walker(costs.len(), halve);
         let records = |w: &[Walk]| w.iter().map(|w| w.record.cost).collect::<Vec<_>>();
         let mut walks = fresh();
         // nothing used yet: all eight stay
@@ -821,7 +834,7 @@ mod tests {
             w.since = i as u64;
         }
         let mut obs = NoObserver;
-        let mut ctx = Context::new(&inst, &m, 1, budget, &mut obs);
+        let mut ctx = Context::new(&inst, &m, 1, THOUSAND, &mut obs);
         ctx.count(450);
         ils(0.2).drop_walks(&ctx, &mut walks);
         assert_eq!(walks.iter().map(|w| w.since).collect::<Vec<_>>(), [1, 2]);
@@ -831,19 +844,10 @@ mod tests {
     /// first share of the budget; without `halve` the share used does not matter.
     #[test]
     fn walks_start_only_within_the_first_share() {
-        let inst = random_matrix_instance(12, 5, 100, &[]);
-        let m = CostModel::new(&inst, Objective::Matrix);
-        let budget = Budget {
-            time_limit: None,
-            max_evals: Some(1000),
-        };
+        let (inst, m) = small();
         let mut obs = NoObserver;
-        let mut ctx = Context::new(&inst, &m, 1, budget, &mut obs);
-        let ils = |halve: f64| Ils {
-            halve,
-            walks: 8,
-            ..from_params(&INFO.check_params(&Default::default()).unwrap())
-        };
+        let mut ctx = Context::new(&inst, &m, 1, THOUSAND, &mut obs);
+        let ils = |halve: f64| walker(8, halve);
         assert!(ils(0.15).may_start_walk(&ctx, 1));
         assert!(!ils(0.15).may_start_walk(&ctx, 8));
         ctx.count(149);
