@@ -15,6 +15,7 @@ use crate::clock::Ticker;
 use crate::error::{Error, Result};
 use crate::model::Visit;
 use rustc_hash::FxHashMap;
+use std::time::Instant;
 
 /// Registry entry.
 pub static INFO: SolverInfo = SolverInfo {
@@ -91,6 +92,7 @@ impl Solver for Exact {
             levels: Vec::with_capacity(n),
             pred_mask,
             sort_per_key: 0.0,
+            grow_per_key: 0.0,
         };
         let mut first = Level::default();
         let mut ideals = 0u64;
@@ -141,6 +143,22 @@ fn out_of_budget(k: usize, n: usize) -> Error {
     ))
 }
 
+/// Doubles the capacity of level `k`'s full table `next`, unless the time left would not cover
+/// the rehash, estimated at twice the last growth's time per state (`per_key`, updated here):
+/// the cost per state rises as the table outgrows the caches.
+fn grow(ctx: &Context, next: &mut Level, k: usize, per_key: &mut f64) -> Result<()> {
+    let len = next.len();
+    if let Some(left) = ctx.deadline().remaining()
+        && left.as_secs_f64() < 2.0 * *per_key * len as f64
+    {
+        return Err(out_of_budget(k, ctx.model.n()));
+    }
+    let growing = Instant::now();
+    next.reserve(len.max(16));
+    *per_key = growing.elapsed().as_secs_f64() / len.max(1) as f64;
+    Ok(())
+}
+
 /// The DP's tables and memory account.
 struct Dp {
     limit: u64,
@@ -151,6 +169,9 @@ struct Dp {
     /// Seconds per state of the last level's sort: the next sort is not started when the
     /// time left would not cover it (a sort cannot stop halfway; a level holds millions).
     sort_per_key: f64,
+    /// Seconds per state of the last growth of a level's table: the same for the next growth
+    /// (a rehash of every state, which cannot stop halfway either).
+    grow_per_key: f64,
 }
 
 impl Dp {
@@ -167,7 +188,7 @@ impl Dp {
         {
             return Err(out_of_budget(k, n));
         }
-        let sorting = std::time::Instant::now();
+        let sorting = Instant::now();
         let mut keys: Vec<Key> = prev.keys().copied().collect();
         keys.sort_unstable();
         self.sort_per_key = sorting.elapsed().as_secs_f64() / keys.len().max(1) as f64;
@@ -212,6 +233,9 @@ impl Dp {
                             }
                         }
                         None => {
+                            if next.len() == next.capacity() {
+                                grow(ctx, &mut next, k, &mut self.grow_per_key)?;
+                            }
                             self.used += BYTES_PER_STATE;
                             next.insert(key, (best.1, best.0));
                         }
