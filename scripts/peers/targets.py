@@ -96,7 +96,7 @@ def table(groups):
     for (name, limit), inst in groups.items():
         at, gaps, loads, seeds = 0, [], [], set()
         for instance, runs in inst.items():
-            loads += [r["loadavg"] for r in runs]
+            loads += [r["loadavg"] for r in runs if r.get("loadavg") is not None]
             seeds |= {r["seed"] for r in runs}
             best = runs[0].get("best_known")
             if best is None:

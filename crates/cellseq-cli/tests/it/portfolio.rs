@@ -194,8 +194,9 @@ fn auto_picks_its_rule_by_symmetry_and_precedence_density() {
     for after_beam in [false, true] {
         assert_eq!(
             plan_text(c.plan(after_beam)),
-            "local-search:0.1,~eacs:0.2,ils[accept=0.01;shift-repair=2]*:0.25,\
-             ils[accept=0.03;shift-repair=2]*:0.85,reopt[window=16]*:1"
+            "local-search:0.1,~eacs:0.2,\
+             ils[accept=0.01;kicks=2;perturb=swap;shift-repair=2]*:0.25,\
+             ils[accept=0.03;kicks=2;perturb=swap;shift-repair=2]*:0.85,reopt[window=16]*:1"
         );
     }
     // dense instances: ils with longer kicks; after a beam phase (up to 300 cells) a colony

@@ -75,10 +75,11 @@ with the longer kicks, from closure density 0.2) \
 and **symmetric-modes**, several modes per cell (a colony before `ils`); \
 **free** asymmetric matrices with no precedence apart from a fixed start and end (`atsp`); \
 **sparse** precedence (a short `local-search`, a colony run backwards, `ils` in a 1 % then a 3 \
-% acceptance band with the bounded-shift DP ending every repair, window re-optimization of the \
-best), and with several modes per cell on up to 300 cells **sparse-modes** (three rounds of a \
-fresh colony, each polished by `ils` in the 1 % band, then `ils` in the 3 % band from the best \
-of the three and window re-optimization); **dense** precedence (a short `local-search`, then \
+% acceptance band, its kicks two random segment swaps, with the bounded-shift DP ending every \
+repair, window re-optimization of the best), and with several modes per cell on up to 300 \
+cells **sparse-modes** (three rounds of a fresh colony, each polished by `ils` in the 1 % \
+band, then `ils` in the 3 % band from the best of the three and window re-optimization); \
+**dense** precedence (a short `local-search`, then \
 `ils` with kicks that reorder up to 45 cells; on up to 300 cells, when the beam runs, half the \
 budget for the beam, then the default phases); **geometric free** instances (geometric, no or \
 very sparse precedence, links that cost the same both ways: `local-search` on the two-level \
