@@ -179,7 +179,7 @@ are re-chosen); `window-repair=true` runs them in every repair as well.",
             name: "walks",
             default: "1",
             kind: ParamKind::int(1, MAX_WALKS),
-            help: "record-to-record walks kicked in turn, each in its own band above its own record and restarted from its own record; every repaired kick is crossed with the best of all walks, so walks in different basins exchange segments (walks after the first start from the first's local optimum scattered by random feasible reorders over the whole path, with halve > 0 only while its first share of the budget lasts; at most 64, more count as 64)",
+            help: "record-to-record walks kicked in turn, each in its own band above its own record and restarted from its own record; every repaired kick is crossed with the best of all walks, so walks in different basins exchange segments (walks after the first start from the first's local optimum scattered by random feasible reorders over the whole path, only while the first share of the budget lasts: halve's, or half the budget with halve = 0; at most 64, more count as 64)",
         },
         ParamSpec {
             name: "halve",
@@ -215,6 +215,11 @@ fn used_share(ctx: &Context) -> f64 {
         0.0
     }
 }
+
+/// Without `halve`, walks after the first start only within this share of the budget: on
+/// large instances a start (a scatter and a full descent) takes seconds, and the walks need
+/// the rest for their kicks.
+const START_SHARE: f64 = 0.5;
 
 /// Most walks kept at once (each holds two solutions, so memory stays bounded).
 const MAX_WALKS: u64 = 64;
@@ -625,9 +630,12 @@ impl Ils {
     /// left, and with `halve` > 0 only within its first share of the budget (on large
     /// instances, where a walk's descent takes seconds, the rest is left to the kicks).
     fn may_start_walk(&self, ctx: &Context, started: usize) -> bool {
-        started < self.walks
-            && !ctx.exhausted()
-            && (self.halve <= 0.0 || used_share(ctx) < self.halve)
+        let share = if self.halve > 0.0 {
+            self.halve
+        } else {
+            START_SHARE
+        };
+        started < self.walks && !ctx.exhausted() && used_share(ctx) < share
     }
 
     /// With `halve` > 0, keeps the `walks >> stage` walks of the best records, where `stage`
@@ -840,8 +848,8 @@ mod tests {
         assert_eq!(walks.iter().map(|w| w.since).collect::<Vec<_>>(), [1, 2]);
     }
 
-    /// Walks start while fewer than `walks` are under way and, with `halve`, only within its
-    /// first share of the budget; without `halve` the share used does not matter.
+    /// Walks start while fewer than `walks` are under way and only within the first share of
+    /// the budget: `halve`'s, or half of it without `halve`.
     #[test]
     fn walks_start_only_within_the_first_share() {
         let (inst, m) = small();
@@ -856,7 +864,11 @@ mod tests {
         assert!(!ils(0.15).may_start_walk(&ctx, 1));
         assert!(ils(0.0).may_start_walk(&ctx, 7));
         assert!(!ils(0.0).may_start_walk(&ctx, 8));
-        ctx.count(850);
-        assert!(!ils(0.0).may_start_walk(&ctx, 1), "the budget is spent");
+        ctx.count(349);
+        assert!(ils(0.0).may_start_walk(&ctx, 7));
+        ctx.count(1);
+        assert!(!ils(0.0).may_start_walk(&ctx, 1), "half the budget is used");
+        ctx.count(500);
+        assert!(!ils(0.15).may_start_walk(&ctx, 1), "the budget is spent");
     }
 }
