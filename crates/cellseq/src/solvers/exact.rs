@@ -143,14 +143,20 @@ fn out_of_budget(k: usize, n: usize) -> Error {
     ))
 }
 
+/// Whether the time left covers `seconds`, the estimate of a step that cannot stop halfway
+/// (a level's sort or a table's rehash); always without a deadline.
+fn time_covers(ctx: &Context, seconds: f64) -> bool {
+    ctx.deadline()
+        .remaining()
+        .is_none_or(|left| left.as_secs_f64() >= seconds)
+}
+
 /// Doubles the capacity of level `k`'s full table `next`, unless the time left would not cover
 /// the rehash, estimated at twice the last growth's time per state (`per_key`, updated here):
 /// the cost per state rises as the table outgrows the caches.
 fn grow(ctx: &Context, next: &mut Level, k: usize, per_key: &mut f64) -> Result<()> {
     let len = next.len();
-    if let Some(left) = ctx.deadline().remaining()
-        && left.as_secs_f64() < 2.0 * *per_key * len as f64
-    {
+    if !time_covers(ctx, 2.0 * *per_key * len as f64) {
         return Err(out_of_budget(k, ctx.model.n()));
     }
     let growing = Instant::now();
@@ -183,9 +189,7 @@ impl Dp {
         let mut next = Level::default();
         let mut evals = 0u64;
         // deterministic iteration: the states of the previous level sorted (grouped by ideal)
-        if let Some(left) = ctx.deadline().remaining()
-            && left.as_secs_f64() < self.sort_per_key * prev.len() as f64
-        {
+        if !time_covers(ctx, self.sort_per_key * prev.len() as f64) {
             return Err(out_of_budget(k, n));
         }
         let sorting = Instant::now();
