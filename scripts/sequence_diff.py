@@ -28,7 +28,7 @@ import os
 import sys
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "peers"))
-from sop_common import read_sop, tour_cost  # noqa: E402
+from sop_common import read_sop, tour_cost, write_sop  # noqa: E402
 
 
 def read_sequence(path, n):
@@ -109,12 +109,7 @@ def write_window(M, seq, s, e, out):
             else:
                 row.append(max(M[i][j], 0))
         rows.append(row)
-    with open(out, "w") as f:
-        f.write(f"NAME: window-{s}-{e}\nTYPE: SOP\nDIMENSION: {k}\nEDGE_WEIGHT_TYPE: EXPLICIT\n"
-                f"EDGE_WEIGHT_FORMAT: FULL_MATRIX\nEDGE_WEIGHT_SECTION\n{k}\n")
-        for row in rows:
-            f.write(" ".join(map(str, row)) + "\n")
-        f.write("EOF\n")
+    write_sop(out, f"window-{s}-{e}", rows)
     print(f"wrote {out}: {k} nodes, the window's cost in the sequence {span_cost(M, seq, s, e):g}")
 
 

@@ -11,13 +11,7 @@ SCRIPTS = os.path.join(ROOT, "scripts")
 sys.path.insert(0, SCRIPTS)
 
 import sequence_diff  # noqa: E402
-
-
-def write_sop(path, M):
-    n = len(M)
-    rows = "\n".join(" ".join(map(str, r)) for r in M)
-    path.write_text(f"NAME: t\nTYPE: SOP\nDIMENSION: {n}\nEDGE_WEIGHT_TYPE: EXPLICIT\n"
-                    f"EDGE_WEIGHT_FORMAT: FULL_MATRIX\nEDGE_WEIGHT_SECTION\n{n}\n{rows}\nEOF\n")
+from sop_common import write_sop  # noqa: E402  (scripts/peers, put on the path by sequence_diff)
 
 
 def write_solution(path, seq):
@@ -73,7 +67,7 @@ def test_a_window_written_out_keeps_its_precedence_and_the_exact_solver_improves
     cheap = {(0, 1), (1, 2), (2, 3), (3, 4), (4, 5), (5, 6), (1, 3)}
     M = matrix(7, cheap, pred=[(3, 2)])
     inst, sol, out = tmp_path / "t.sop", tmp_path / "a.json", tmp_path / "w.sop"
-    write_sop(inst, M)
+    write_sop(inst, "t", M)
     write_solution(sol, [0, 1, 4, 3, 2, 5, 6])
     run = subprocess.run([sys.executable, os.path.join(SCRIPTS, "sequence_diff.py"), str(inst),
                           str(sol), "--window", "2", "4", "--out", str(out)],
