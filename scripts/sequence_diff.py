@@ -31,10 +31,22 @@ sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "pee
 from sop_common import read_sop, tour_cost, write_sop  # noqa: E402
 
 
+def read_or_exit(path, read):
+    """read(path), or an exit naming the file and the problem (no traceback)."""
+    try:
+        return read(path)
+    except (OSError, ValueError, KeyError, TypeError) as e:
+        sys.exit(f"{path}: {e.__class__.__name__}: {e}")
+
+
 def read_sequence(path, n):
     """The node order (0-based) of a cellseq solution file of a TSPLIB SOP instance."""
-    with open(path) as f:
-        seq = [int(v["cell"]) - 1 for v in json.load(f)["sequence"]]
+
+    def read(p):
+        with open(p) as f:
+            return [int(v["cell"]) - 1 for v in json.load(f)["sequence"]]
+
+    seq = read_or_exit(path, read)
     if sorted(seq) != list(range(n)):
         sys.exit(f"{path}: not a sequence of the instance's {n} nodes")
     return seq
@@ -120,7 +132,7 @@ def main():
     ap.add_argument("--window", nargs=2, type=int, metavar=("START", "END"))
     ap.add_argument("--out")
     args = ap.parse_args()
-    _, n, M = read_sop(args.instance)
+    _, n, M = read_or_exit(args.instance, read_sop)
     named = [(p, read_sequence(p, n)) for p in args.solutions]
     if args.window:
         if not args.out or len(named) != 1:

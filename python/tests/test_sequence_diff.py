@@ -84,3 +84,20 @@ def test_a_window_written_out_keeps_its_precedence_and_the_exact_solver_improves
                           str(sol), "--window", "0", "4", "--out", str(out)],
                          capture_output=True, text=True)
     assert bad.returncode != 0 and "must lie within 1..5" in bad.stderr
+
+
+def test_unreadable_files_are_refused_naming_the_file(tmp_path):
+    inst, sol = tmp_path / "t.sop", tmp_path / "a.json"
+    write_sop(inst, "t", matrix(4, set()))
+    for text in ["not json", '{"sequence": [{"mode": 0}]}', '{"sequence": [{"cell": "x"}]}']:
+        sol.write_text(text)
+        run = subprocess.run([sys.executable, os.path.join(SCRIPTS, "sequence_diff.py"),
+                              str(inst), str(sol), str(sol)], capture_output=True, text=True)
+        assert run.returncode != 0 and str(sol) in run.stderr
+        assert "Traceback" not in run.stderr
+    write_solution(sol, [0, 1, 2, 3])
+    (tmp_path / "bad.sop").write_text("TYPE: SOP\nDIMENSION: 3\nEDGE_WEIGHT_SECTION\n3\n0 1\n")
+    run = subprocess.run([sys.executable, os.path.join(SCRIPTS, "sequence_diff.py"),
+                          str(tmp_path / "bad.sop"), str(sol), str(sol)],
+                         capture_output=True, text=True)
+    assert run.returncode != 0 and "bad.sop" in run.stderr and "Traceback" not in run.stderr
