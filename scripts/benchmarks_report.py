@@ -22,6 +22,9 @@ import statistics
 import sys
 from collections import OrderedDict, defaultdict
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "peers"))
+import safe_files  # noqa: E402
+
 EPS = 1e-9
 SOP_PLANS = ["sop", "sop-auto-5x10s", "sop-auto-10s", "sop-auto-5x1s", "sop-quick", "sop-solvers-1s"]
 PCG_PLANS = ["pcgtsp", "pcgtsp-quick"]
@@ -433,8 +436,7 @@ def main():
         i = L.index("## Machine and run conditions")
         L[i:i] = T
 
-    with open(out, "w") as f:
-        f.write("\n".join(L).rstrip() + "\n")
+    safe_files.write_text(out, "\n".join(L).rstrip() + "\n")
     print(f"wrote {out}", file=sys.stderr)
 
 

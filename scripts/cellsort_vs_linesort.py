@@ -20,6 +20,9 @@ import os
 import sys
 import time
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "peers"))
+import safe_files  # noqa: E402
+
 import vpype_cli
 
 MM_PER_PX = 25.4 / 96.0
@@ -111,8 +114,7 @@ def main():
     foot = ["", f"Total sort time: linesort {tot_l:.2f} s, cellsort {tot_c:.2f} s."]
     text = "\n".join(head + body + foot) + "\n"
     if a.out:
-        with open(a.out, "w") as fh:
-            fh.write(text)
+        safe_files.write_text(a.out, text)
     print(text)
 
 

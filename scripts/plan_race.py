@@ -31,6 +31,7 @@ import sys
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "peers"))
 from sop_common import cellseq_solve  # noqa: E402
+import safe_files  # noqa: E402
 
 
 def run(cellseq, path, variant, limit, objective, seed):
@@ -99,15 +100,13 @@ def main():
             summary.append((os.path.basename(f), lim,
                             {n: statistics.median(c) for n, c in costs.items()}, costs))
     if a.tsv:
-        with open(a.tsv, "w") as t:
-            t.write("file\tlimit_s\tplan\tseed\tcost\tevaluations\telapsed_s\n")
-            for r in runs:
-                t.write(f"{r[0]}\t{r[1]}\t{r[2]}\t{r[6]}\t{r[3]:.6f}\t{r[4]}\t{r[5]:.3f}\n")
+        rows = ["file\tlimit_s\tplan\tseed\tcost\tevaluations\telapsed_s\n"]
+        rows += [f"{r[0]}\t{r[1]}\t{r[2]}\t{r[6]}\t{r[3]:.6f}\t{r[4]}\t{r[5]:.3f}\n" for r in runs]
+        safe_files.write_text(a.tsv, "".join(rows))
     lines = table([n for n, _ in variants], summary)
     text = "\n".join(lines) + "\n"
     if a.out:
-        with open(a.out, "w") as o:
-            o.write(text)
+        safe_files.write_text(a.out, text)
     else:
         sys.stdout.write(text)
 

@@ -59,6 +59,7 @@ import tomllib
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "peers"))
 from sop_common import cellseq_solve  # noqa: E402
+import safe_files  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 BUILT_IN = os.path.join(ROOT, "crates", "cellseq", "src", "solvers", "auto", "portfolio.toml")
@@ -294,8 +295,7 @@ class Runs:
     def add(self, r):
         with self.lock:
             self.done[(r["file"], r["plan"], r["seed"], r["evals"])] = r
-            with open(self.path, "a") as f:
-                f.write(json.dumps(r) + "\n")
+            safe_files.append_line(self.path, json.dumps(r))
 
 
 def solve(binary, file, portfolio, seed, evals):
@@ -394,8 +394,7 @@ def main():
     plan_files = {}
     for name, rule in plans.items():
         path = os.path.abspath(os.path.join(a.out, "cand", "plan-%s.toml" % name))
-        with open(path, "w") as f:
-            f.write(portfolio_text(beam, [(name, rule, None)]))
+        safe_files.write_text(path, portfolio_text(beam, [(name, rule, None)]))
         plan_files[name] = path
     # the catch-all's and the geometric rules' plans are left out: no matrix instance
     # reaches them
@@ -419,13 +418,13 @@ def main():
                                     abs(t[2]["cells"] - 300)))[2]
     pick_path = os.path.join(a.out, "pick.toml")
     pick_text = portfolio_text(beam, candidate_rules(pick, plans, geometric))
-    with open(pick_path, "w") as f:
-        f.write("# chosen by scripts/portfolio_sweep.py on the training families\n" + pick_text)
+    safe_files.write_text(
+        pick_path, "# chosen by scripts/portfolio_sweep.py on the training families\n" + pick_text)
     # runs of the pick's file are cached under a label naming its content
     pick_label = "file:pick-" + hashlib.sha1(pick_text.encode()).hexdigest()[:12]
     builtin_path = os.path.join(a.out, "cand", "built-in.toml")
-    with open(builtin_path, "w") as f:
-        f.write(portfolio_text(beam, candidate_rules(BUILT_IN_CAND, plans, geometric)))
+    safe_files.write_text(
+        builtin_path, portfolio_text(beam, candidate_rules(BUILT_IN_CAND, plans, geometric)))
 
     # held back: composed, then both portfolio files for real
     hb_sc, hb_ft = scores_of(parts["heldback"], names, runs, a)
@@ -499,8 +498,7 @@ def main():
         rep += ["\n## Validation (reported, not used for choosing)\n\n",
                 table(rows, ["set", "portfolio", "files", "mean gap %", "at or below best known",
                              "results that differ"])]
-    with open(os.path.join(a.out, "report.md"), "w") as f:
-        f.write("".join(rep))
+    safe_files.write_text(os.path.join(a.out, "report.md"), "".join(rep))
     print("".join(rep[:6]))
     return 0
 

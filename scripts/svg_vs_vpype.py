@@ -49,6 +49,9 @@ import sys
 import tempfile
 import time
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "peers"))
+import safe_files  # noqa: E402
+
 PX_PER_MM = 96.0 / 25.4
 QUANTIZATION = 0.1  # px: curve flattening of the reader (vpype's default)
 
@@ -231,8 +234,8 @@ def main_per_layer(files, args):
                   sum(r["vpype"] for r in both)))
     print(summary)
     if args.out:
-        with open(args.out, "w") as fh:
-            fh.write("\n".join(head + [fmt_layer(r) for r in rows]) + "\n" + summary + "\n")
+        safe_files.write_text(
+            args.out, "\n".join(head + [fmt_layer(r) for r in rows]) + "\n" + summary + "\n")
 
 
 def fmt_layer(r):
@@ -293,8 +296,7 @@ def main():
     print(summary)
     lines.append(summary)
     if args.out:
-        with open(args.out, "w") as fh:
-            fh.write("\n".join(lines) + "\n")
+        safe_files.write_text(args.out, "\n".join(lines) + "\n")
     print(json.dumps({"files": len(rows), "at_or_below": ok, "with_both": len(both),
                       "refused": refused}))
 

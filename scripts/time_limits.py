@@ -31,6 +31,9 @@ import tempfile
 import time
 from pathlib import Path
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "peers"))
+import safe_files  # noqa: E402
+
 SMALL = [
     ("random-sop", {"n": 198, "c": 100, "p": 0}),
     ("random-sop", {"n": 298, "c": 100, "p": 0}),
@@ -129,10 +132,8 @@ def main():
                    f"{rss / 1024:.0f}", str(code), str(cost), err if code else ""]
             rows.append(row)
             print("\t".join(row), flush=True)
-    with open(a.out / "time_limits.tsv", "w") as f:
-        f.write(head + "\n")
-        for r in rows:
-            f.write("\t".join(r) + "\n")
+    safe_files.write_text(a.out / "time_limits.tsv",
+                          "".join(line + "\n" for line in [head] + ["\t".join(r) for r in rows]))
     worst = max(rows, key=lambda r: float(r[4]))
     print(f"# largest overrun past max(limit, read): {worst[4]} s ({worst[1]} on {worst[0]},"
           f" read {worst[2]} s), limit {a.limit} s", file=sys.stderr)

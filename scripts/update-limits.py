@@ -10,6 +10,9 @@ import pathlib
 import subprocess
 import sys
 
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent / "peers"))
+import safe_files  # noqa: E402
+
 root = pathlib.Path(__file__).resolve().parent.parent
 binary = sys.argv[1] if len(sys.argv) > 1 else str(root / "target/release/cellseq")
 section = subprocess.run(
@@ -26,5 +29,5 @@ if a < 0 or b < 0:
     doc = doc[: at + 1] + section + "\n\n" + doc[at + 1 :]
 else:
     doc = doc[:a] + section + doc[b + len(end) :]
-doc_path.write_text(doc)
+safe_files.write_text(doc_path, doc)
 print(f"updated {doc_path.relative_to(root)} ({len(lines)} lines of limits)")

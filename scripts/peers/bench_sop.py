@@ -25,6 +25,7 @@ import os
 import sys
 
 import sop_common as sc
+import safe_files
 
 
 def run_cellseq(path, a):
@@ -104,11 +105,10 @@ def main():
                 r = {"peer": p, "instance": sc.instance_name(path), "cost": None,
                      "error": str(e)[:300], "wall_s": None}
             if a.out:
-                with open(a.out, "a") as f:
-                    r2 = dict(r)
-                    r2.pop("tour", None)
-                    r2.pop("workdir", None)  # temp path of this machine
-                    f.write(json.dumps(r2) + "\n")
+                r2 = dict(r)
+                r2.pop("tour", None)
+                r2.pop("workdir", None)  # temp path of this machine
+                safe_files.append_line(a.out, json.dumps(r2))
             g = sc.gap_pct(r.get("cost"), best)
             cost = r.get("cost")
             if p == "cpsat" and cost is not None:

@@ -30,6 +30,7 @@ import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import lkh_sop  # noqa: E402
+import safe_files  # noqa: E402
 import sop_common as sc  # noqa: E402
 
 UNBOUNDED_TRIALS = 1_000_000_000
@@ -139,8 +140,7 @@ def main():
                     if r["lower_bound"] is not None:
                         bound = max(bound or 0, r["lower_bound"])
                     if a.jsonl:
-                        with open(a.jsonl, "a") as f:
-                            f.write(json.dumps(r) + "\n")
+                        safe_files.append_line(a.jsonl, json.dumps(r))
                     print(json.dumps(r), file=sys.stderr)
             med = {k: statistics.median(x["cost"] for x in v) for k, v in runs.items()}
             wall = {k: statistics.median(x["wall_s"] for x in v) for k, v in runs.items()}
@@ -159,8 +159,7 @@ def main():
         text += "\n1-minute load average at the end of each run: %.2f to %.2f (median %.2f).\n" % (
             min(loads), max(loads), statistics.median(loads))
     if a.out:
-        with open(a.out, "w") as f:
-            f.write(text)
+        safe_files.write_text(a.out, text)
     else:
         sys.stdout.write(text)
     return 0

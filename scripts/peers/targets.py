@@ -32,6 +32,7 @@ import statistics
 import sys
 
 from sop_common import cellseq_solve, gap_pct
+import safe_files
 
 EXTS = (".sop", ".pcglns", ".pcgtsp")
 
@@ -55,8 +56,7 @@ def run_all(a):
                        "loadavg": load}
                 print(json.dumps(rec), file=sys.stderr)
                 if a.jsonl:
-                    with open(a.jsonl, "a") as f:
-                        f.write(json.dumps(rec) + "\n")
+                    safe_files.append_line(a.jsonl, json.dumps(rec))
                 records.append(rec)
     return records
 
@@ -192,8 +192,7 @@ def main():
     groups = group(records)
     text = table(groups) + robustness(groups, a.gap_target)
     if a.out:
-        with open(a.out, "w") as f:
-            f.write(text)
+        safe_files.write_text(a.out, text)
     sys.stdout.write(text)
     return 0
 
