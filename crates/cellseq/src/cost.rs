@@ -311,6 +311,15 @@ impl CostModel {
     pub fn nodes(&self) -> usize {
         *self.offsets.last().unwrap_or(&0) as usize
     }
+    /// Adds `add` to the matrix arc from node `na` to node `nb` (nothing on geometric models):
+    /// the penalised costs of `gls`, in a copy of the model. The closure and the cheapest arcs
+    /// already cached stay as they were, so with `add >= 0` they are lower bounds of the new
+    /// costs, not the costs themselves.
+    pub fn add_to_arc(&mut self, na: usize, nb: usize, add: f64) {
+        if let Some(m) = self.matrix.as_mut() {
+            m.costs[na * m.size + nb] += add;
+        }
+    }
     /// The transitive closure of the precedence (ancestor and descendant bitsets), built on
     /// first use and shared by every search on this model; `None` without precedence or
     /// above [`CLOSURE_MAX_CELLS`] cells.

@@ -176,7 +176,7 @@ fn improvers_reach_small_gaps_on_esc25() {
     let inst = load_instance(&instance_path("tsplib-sop/ESC25.sop")).unwrap();
     let none = BTreeMap::new();
     let mut f = Vec::new();
-    for name in ["sa", "tabu", "aco"] {
+    for name in ["sa", "tabu", "aco", "gls"] {
         let obj = inst.default_objective();
         let r = run(
             name,

@@ -84,10 +84,16 @@ impl<'a> Search<'a> {
     /// Like [`Search::new`], with the neighbour lists cut off at `deadline`
     /// ([`Neighbours::new_until`]).
     pub fn new_until(c: Costs<'a>, k: usize, deadline: Deadline) -> Self {
+        Self::with_neighbours(c, Neighbours::new_until(c.m, k, deadline))
+    }
+
+    /// A search over `c` with candidate lists `nb` made elsewhere (for other costs of the same
+    /// cells, such as the true costs under a search on penalised ones).
+    pub fn with_neighbours(c: Costs<'a>, nb: Neighbours) -> Self {
         let n = c.m.n();
         Search {
             c,
-            nb: Neighbours::new_until(c.m, k, deadline),
+            nb,
             max_block: if n <= 120 {
                 n
             } else if n <= LAZY_REACH_CELLS {

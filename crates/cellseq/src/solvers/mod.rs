@@ -48,6 +48,7 @@ registry! {
     GreedyEdge => edge,
     Insertion => insertion,
     Ils => ils,
+    Gls => gls,
     Atsp => atsp,
     Exact => exact,
     Beam => beam,
@@ -490,7 +491,7 @@ mod tests {
         assert!(e.contains("nosuch"), "{e}");
         let e = info.build(&kv("greedy*:1")).err().unwrap().to_string();
         assert!(
-            e.contains("only ils, eacs and reopt can start from an earlier sequence"),
+            e.contains("only gls, ils, eacs and reopt can start from an earlier sequence"),
             "{e}"
         );
     }
