@@ -183,9 +183,9 @@ fn auto_picks_its_rule_by_symmetry_and_precedence_density() {
     assert!(c.features.symmetric && !c.features.geometric);
     assert_eq!(
         plan_text(c.plan(false)),
-        "local-search:0.1,ils[accept=0.01;halve=0.15;walks=8]*:1"
+        "local-search:0.1,gls[alpha=3;top=2]*:1"
     );
-    assert_eq!(plan_text(c.plan(true)), "ils[accept=0.01]*:1");
+    assert_eq!(plan_text(c.plan(true)), "gls[alpha=3;top=2]*:1");
     assert_eq!(c.beam.share, 0.3);
     let c = a.choose(&esc);
     assert_eq!(c.rule, "sparse");
@@ -500,7 +500,7 @@ fn bad_portfolios_are_refused_naming_the_file_and_the_entry() {
                     "{ solver = \"greedy\", share = 1.0, start = \"best\" }"
                 )
             ),
-            "only ils, eacs and reopt can start from an earlier sequence",
+            "only gls, ils, eacs and reopt can start from an earlier sequence",
         ),
         (
             format!(
