@@ -13,6 +13,12 @@ The family, n and p columns (p: closure density %, or w= the window length of
 
 usage: families_vs_lkh.py FILE.sop... --lkh PATH [--cellseq PATH] [--time-limit 1 10]
                           [--seeds 1 2 3] [--out notes.md] [--jsonl runs.jsonl]
+                          [--lkh-from-jsonl OLD.jsonl...]
+
+`--lkh-from-jsonl` takes LKH-3's runs from earlier `--jsonl` files (same instance, time limit
+and seed) instead of running it again, for a new cellseq against the same LKH-3 runs; those
+records are written to the new `--jsonl` too, marked `"reused": true`. A run not found there
+is made as usual.
 
 Note: LKH's TIME_LIMIT counts its own user CPU time (getrusage) and excludes its
 preprocessing; cellseq's --time-limit is wall-clock. On a loaded machine LKH therefore gets
@@ -107,6 +113,23 @@ def best_known_summary(rows):
     return out
 
 
+def reused_lkh_runs(paths):
+    """LKH-3's runs in earlier --jsonl files, by (instance, time limit, seed); the last wins."""
+    old = {}
+    for path in paths:
+        try:
+            with open(path) as f:
+                for line in f:
+                    if not line.strip():
+                        continue
+                    r = json.loads(line)
+                    if r.get("peer") == "lkh3":
+                        old[(r["instance"], float(r["time_limit"]), int(r["seed"]))] = r
+        except (OSError, ValueError, KeyError, TypeError) as e:
+            sys.exit("%s: not a --jsonl file of this script (%s)" % (path, e))
+    return old
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("files", nargs="+")
@@ -116,8 +139,11 @@ def main():
     ap.add_argument("--seeds", type=int, nargs="+", default=[1, 2, 3])
     ap.add_argument("--out", help="write the Markdown table here (else stdout)")
     ap.add_argument("--jsonl", help="append every run as a JSON line here")
+    ap.add_argument("--lkh-from-jsonl", nargs="+", default=[], metavar="OLD.jsonl",
+                    help="take LKH-3's runs from these earlier --jsonl files where they hold one")
     a = ap.parse_args()
-    if not os.path.exists(a.lkh):
+    old = reused_lkh_runs(a.lkh_from_jsonl)
+    if not os.path.exists(a.lkh) and not old:
         ap.error("no LKH-3 binary at %s (--lkh PATH or LKH_BIN)" % a.lkh)
     rows, loads = [], []
     for path in a.files:
@@ -132,9 +158,16 @@ def main():
                                          ("lkh3", run_lkh, a.lkh)):
                     # cellseq's lower bound (after its search, outside the time limit) is
                     # computed on the first run of an instance only
-                    r = fn(binary, path, limit, seed, bound=(bound is None))
-                    r.update(instance=sc.instance_name(path), time_limit=limit, seed=seed,
-                             loadavg=round(os.getloadavg()[0], 2))
+                    key = (sc.instance_name(path), float(limit), seed)
+                    if peer == "lkh3" and key in old:
+                        r = dict(old[key], reused=True)
+                    else:
+                        if peer == "lkh3" and not os.path.exists(binary):
+                            sys.exit("no LKH-3 run of %s at %g s seed %d in %s, and no binary "
+                                     "at %s" % (key[0], limit, seed, a.lkh_from_jsonl, binary))
+                        r = fn(binary, path, limit, seed, bound=(bound is None))
+                        r.update(instance=key[0], time_limit=limit, seed=seed,
+                                 loadavg=round(os.getloadavg()[0], 2))
                     loads.append(r["loadavg"])
                     runs[peer].append(r)
                     if r["lower_bound"] is not None:
