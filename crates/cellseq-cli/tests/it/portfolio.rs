@@ -255,29 +255,43 @@ fn auto_picks_its_rule_by_symmetry_and_precedence_density() {
     assert_eq!(c.rule, "default");
     assert!(c.features.geometric && c.features.free_density > 0.001);
     assert_eq!(plan_text(c.plan(true)), "local-search:0.3,eacs:0.5,ils*:1");
-    // a symmetric matrix of one mode per cell above the beam's 400 cells: `ils` alone, with
-    // the halved walks, and no beam phase; at 400 cells the `symmetric` rule
-    for (n, rule) in [("398", "symmetric"), ("399", "symmetric-large")] {
+    // a symmetric matrix of one mode per cell above the beam's 400 cells: no beam phase;
+    // up to 1000 cells guided local search alone, at 400 cells the `symmetric` rule
+    for (n, rule) in [("398", "symmetric"), ("399", "symmetric-medium")] {
         let c = a.choose(&generated("symmetric", &[("n", n), ("p", "1")], 1));
         assert_eq!(c.rule, rule, "{n} cells and the two ends");
     }
-    let c = a.choose(&generated("symmetric", &[("n", "450"), ("p", "1")], 1));
+    for (n, p) in [("450", "1"), ("450", "30")] {
+        let c = a.choose(&generated("symmetric", &[("n", n), ("p", p)], 1));
+        assert_eq!((c.rule, c.beam.share), ("symmetric-medium", 0.0));
+        assert_eq!(plan_text(c.plan(false)), "gls[alpha=3;top=2]:1");
+    }
+    for (n, rule) in [("998", "symmetric-medium"), ("999", "symmetric-large")] {
+        let c = a.choose(&generated("symmetric", &[("n", n), ("p", "1")], 1));
+        assert_eq!(c.rule, rule, "{n} cells and the two ends");
+    }
+    // above 1000 cells `ils` alone, with the halved walks
+    let c = a.choose(&generated("symmetric", &[("n", "1050"), ("p", "1")], 1));
     assert_eq!((c.rule, c.beam.share), ("symmetric-large", 0.0));
     assert!(c.features.symmetric && c.features.modes == 1.0);
     assert_eq!(
         plan_text(c.plan(false)),
         "ils[accept=0.01;halve=0.15;max-seg=10;walks=8]:1"
     );
+    // `compiler-dag` (closure density 0.8 and above) keeps `ils` at every size above 400
+    let c = a.choose(&generated("compiler-dag", &[("n", "450")], 1));
+    assert!(c.features.closure_density >= 0.8);
+    assert_eq!(c.rule, "symmetric-large-dense");
     // with dense precedence (closure density 0.2 and above) the kicks keep their longer
     // windows
-    let c = a.choose(&generated("compiler-dag", &[("n", "450")], 1));
+    let c = a.choose(&generated("compiler-dag", &[("n", "1050")], 1));
     assert!(c.features.closure_density >= 0.2);
     assert_eq!((c.rule, c.beam.share), ("symmetric-large-dense", 0.0));
     assert_eq!(
         plan_text(c.plan(false)),
         "ils[accept=0.01;halve=0.15;walks=8]:1"
     );
-    let c = a.choose(&generated("symmetric", &[("n", "450"), ("p", "30")], 1));
+    let c = a.choose(&generated("symmetric", &[("n", "1050"), ("p", "30")], 1));
     assert_eq!(c.rule, "symmetric-large-dense");
     // a symmetric matrix with several modes per cell keeps the colony in its plan
     let c = a.choose(&generated("generalized", &[("n", "30"), ("modes", "3")], 1));
@@ -378,6 +392,7 @@ fn the_built_in_portfolio_parses_validates_and_ends_with_a_catch_all() {
     assert_eq!(
         names,
         [
+            "symmetric-medium",
             "symmetric-large",
             "symmetric-large-dense",
             "symmetric",
