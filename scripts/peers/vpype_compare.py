@@ -25,7 +25,7 @@ import sys
 import tempfile
 import time
 
-import safe_files
+from vpype_linesort_bench import write_polylines
 
 PX_PER_MM = 96.0 / 25.4
 
@@ -44,14 +44,7 @@ def gen_svg(path, n_paths, seed=1, width=420.0, height=297.0):
             y = min(max(y + step * math.sin(ang), 0), height)
             pts.append((x, y))
         polys.append(pts)
-    parts = ['<?xml version="1.0" encoding="utf-8"?>\n',
-             '<svg xmlns="http://www.w3.org/2000/svg" width="%gmm" height="%gmm" '
-             'viewBox="0 0 %g %g">\n<g fill="none" stroke="black" stroke-width="0.3">\n'
-             % (width, height, width, height)]
-    parts += ['<polyline points="%s"/>\n' % " ".join("%.3f,%.3f" % p for p in pts)
-              for pts in polys]
-    parts.append("</g>\n</svg>\n")
-    safe_files.write_text(path, "".join(parts))
+    write_polylines(path, polys, width, height)
 
 
 def pen_up_mm(svg):
