@@ -255,6 +255,7 @@ impl Gls {
         let mut pm = m.clone();
         let mut seeds = Vec::new();
         let (mut rounds, mut gains) = (0u64, 0u64);
+        // `exhausted` is also true once the best meets the model's floor (an optimum)
         while !ctx.exhausted() {
             rounds += 1;
             pen.penalise(&c, &s, &mut pm, self.top, &mut seeds);
@@ -286,7 +287,7 @@ mod tests {
     use super::*;
     use crate::context::NoObserver;
     use crate::engine::atsp::random_matrix_instance;
-    use crate::model::Objective;
+    use crate::model::{CostMatrix, Objective};
     use crate::solvers::Budget;
 
     /// The links of highest `cost / (1 + penalty)` get the penalties, ties to the earlier
@@ -320,6 +321,33 @@ mod tests {
         let again = top / 2.0 > by_util[2].0
             || (top / 2.0 == by_util[2].0 && p0 < by_util[2].1);
         assert_eq!(pen.of(p0 as u32, p0 as u32 + 1), 1 + u32::from(again));
+    }
+
+    /// A best at the model's floor ends the rounds at once (here every link costs 0, so λ is
+    /// 0 and no penalty could lead anywhere), not at the end of a large evaluation budget.
+    #[test]
+    fn stops_at_the_floor() {
+        let mut inst = random_matrix_instance(30, 5, 100, &[]);
+        if let Some(mx) = inst.matrix.as_mut() {
+            for x in mx.costs.iter_mut().filter(|x| **x < CostMatrix::FORBIDDEN) {
+                *x = 0.0;
+            }
+        }
+        let m = CostModel::new(&inst, Objective::Matrix);
+        let budget = Budget {
+            time_limit: None,
+            max_evals: Some(1_000_000_000),
+        };
+        let mut obs = NoObserver;
+        let mut ctx = Context::new(&inst, &m, 1, budget, &mut obs);
+        let g = Gls {
+            alpha: 3.0,
+            top: 2,
+            k: 12,
+        };
+        let o = g.solve(&mut ctx).unwrap();
+        assert_eq!(Solution::new(&Costs::open(&m), &o.sequence).cost, 0.0);
+        assert!(ctx.evaluations() < 1_000_000, "{}", ctx.evaluations());
     }
 
     /// On a 60-cell random instance with precedence the search ends feasible, no worse than
