@@ -46,6 +46,12 @@ pub static NEAR_SYMMETRIC_SPECS: &[ParamSpec] = &[
         kind: ParamKind::float(0.0, 100.0),
         help: "asymmetric part: each arc adds an integer uniform in [0, asym % of c]",
     },
+    ParamSpec {
+        name: "plane",
+        default: "false",
+        kind: ParamKind::Bool,
+        help: "the symmetric part is the rounded distance between random points in a c x c square (metric costs, as TSPLIB's kro instances) instead of a random matrix",
+    },
 ];
 
 /// Integer costs uniform in [0, c] for every ordered pair of `n` cells (row-major, diagonal 0).
@@ -67,6 +73,23 @@ fn symmetric_costs(n: usize, c: u64, rng: &mut ChaCha8Rng) -> Vec<f64> {
     for i in 0..n {
         for j in i + 1..n {
             let v = rng.random_range(0..=c) as f64;
+            m[i * n + j] = v;
+            m[j * n + i] = v;
+        }
+    }
+    m
+}
+
+/// Rounded distances between `n` points uniform in a `c` x `c` square (row-major, diagonal 0).
+fn plane_costs(n: usize, c: u64, rng: &mut ChaCha8Rng) -> Vec<f64> {
+    let side = c as f64;
+    let pts: Vec<(f64, f64)> = (0..n)
+        .map(|_| (rng.random_range(0.0..=side), rng.random_range(0.0..=side)))
+        .collect();
+    let mut m = vec![0.0; n * n];
+    for i in 0..n {
+        for j in i + 1..n {
+            let v = (pts[i].0 - pts[j].0).hypot(pts[i].1 - pts[j].1).round();
             m[i * n + j] = v;
             m[j * n + i] = v;
         }
@@ -185,8 +208,13 @@ pub fn near_symmetric(p: &Params, seed: u64) -> Result<Instance> {
     let density = p.float("p") / 100.0;
     let asym = p.float("asym");
     let top = (asym / 100.0 * c as f64).round() as u64;
+    let plane = p.bool("plane");
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    let mut m = symmetric_costs(n, c, &mut rng);
+    let mut m = if plane {
+        plane_costs(n, c, &mut rng)
+    } else {
+        symmetric_costs(n, c, &mut rng)
+    };
     for i in 0..n {
         for j in 0..n {
             if i != j {
@@ -195,6 +223,11 @@ pub fn near_symmetric(p: &Params, seed: u64) -> Result<Instance> {
         }
     }
     let edges = random_dag(n, density, &mut rng);
-    let name = format!("near-symmetric-n{n}-c{c}-p{}-s{seed}", p.float("p"));
+    let kind = if plane {
+        "near-symmetric-plane"
+    } else {
+        "near-symmetric"
+    };
+    let name = format!("{kind}-n{n}-c{c}-p{}-s{seed}", p.float("p"));
     Ok(sop_shaped(name, &vec![1; n], |u, v| m[u * n + v], &edges))
 }

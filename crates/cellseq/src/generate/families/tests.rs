@@ -92,6 +92,45 @@ fn atsp_has_only_the_dummy_precedence_and_tmat_satisfies_the_triangle_inequality
 }
 
 #[test]
+fn near_symmetric_in_the_plane_is_metric_up_to_rounding_and_its_asymmetric_part() {
+    // asym = 0: symmetric rounded distances, so the triangle inequality holds within 1
+    let inst = gen_(
+        "near-symmetric",
+        &[("n", "40"), ("asym", "0"), ("plane", "true")],
+        4,
+    );
+    let m = inst.matrix.as_ref().unwrap();
+    let n = m.size - 2;
+    for i in 1..=n {
+        for j in 1..=n {
+            assert_eq!(m.get(i, j), m.get(j, i));
+            for k in 1..=n {
+                if i != j && j != k && i != k {
+                    assert!(m.get(i, k) <= m.get(i, j) + m.get(j, k) + 1.0 + 1e-9);
+                }
+            }
+        }
+    }
+    // a random matrix breaks the inequality somewhere; with asym = 5 each arc adds at most 50
+    let random = gen_("near-symmetric", &[("n", "40"), ("asym", "0")], 4);
+    let r = random.matrix.as_ref().unwrap();
+    let broken = (1..=n)
+        .any(|i| (1..=n).any(|j| (1..=n).any(|k| r.get(i, k) > r.get(i, j) + r.get(j, k) + 1.0)));
+    assert!(
+        broken,
+        "the random matrix is metric too: the test tells nothing"
+    );
+    let noisy = gen_("near-symmetric", &[("n", "40"), ("plane", "true")], 4);
+    let q = noisy.matrix.as_ref().unwrap();
+    for i in 1..=n {
+        for j in 1..=n {
+            let d = q.get(i, j) - m.get(i, j);
+            assert!((0.0..=50.0).contains(&d), "{i} {j}: {d}");
+        }
+    }
+}
+
+#[test]
 fn compiler_dag_is_acyclic_sparse_and_not_transitively_closed() {
     for seed in 1..=5 {
         let inst = gen_("compiler-dag", &[("n", "300")], seed);
