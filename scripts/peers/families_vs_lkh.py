@@ -118,14 +118,10 @@ def reused_lkh_runs(paths):
     old = {}
     for path in paths:
         try:
-            with open(path) as f:
-                for line in f:
-                    if not line.strip():
-                        continue
-                    r = json.loads(line)
-                    if r.get("peer") == "lkh3":
-                        old[(r["instance"], float(r["time_limit"]), int(r["seed"]))] = r
-        except (OSError, ValueError, KeyError, TypeError) as e:
+            for r in sc.read_jsonl([path]):
+                if r.get("peer") == "lkh3":
+                    old[(r["instance"], float(r["time_limit"]), int(r["seed"]))] = r
+        except (OSError, ValueError, KeyError, TypeError, AttributeError) as e:
             sys.exit("%s: not a --jsonl file of this script (%s)" % (path, e))
     return old
 

@@ -31,7 +31,7 @@ import random
 import statistics
 import sys
 
-from sop_common import cellseq_solve, gap_pct
+from sop_common import cellseq_solve, gap_pct, read_jsonl
 import safe_files
 
 EXTS = (".sop", ".pcglns", ".pcgtsp")
@@ -58,15 +58,6 @@ def run_all(a):
                 if a.jsonl:
                     safe_files.append_line(a.jsonl, json.dumps(rec))
                 records.append(rec)
-    return records
-
-
-def read_jsonl(paths):
-    """Run records from JSON-lines files written by --jsonl."""
-    records = []
-    for path in paths:
-        with open(path) as f:
-            records.extend(json.loads(line) for line in f if line.strip())
     return records
 
 
