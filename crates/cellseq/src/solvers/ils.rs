@@ -23,6 +23,7 @@ use super::Build;
 use super::StartsFrom;
 use super::start::{greedy_solution, outcome};
 use super::{Caps, Context, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo};
+use crate::engine::corridor::{self, Corridor as Shape};
 use crate::engine::crossover::Crossover;
 use crate::engine::lk::Lk;
 use crate::engine::moves::sop3_delta;
@@ -32,7 +33,7 @@ use crate::engine::sop3x::{TwoWay, sop3_two_way};
 use crate::engine::vnd::Search;
 use crate::engine::{Costs, Solution, cheaper};
 use crate::error::Result;
-use crate::model::Sequence;
+use crate::model::{Sequence, Visit};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -188,6 +189,24 @@ are re-chosen); `window-repair=true` runs them in every repair as well.",
             help: "with walks > 1: each time this share of the budget is used (of the evaluation budget when one is set, else of the time limit; without either none is dropped), the walks with the worse records are dropped, half at a time, down to one; early records pick the basin the rest of the budget deepens; no walk starts after the first such share, so on large instances, where a walk's start takes seconds, the rest is left to the kicks (0: every walk runs to the end)",
         },
         ParamSpec {
+            name: "corridor",
+            default: "0",
+            kind: ParamKind::int(0, 1 << 20),
+            help: "corridor search (engine::corridor: prefixes within `corridor-diff` cells of the best's, no cell moved more than `corridor-reach` places) from the best with this many states per prefix length, once the walk has spent as many evaluations since its last record, or since the last pass, as the last pass took; a pass without a gain doubles the width up to 65536, a gain is polished and the walk goes on from it (0: off)",
+        },
+        ParamSpec {
+            name: "corridor-diff",
+            default: "5",
+            kind: ParamKind::int(1, crate::engine::corridor::MAX_DIFF as u64),
+            help: "with corridor > 0: most cells by which a prefix may differ from the best's prefix of the same length",
+        },
+        ParamSpec {
+            name: "corridor-reach",
+            default: "30",
+            kind: ParamKind::int(1, crate::engine::corridor::MAX_REACH as u64),
+            help: "with corridor > 0: most places a cell may move",
+        },
+        ParamSpec {
             name: "stall",
             default: "20000",
             kind: ParamKind::int(1, crate::params::MAX_ITERATIONS),
@@ -253,6 +272,11 @@ pub fn from_params(p: &Params) -> Ils {
         shift_repair: p.int("shift-repair") as usize,
         walks: p.int("walks") as usize,
         halve: p.float("halve"),
+        corridor: Shape {
+            diff: p.int("corridor-diff") as usize,
+            reach: p.int("corridor-reach") as usize,
+            width: p.int("corridor") as usize,
+        },
     }
 }
 
@@ -302,6 +326,83 @@ pub struct Ils {
     pub walks: usize,
     /// Share of the budget after which the worse half of the walks is dropped (0: never).
     pub halve: f64,
+    /// The corridor of the passes and the first pass's width (0: no passes).
+    pub corridor: Shape,
+}
+
+/// Widest corridor pass of [`Ils`].
+const CORRIDOR_MAX_WIDTH: usize = 1 << 16;
+
+/// [`Ils`]'s corridor passes: a pass from the best is due once the walk has spent, since its
+/// last record or the last pass, as many evaluations as that pass took (the first pass's
+/// count is estimated), so a stalled walk and the passes share the budget evenly.
+struct Passes {
+    shape: Shape,
+    /// Evaluations of the last pass (estimated before the first).
+    spent: u64,
+    /// Evaluation count at the walk's last record or the end of the last pass.
+    mark: u64,
+    gains: u64,
+    runs: u64,
+}
+
+impl Passes {
+    fn new(shape: Shape, n: usize, evals: u64) -> Self {
+        Passes {
+            shape,
+            spent: (shape.width as u64).saturating_mul(n as u64 * 8),
+            mark: evals,
+            gains: 0,
+            runs: 0,
+        }
+    }
+
+    fn due(&self, evals: u64) -> bool {
+        self.shape.width > 0 && evals >= self.mark.saturating_add(self.spent)
+    }
+
+    /// One pass from `best`: the cheaper sequence it finds, if any, polished by the VND (and
+    /// Lin–Kernighan where it runs).
+    fn run(
+        &mut self,
+        ctx: &mut Context,
+        (search, lk): (&mut Search, Option<&mut Lk>),
+        best: &Solution,
+    ) -> Option<Solution> {
+        let before = ctx.evaluations();
+        let c = &search.c;
+        let found = corridor::improve(c, best, ctx, self.shape);
+        self.runs += 1;
+        self.mark = ctx.evaluations();
+        self.spent = self.mark - before;
+        match found {
+            Some((order, _)) => {
+                self.gains += 1;
+                let seq: Sequence = order
+                    .iter()
+                    .map(|&x| Visit::new(x as usize, best.mode[x as usize] as usize))
+                    .collect();
+                let mut s = Solution::new(c, &seq);
+                search.vnd(&mut s, ctx);
+                if let Some(lk) = lk {
+                    lk.alternate_with_vnd(search, &mut s, ctx);
+                }
+                if super::trace_enabled() {
+                    eprintln!(
+                        "ils: best {} by a corridor pass of width {}, {:.2} s",
+                        s.cost + ctx.model.constant(),
+                        self.shape.width,
+                        ctx.elapsed()
+                    );
+                }
+                Some(s)
+            }
+            None => {
+                self.shape.width = (self.shape.width * 2).min(CORRIDOR_MAX_WIDTH);
+                None
+            }
+        }
+    }
 }
 
 /// One record-to-record walk of [`Ils`]: its current solution, its record and the kicks since
@@ -499,27 +600,13 @@ impl Ils {
         let mut label = 0u32;
         let mut seeds: Vec<u32> = Vec::new();
         let mut scratch = Shuffle::default();
-        let mut walks = vec![Walk {
-            record: cur.clone(),
+        let mut walks = self.start_walks(
+            ctx,
+            (&mut search, lk.as_mut()),
             cur,
-            since: 0,
-        }];
-        while self.may_start_walk(ctx, walks.len()) {
-            let mut s = walks[0].record.clone();
-            self.scatter(ctx, (&mut search, lk.as_mut()), &mut s, &mut rng, max_seg);
-            if cheaper(s.cost, best.cost) {
-                best.clone_from(&s);
-                ctx.report(best.cost + m.constant());
-            }
-            walks.push(Walk {
-                record: s.clone(),
-                cur: s,
-                since: 0,
-            });
-        }
-        if super::trace_enabled() && self.walks > 1 {
-            eprintln!("ils: {} walks started, {:.2} s", walks.len(), ctx.elapsed());
-        }
+            &mut best,
+            (&mut rng, max_seg),
+        );
         let mut ruin = Ruin::new(self.ruin_size, self.ruin_string, 0.01);
         let mut w = TwoWay::default();
         let bounded = ctx.budget.max_evals.is_some() || ctx.budget.time_limit.is_some();
@@ -531,6 +618,7 @@ impl Ils {
         let mut shift_repair = ShiftDp::new(self.shift_repair.max(2), 200_000);
         let mut shift_gains = 0u64;
         let trace = super::trace_enabled();
+        let mut passes = Passes::new(self.corridor, n, ctx.evaluations());
         while !ctx.exhausted() {
             if !bounded && since_best >= self.stall {
                 break;
@@ -540,6 +628,17 @@ impl Ils {
             }
             let at = (kicks_done % walks.len() as u64) as usize;
             let walk = &mut walks[at];
+            if passes.due(ctx.evaluations())
+                && let Some(s) = passes.run(ctx, (&mut search, lk.as_mut()), &best)
+            {
+                walk.record.clone_from(&s);
+                walk.cur.clone_from(&s);
+                walk.since = 0;
+                best = s;
+                ctx.report(best.cost + m.constant());
+                since_best = 0;
+                continue;
+            }
             trial.clone_from(&walk.cur);
             seeds.clear();
             let mut kicked = false;
@@ -608,6 +707,7 @@ impl Ils {
                         );
                     }
                     since_best = 0;
+                    passes.mark = ctx.evaluations();
                 }
             }
             if trial.cost <= walk.record.cost + self.accept * walk.record.cost.abs() {
@@ -620,10 +720,46 @@ impl Ils {
         }
         if trace {
             eprintln!(
-                "ils: {kicks_done} kicks, {crosses} crossovers gave a new best, {shift_gains} repairs improved by the shift DP"
+                "ils: {kicks_done} kicks, {crosses} crossovers gave a new best, {shift_gains} repairs improved by the shift DP, {} corridor passes gave {} new bests",
+                passes.runs, passes.gains
             );
         }
         Ok(outcome(m, &best))
+    }
+
+    /// The walks: the first from `first`, the others (`walks` > 1) from its local optimum
+    /// scattered by random feasible reorders, while [`Ils::may_start_walk`] allows; `best`
+    /// follows their records.
+    fn start_walks(
+        &self,
+        ctx: &mut Context,
+        (search, mut lk): (&mut Search, Option<&mut Lk>),
+        first: Solution,
+        best: &mut Solution,
+        (rng, max_seg): (&mut ChaCha8Rng, usize),
+    ) -> Vec<Walk> {
+        let mut walks = vec![Walk {
+            record: first.clone(),
+            cur: first,
+            since: 0,
+        }];
+        while self.may_start_walk(ctx, walks.len()) {
+            let mut s = walks[0].record.clone();
+            self.scatter(ctx, (&mut *search, lk.as_deref_mut()), &mut s, rng, max_seg);
+            if cheaper(s.cost, best.cost) {
+                best.clone_from(&s);
+                ctx.report(best.cost + ctx.model.constant());
+            }
+            walks.push(Walk {
+                record: s.clone(),
+                cur: s,
+                since: 0,
+            });
+        }
+        if super::trace_enabled() && self.walks > 1 {
+            eprintln!("ils: {} walks started, {:.2} s", walks.len(), ctx.elapsed());
+        }
+        walks
     }
 
     /// Whether another walk may start, `started` being under way: fewer than `walks`, budget
@@ -869,4 +1005,46 @@ mod tests {
         ctx.count(1);
         assert!(!ils(0.0).may_start_walk(&ctx, 1), "half the budget is used");
     }
+
+    /// Corridor passes are due once the walk has spent, since the mark, as many evaluations
+    /// as the last pass took (the first estimated as 8 × width × n); width 0 never runs one.
+    /// A walk with passes under an evaluation budget is feasible and the same on every run.
+    #[test]
+    fn corridor_passes_are_scheduled_by_evaluations() {
+        let shape = |width| Shape {
+            diff: 5,
+            reach: 30,
+            width,
+        };
+        let p = Passes::new(shape(10), 5, 100);
+        assert!(!p.due(100 + 399));
+        assert!(p.due(100 + 400));
+        assert!(!Passes::new(shape(0), 5, 0).due(u64::MAX));
+        // dense precedence among 40 cells: pairs (i, j), j = i + 2.., every third one
+        let pairs: Vec<(usize, usize)> = (0..40)
+            .flat_map(|i| (i + 2..40).map(move |j| (i, j)))
+            .filter(|&(i, j)| (i + j) % 3 == 0)
+            .collect();
+        let inst = random_matrix_instance(40, 9, 100, &pairs);
+        let m = CostModel::new(&inst, Objective::Matrix);
+        let ils = Ils {
+            corridor: shape(16),
+            ..from_params(&INFO.check_params(&Default::default()).unwrap())
+        };
+        let run = || {
+            let mut obs = NoObserver;
+            let budget = Budget {
+                time_limit: None,
+                max_evals: Some(300_000),
+            };
+            let mut ctx = Context::new(&inst, &m, 3, budget, &mut obs);
+            ils.run(&mut ctx, None).unwrap()
+        };
+        let (a, b) = (run(), run());
+        assert_eq!(a.sequence, b.sequence);
+        let report = crate::checker::check(&inst, &a.sequence, Objective::Matrix)
+            .expect("a feasible sequence");
+        assert!((report.cost - a.cost).abs() < 1e-6);
+    }
+
 }

@@ -53,6 +53,7 @@ registry! {
     Exact => exact,
     Beam => beam,
     Reopt => reopt,
+    Corridor => corridor,
     TwoOpt => two_opt,
     LocalSearch => local_search,
     Sa => sa,
@@ -491,7 +492,7 @@ mod tests {
         assert!(e.contains("nosuch"), "{e}");
         let e = info.build(&kv("greedy*:1")).err().unwrap().to_string();
         assert!(
-            e.contains("only gls, ils, eacs and reopt can start from an earlier sequence"),
+            e.contains("only gls, ils, eacs, reopt and corridor can start from an earlier sequence"),
             "{e}"
         );
     }

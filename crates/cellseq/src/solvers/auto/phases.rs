@@ -12,9 +12,9 @@ pub enum Start {
     /// From scratch (the solver's own construction).
     #[default]
     Fresh,
-    /// From the best sequence so far (`*` after the name; gls, ils, eacs and reopt only).
+    /// From the best sequence so far (`*` after the name; gls, ils, eacs, reopt and corridor only).
     Best,
-    /// From the sequence of the phase just before (`+`; gls, ils, eacs and reopt only): polishes one
+    /// From the sequence of the phase just before (`+`; gls, ils, eacs, reopt and corridor only): polishes one
     /// colony's result even when an earlier phase found a cheaper sequence.
     Previous,
 }
@@ -154,7 +154,7 @@ pub fn parse_plan(plan: &str) -> Result<Vec<Phase>> {
 }
 
 /// The solvers a plan phase can start from an earlier sequence (`*`, `+`): those whose
-/// capabilities say `starts_from`, as "gls, ils, eacs and reopt".
+/// capabilities say `starts_from`, as "gls, ils, eacs, reopt and corridor".
 fn startable() -> String {
     let mut names: Vec<&str> = super::super::registry()
         .into_iter()
