@@ -400,6 +400,7 @@ fn the_built_in_portfolio_parses_validates_and_ends_with_a_catch_all() {
             "free",
             "sparse-modes",
             "sparse",
+            "dense-random",
             "dense",
             "geometric-free",
             "default"
@@ -515,7 +516,7 @@ fn bad_portfolios_are_refused_naming_the_file_and_the_entry() {
                     "{ solver = \"greedy\", share = 1.0, start = \"best\" }"
                 )
             ),
-            "only gls, ils, eacs and reopt can start from an earlier sequence",
+            "only gls, ils, eacs, reopt and corridor can start from an earlier sequence",
         ),
         (
             format!(
