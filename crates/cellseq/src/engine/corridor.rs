@@ -23,7 +23,8 @@
 //!
 //! Cost: about `width × (reach + diff)` candidate steps per position, each an O(1) link and a
 //! precedence check against the direct predecessors; the pilot is O(`diff`). Memory: one
-//! parent index and position per kept state, `n × width` of them.
+//! parent index and position per kept state, `n × width` of them, and one length's children;
+//! the width is capped to keep both bounded ([`MAX_STATES`], [`MAX_CHILDREN`]).
 
 use super::{Costs, Slot, Solution};
 use crate::context::Context;
@@ -37,8 +38,12 @@ pub const MAX_DIFF: usize = 8;
 /// length.
 pub const MAX_REACH: usize = 63;
 
-/// Largest number of kept states over all lengths (`n × width`): 2^25, 256 MiB of history.
-pub const MAX_STATES: usize = 1 << 25;
+/// Largest number of kept states over all lengths (`n × width`): 2^24, 128 MiB of history.
+pub const MAX_STATES: usize = 1 << 24;
+
+/// Largest number of children one length may hold (`width × (reach + diff + 1)`, each with
+/// its index entry): 2^21, about 150 MiB.
+pub const MAX_CHILDREN: usize = 1 << 21;
 
 /// No last cell: the path's start.
 const START: u32 = u32::MAX;
@@ -161,7 +166,9 @@ fn possible(c: &Costs, s: &Solution, k: u32, reach: u32, diff: usize, out: &mut 
 
 /// The cheapest sequence the corridor search finds around `s`, as the new cell order with its
 /// cost, when it is cheaper than `s`; `None` when it is not, or when the budget ran out.
-/// Counts one evaluation per candidate step and polls the budget once per prefix length.
+/// Counts one evaluation per candidate step and per kept child; reads the budget at every
+/// prefix length and every 1024 states within one. The width is capped so that the history
+/// (`n × width`) and one length's children stay within [`MAX_STATES`] and [`MAX_CHILDREN`].
 pub fn improve(c: &Costs, s: &Solution, ctx: &mut Context, k: Corridor) -> Option<(Vec<u32>, f64)> {
     let n = s.n();
     if n < 3 || n >= START as usize {
@@ -169,8 +176,12 @@ pub fn improve(c: &Costs, s: &Solution, ctx: &mut Context, k: Corridor) -> Optio
     }
     let m = c.m;
     let diff = k.diff.clamp(1, MAX_DIFF);
-    let width = k.width.clamp(1, (MAX_STATES / n).max(1));
     let r = k.reach.clamp(1, MAX_REACH) as u32;
+    let width = k
+        .width
+        .min(MAX_STATES / n)
+        .min(MAX_CHILDREN / (r as usize + diff + 1))
+        .max(1);
     let mut tail = vec![0.0; n + 1];
     for p in (0..n).rev() {
         tail[p] = tail[p + 1] + s.link(c, p as isize, p as isize + 1);
@@ -196,7 +207,7 @@ pub fn improve(c: &Costs, s: &Solution, ctx: &mut Context, k: Corridor) -> Optio
     let mut scored: Vec<(f64, u32)> = Vec::new();
     let mut ahead_ok: Vec<u32> = Vec::new();
     for depth in 0..n as u32 {
-        if ctx.exhausted_polled() {
+        if ctx.exhausted() {
             return None;
         }
         children.clear();
@@ -204,6 +215,10 @@ pub fn improve(c: &Costs, s: &Solution, ctx: &mut Context, k: Corridor) -> Optio
         possible(c, s, depth, r, diff, &mut ahead_ok);
         let mut evals = 0u64;
         for (pi, st) in level.iter().enumerate() {
+            // a wide level takes tens of milliseconds: the clock is read within it too
+            if pi % 1024 == 1023 && ctx.exhausted() {
+                return None;
+            }
             let mut behind = st.mask & low;
             let behind_cells = std::iter::from_fn(|| {
                 (behind != 0).then(|| {
