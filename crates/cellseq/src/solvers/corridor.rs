@@ -3,10 +3,9 @@
 
 use super::Build;
 use super::StartsFrom;
-use super::start::{greedy_solution, outcome};
+use super::start::{given_or_polished, outcome};
 use super::{Caps, Context, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo};
 use crate::engine::corridor::{self, Corridor as Shape, MAX_DIFF, MAX_REACH};
-use crate::engine::vnd::Search;
 use crate::engine::{Costs, Solution};
 use crate::error::Result;
 use crate::model::{Sequence, Visit};
@@ -107,19 +106,10 @@ impl Corridor {
     pub fn run(&self, ctx: &mut Context, start: Option<Solution>) -> Result<Outcome> {
         let m = ctx.model;
         let c = Costs::open(m);
-        let fresh = start.is_none();
-        let mut s = match start {
-            Some(s) => s,
-            None => greedy_solution(ctx, &c),
-        };
-        if ctx.deadline().passed() {
+        let (mut s, search) = given_or_polished(ctx, c, start, self.k);
+        let Some(mut search) = search else {
             return Ok(outcome(m, &s));
-        }
-        let mut search = Search::new_until(c, self.k, ctx.deadline());
-        if fresh {
-            search.vnd(&mut s, ctx);
-        }
-        ctx.report(s.cost + m.constant());
+        };
         let mut width = self.width.min(self.max_width);
         let (mut passes, mut gains) = (0u64, 0u64);
         while !ctx.exhausted() {

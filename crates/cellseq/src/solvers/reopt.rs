@@ -28,12 +28,11 @@
 
 use super::Build;
 use super::StartsFrom;
-use super::start::{greedy_solution, outcome};
+use super::start::{given_or_polished, outcome};
 use super::{
     Budget, Caps, Context, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo, Sub,
 };
 use crate::cost::CostModel;
-use crate::engine::vnd::Search;
 use crate::engine::{Costs, Slot, Solution};
 use crate::error::Result;
 use crate::model::{Cell, CostMatrix, Instance, Mode, Objective, Sequence, Visit};
@@ -273,19 +272,10 @@ impl Reopt {
         let m = ctx.model;
         let n = m.n();
         let c = Costs::open(m);
-        let fresh = start.is_none();
-        let mut s = match start {
-            Some(s) => s,
-            None => greedy_solution(ctx, &c),
-        };
-        if ctx.deadline().passed() {
+        let (mut s, search) = given_or_polished(ctx, c, start, self.k);
+        let Some(mut search) = search else {
             return Ok(outcome(m, &s));
-        }
-        let mut search = Search::new_until(c, self.k, ctx.deadline());
-        if fresh {
-            search.vnd(&mut s, ctx);
-        }
-        ctx.report(s.cost + m.constant());
+        };
         if n < 2 {
             return Ok(outcome(m, &s));
         }

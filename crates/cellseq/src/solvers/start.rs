@@ -4,6 +4,7 @@ use super::{Context, Outcome, outcome_of};
 use crate::clock::Ticker;
 use crate::construct::{edge, greedy, insertion};
 use crate::cost::CostModel;
+use crate::engine::vnd::Search;
 use crate::engine::{Costs, Solution};
 use crate::model::{Sequence, Visit};
 use rand::RngExt;
@@ -27,6 +28,32 @@ pub fn greedy_solution(ctx: &mut Context, c: &Costs) -> Solution {
     let s = Solution::new(c, &seq);
     ctx.report(s.cost + c.m.constant());
     s
+}
+
+/// The start of an improvement solver that may be given one: `start`, or else the greedy
+/// sequence polished by the VND with `k` candidates, reported to the observer; with the
+/// search to go on with, or `None` when the time limit passed before it was built (the start
+/// is then the answer).
+pub fn given_or_polished<'a>(
+    ctx: &mut Context,
+    c: Costs<'a>,
+    start: Option<Solution>,
+    k: usize,
+) -> (Solution, Option<Search<'a>>) {
+    let fresh = start.is_none();
+    let mut s = match start {
+        Some(s) => s,
+        None => greedy_solution(ctx, &c),
+    };
+    if ctx.deadline().passed() {
+        return (s, None);
+    }
+    let mut search = Search::new_until(c, k, ctx.deadline());
+    if fresh {
+        search.vnd(&mut s, ctx);
+    }
+    ctx.report(s.cost + c.m.constant());
+    (s, Some(search))
 }
 
 /// The best of the greedy start; on geometric instances with precedence (up to
