@@ -17,7 +17,9 @@
 //! that share of the budget is used, down to one: the `symmetric` rule's plan without a beam
 //! runs eight walks so (notes/lab/halved-walks.md). Walks then start only within the first
 //! such share: on 1500 cells eight starts took a whole 10 s budget
-//! (notes/lab/large-symmetric-kicks.md).
+//! (notes/lab/large-symmetric-kicks.md). With `corridor` the walk, once stalled, shares the
+//! budget with corridor passes from the best ([`crate::engine::corridor`];
+//! notes/lab/corridor.md).
 
 use super::Build;
 use super::StartsFrom;
@@ -58,6 +60,10 @@ crossover: the two sequences are cut wherever their prefixes hold the same cells
 cheapest feasible mix of segments is kept, in O(n).
 - **Acceptance**: record-to-record, within `accept` above the best; a restart from the best \
 after `restart` kicks without a gain.
+- **Corridor passes** (`corridor` > 0): once the walk has spent as many evaluations since its \
+last record as the last pass took, the corridor search (engine::corridor) reorders the best \
+within prefixes that differ from its own by at most `corridor-diff` cells; a gain is \
+polished and the walk goes on from it. In `auto` the `dense-random` rule runs them.
 - On instances whose cells have several modes (PCGTSPLIB), the polish of a new best adds \
 window moves with modes (a cell moved inside a 5-position window while the modes around it \
 are re-chosen); `window-repair=true` runs them in every repair as well.",
