@@ -67,11 +67,12 @@ its `max_cells` cells and, under a wall-clock budget, only when that budget is a
 `min_seconds`; when it proves the optimum, `auto` stops there.
 2. Then the rule's phases (or its `after_beam` phases after a beam phase that ran). The \
 built-in rules: **symmetric** cost matrices with one mode per cell (a short `local-search`, \
-then `ils` with Lin–Kernighan chains in a 1 % acceptance band, eight walks of which the worse \
-half is dropped at 15, 30 and 45 % of its budget, or one walk from the beam's sequence when \
-the beam ran; above 400 cells **symmetric-large**, that `ils` alone without the local search, \
-its kicks reordering at most 10 cells under sparse precedence, and **symmetric-large-dense**, \
-with the longer kicks, from closure density 0.2) \
+then guided local search, `gls`, also after the beam when it ran; on 401–1000 cells with \
+closure density below 0.8 **symmetric-medium**, `gls` alone; otherwise above 400 cells \
+**symmetric-large**, `ils` with Lin–Kernighan chains in a 1 % acceptance band, eight walks of \
+which the worse half is dropped at 15, 30 and 45 % of its budget, its kicks reordering at most \
+10 cells under sparse precedence, and **symmetric-large-dense**, with the longer kicks, from \
+closure density 0.2) \
 and **symmetric-modes**, several modes per cell (a colony before `ils`); \
 **free** asymmetric matrices with no precedence apart from a fixed start and end (`atsp`); \
 **sparse** precedence (a short `local-search`, a colony run backwards, `ils` in a 1 % then a 3 \
@@ -81,7 +82,9 @@ cells **sparse-modes** (three rounds of a fresh colony, each polished by `ils` i
 band, then `ils` in the 3 % band from the best of the three and window re-optimization); \
 **dense** precedence (a short `local-search`, then \
 `ils` with kicks that reorder up to 45 cells; on up to 300 cells, when the beam runs, half the \
-budget for the beam, then the default phases); **geometric free** instances (geometric, no or \
+budget for the beam, then the default phases), and with costs spread as random ones \
+(`cost_spread` 0.5 and above) **dense-random**, whose walk also runs corridor passes when it \
+stalls; **geometric free** instances (geometric, no or \
 very sparse precedence, links that cost the same both ways: `local-search` on the two-level \
 list with local and random-walk double-bridge kicks for the whole budget); and the catch-all \
 **default**, the other geometric instances among them (`local-search`, an `eacs` colony of its \
