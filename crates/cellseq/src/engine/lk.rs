@@ -174,6 +174,20 @@ impl Lk {
         .filter(|l| mode == Some(true) || l.symmetric)
     }
 
+    /// The full descent: `search`'s VND, then, where Lin–Kernighan runs (`lk`), LK
+    /// alternating with the VND ([`Lk::alternate_with_vnd`]).
+    pub fn full_descent(
+        lk: Option<&mut Lk>,
+        search: &mut Search,
+        s: &mut Solution,
+        ctx: &mut Context,
+    ) {
+        search.vnd(s, ctx);
+        if let Some(lk) = lk {
+            lk.alternate_with_vnd(search, s, ctx);
+        }
+    }
+
     /// Alternates LK from every cell with `search`'s VND until LK finds nothing or the budget
     /// ends (the polish of a new best).
     pub fn alternate_with_vnd(&mut self, search: &mut Search, s: &mut Solution, ctx: &mut Context) {

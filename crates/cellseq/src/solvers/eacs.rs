@@ -380,11 +380,8 @@ impl Eacs {
             return Ok(outcome(m, &best));
         }
         let mut search = Search::new_until(c, self.k, ctx.deadline());
-        search.vnd(&mut best, ctx);
         let mut lk = Lk::when(self.lk, &c, 12, 3);
-        if let Some(lk) = lk.as_mut() {
-            lk.alternate_with_vnd(&mut search, &mut best, ctx);
-        }
+        Lk::full_descent(lk.as_mut(), &mut search, &mut best, ctx);
         ctx.report(best.cost + m.constant());
         if n < 3 {
             return Ok(outcome(m, &best));
@@ -459,10 +456,7 @@ impl Eacs {
                     }
                 }
                 if cheaper(s.cost, best.cost) {
-                    search.vnd(&mut s, ctx);
-                    if let Some(lk) = lk.as_mut() {
-                        lk.alternate_with_vnd(&mut search, &mut s, ctx);
-                    }
+                    Lk::full_descent(lk.as_mut(), &mut search, &mut s, ctx);
                     best = s;
                     ctx.report(best.cost + m.constant());
                     improved = true;

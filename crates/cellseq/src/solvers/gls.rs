@@ -33,7 +33,7 @@ use crate::cost::CostModel;
 use crate::engine::lk::Lk;
 use crate::engine::neighbours::Neighbours;
 use crate::engine::vnd::Search;
-use crate::engine::{Costs, Solution};
+use crate::engine::{Costs, Solution, cheaper};
 use crate::error::Result;
 use crate::model::Sequence;
 use rustc_hash::FxHashMap;
@@ -198,10 +198,7 @@ fn descend(
     ctx: &mut Context,
 ) -> Neighbours {
     let mut search = Search::with_neighbours(c, nb);
-    search.vnd(s, ctx);
-    if let Some(lk) = lk.as_mut() {
-        lk.alternate_with_vnd(&mut search, s, ctx);
-    }
+    Lk::full_descent(lk.as_mut(), &mut search, s, ctx);
     search.nb
 }
 
@@ -264,7 +261,7 @@ impl Gls {
             s.cost = s.evaluate(&pc);
             nb = repair(pc, nb, &mut lk, &mut s, ctx, &seeds);
             let real = s.evaluate(&c);
-            if real < best.cost - 1e-9 * best.cost.abs().max(1.0) {
+            if cheaper(real, best.cost) {
                 let mut t = s.clone();
                 t.cost = real;
                 nb = descend(c, nb, &mut lk, &mut t, ctx);

@@ -389,10 +389,7 @@ impl Passes {
                     .map(|&x| Visit::new(x as usize, best.mode[x as usize] as usize))
                     .collect();
                 let mut s = Solution::new(c, &seq);
-                search.vnd(&mut s, ctx);
-                if let Some(lk) = lk {
-                    lk.alternate_with_vnd(search, &mut s, ctx);
-                }
+                Lk::full_descent(lk, search, &mut s, ctx);
                 if super::trace_enabled() {
                     eprintln!(
                         "ils: best {} by a corridor pass of width {}, {:.2} s",
@@ -696,10 +693,7 @@ impl Ils {
             }
             if crossed || cheaper(trial.cost, walk.record.cost) {
                 // polish a new record with the full descent before keeping it
-                search.vnd(&mut trial, ctx);
-                if let Some(lk) = lk.as_mut() {
-                    lk.alternate_with_vnd(&mut search, &mut trial, ctx);
-                }
+                Lk::full_descent(lk.as_mut(), &mut search, &mut trial, ctx);
                 walk.record.clone_from(&trial);
                 walk.since = 0;
                 if crossed || cheaper(trial.cost, best.cost) {
@@ -836,10 +830,7 @@ impl Ils {
             shuffle(&c, s, rng, max_seg, &mut scratch, &mut seeds);
         }
         ctx.count(seeds.len() as u64 + 1);
-        search.vnd(s, ctx);
-        if let Some(lk) = lk {
-            lk.alternate_with_vnd(search, s, ctx);
-        }
+        Lk::full_descent(lk, search, s, ctx);
     }
 
     /// Repairs a kicked `trial` around the kicked cells `seeds`: Or-opt, SOP-3-exchange and
