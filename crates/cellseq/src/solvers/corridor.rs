@@ -4,7 +4,7 @@
 use super::Build;
 use super::StartsFrom;
 use super::start::{given_or_polished, outcome};
-use super::{Caps, Context, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo};
+use super::{Caps, Context, Outcome, ParamKind, ParamSpec, Params, SolverInfo};
 use crate::engine::corridor::{self, Corridor as Shape, MAX_DIFF, MAX_REACH};
 use crate::engine::{Costs, Solution};
 use crate::error::Result;
@@ -87,23 +87,10 @@ pub struct Corridor {
     pub k: usize,
 }
 
-impl Solver for Corridor {
-    fn solve(&self, ctx: &mut Context) -> Result<Outcome> {
-        self.run(ctx, None)
-    }
-}
-
 impl StartsFrom for Corridor {
-    fn start_from(&self, ctx: &mut Context, start: &Sequence) -> Result<Outcome> {
-        let start = Solution::new(&Costs::open(ctx.model), start);
-        self.run(ctx, Some(start))
-    }
-}
-
-impl Corridor {
     /// Runs the passes from `start` (evaluated with open-loop costs), or from the greedy
     /// sequence polished by the VND when `start` is `None`.
-    pub fn run(&self, ctx: &mut Context, start: Option<Solution>) -> Result<Outcome> {
+    fn run_from(&self, ctx: &mut Context, start: Option<Solution>) -> Result<Outcome> {
         let m = ctx.model;
         let c = Costs::open(m);
         let (mut s, search) = given_or_polished(ctx, c, start, self.k);

@@ -25,7 +25,7 @@ use super::Build;
 use super::StartsFrom;
 use super::aco::{COLONY, Pheromone};
 use super::start::{greedy_solution, outcome};
-use super::{Caps, Context, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo};
+use super::{Caps, Context, Outcome, ParamKind, ParamSpec, Params, SolverInfo};
 use crate::clock::Ticker;
 use crate::engine::crossover::Crossover;
 use crate::engine::lk::Lk;
@@ -352,23 +352,10 @@ pub fn focused_descent(
     }
 }
 
-impl Solver for Eacs {
-    fn solve(&self, ctx: &mut Context) -> Result<Outcome> {
-        self.run(ctx, None)
-    }
-}
-
 impl StartsFrom for Eacs {
-    fn start_from(&self, ctx: &mut Context, start: &Sequence) -> Result<Outcome> {
-        let start = Solution::new(&Costs::open(ctx.model), start);
-        self.run(ctx, Some(start))
-    }
-}
-
-impl Eacs {
     /// Runs the colony from `start` (evaluated with open-loop costs), or from the greedy
     /// sequence when `start` is `None`.
-    pub fn run(&self, ctx: &mut Context, start: Option<Solution>) -> Result<Outcome> {
+    fn run_from(&self, ctx: &mut Context, start: Option<Solution>) -> Result<Outcome> {
         let m = ctx.model;
         let n = m.n();
         let c = Costs::open(m);

@@ -27,7 +27,7 @@
 use super::Build;
 use super::start::{greedy_solution, outcome};
 use super::{
-    Caps, Context, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo, StartsFrom,
+    Caps, Context, Outcome, ParamKind, ParamSpec, Params, SolverInfo, StartsFrom,
 };
 use crate::cost::CostModel;
 use crate::engine::lk::Lk;
@@ -35,7 +35,6 @@ use crate::engine::neighbours::Neighbours;
 use crate::engine::vnd::Search;
 use crate::engine::{Costs, Solution, cheaper};
 use crate::error::Result;
-use crate::model::Sequence;
 use rustc_hash::FxHashMap;
 
 /// Registry entry.
@@ -100,19 +99,6 @@ pub struct Gls {
     pub top: usize,
     /// Candidate neighbours per cell.
     pub k: usize,
-}
-
-impl Solver for Gls {
-    fn solve(&self, ctx: &mut Context) -> Result<Outcome> {
-        self.run(ctx, None)
-    }
-}
-
-impl StartsFrom for Gls {
-    fn start_from(&self, ctx: &mut Context, start: &Sequence) -> Result<Outcome> {
-        let s = Solution::new(&Costs::open(ctx.model), start);
-        self.run(ctx, Some(s))
-    }
 }
 
 /// Whether penalties apply to this model (see the module documentation).
@@ -227,8 +213,8 @@ fn repair(
     search.nb
 }
 
-impl Gls {
-    fn run(&self, ctx: &mut Context, start: Option<Solution>) -> Result<Outcome> {
+impl StartsFrom for Gls {
+    fn run_from(&self, ctx: &mut Context, start: Option<Solution>) -> Result<Outcome> {
         let m = ctx.model;
         let c = Costs::open(m);
         let mut s = match start {
@@ -284,7 +270,8 @@ mod tests {
     use super::*;
     use crate::context::NoObserver;
     use crate::engine::atsp::random_matrix_instance;
-    use crate::model::{CostMatrix, Objective};
+    use crate::model::{CostMatrix, Objective, Sequence};
+    use crate::solvers::Solver;
     use crate::solvers::Budget;
 
     /// The links of highest `cost / (1 + penalty)` get the penalties, ties to the earlier

@@ -24,7 +24,7 @@
 use super::Build;
 use super::StartsFrom;
 use super::start::{greedy_solution, outcome};
-use super::{Caps, Context, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo};
+use super::{Caps, Context, Outcome, ParamKind, ParamSpec, Params, SolverInfo};
 use crate::engine::corridor::{self, Corridor as Shape};
 use crate::engine::crossover::Crossover;
 use crate::engine::lk::Lk;
@@ -563,23 +563,10 @@ struct Shuffle {
     out: Vec<u32>,
 }
 
-impl Solver for Ils {
-    fn solve(&self, ctx: &mut Context) -> Result<Outcome> {
-        self.run(ctx, None)
-    }
-}
-
 impl StartsFrom for Ils {
-    fn start_from(&self, ctx: &mut Context, start: &Sequence) -> Result<Outcome> {
-        let start = Solution::new(&Costs::open(ctx.model), start);
-        self.run(ctx, Some(start))
-    }
-}
-
-impl Ils {
     /// Runs the search from `start` (evaluated with open-loop costs), or from the greedy
     /// sequence when `start` is `None`.
-    pub fn run(&self, ctx: &mut Context, start: Option<Solution>) -> Result<Outcome> {
+    fn run_from(&self, ctx: &mut Context, start: Option<Solution>) -> Result<Outcome> {
         let m = ctx.model;
         let n = m.n();
         let c = Costs::open(m);
@@ -726,7 +713,9 @@ impl Ils {
         }
         Ok(outcome(m, &best))
     }
+}
 
+impl Ils {
     /// The walks: the first from `first`, the others (`walks` > 1) from its local optimum
     /// scattered by random feasible reorders, while [`Ils::may_start_walk`] allows; `best`
     /// follows their records.
@@ -1035,7 +1024,7 @@ mod tests {
                 max_evals: Some(300_000),
             };
             let mut ctx = Context::new(&inst, &m, 3, budget, &mut obs);
-            ils.run(&mut ctx, None).unwrap()
+            ils.run_from(&mut ctx, None).unwrap()
         };
         let (a, b) = (run(), run());
         assert_eq!(a.sequence, b.sequence);

@@ -1,8 +1,8 @@
 //! Solvers: one [`SolverKind`] per registry entry, what each declares ([`SolverInfo`]: name,
 //! summary, description, parameters, capabilities), and how they are run.
 //!
-//! To add a solver: write `src/solvers/<name>.rs` with a type implementing [`Solver`] (and
-//! [`StartsFrom`] or [`WarmStart`] when it can take a start sequence) and a
+//! To add a solver: write `src/solvers/<name>.rs` with a type implementing [`Solver`] (or
+//! [`StartsFrom`], which makes it one, or [`WarmStart`] when it can take a start sequence) and a
 //! `pub static INFO: SolverInfo` that declares everything about it, then add one line to the
 //! `registry!` list below. The [`SolverKind`] variant, [`registry`], `docs/solvers.md`
 //! ([`markdown`]) and the conformance tests (which iterate [`SolverKind::ALL`]) follow from it.
@@ -75,6 +75,7 @@ pub use docs::{kind_label, markdown};
 
 use crate::checker::{Report, check};
 use crate::cost::CostModel;
+use crate::engine::{Costs, Solution};
 use crate::error::{Error, Result};
 use crate::model::{Instance, Objective, Sequence};
 use std::collections::BTreeMap;
@@ -95,10 +96,18 @@ pub trait Solver: Send + Sync {
 }
 
 /// A solver that searches from a given sequence and returns one no worse (a plan phase may
-/// start it from an earlier phase's sequence: `*`, `+`).
-pub trait StartsFrom: Solver {
-    /// Runs the algorithm from `start`, a feasible sequence of the context's instance.
-    fn start_from(&self, ctx: &mut Context, start: &Sequence) -> Result<Outcome>;
+/// start it from an earlier phase's sequence: `*`, `+`), or from a start of its own; every
+/// such type is a [`Solver`] that runs from its own start.
+pub trait StartsFrom: Send + Sync {
+    /// Runs the algorithm from `start`, a feasible sequence of the context's instance
+    /// evaluated with open-loop costs, or from the solver's own start when `None`.
+    fn run_from(&self, ctx: &mut Context, start: Option<Solution>) -> Result<Outcome>;
+}
+
+impl<T: StartsFrom> Solver for T {
+    fn solve(&self, ctx: &mut Context) -> Result<Outcome> {
+        self.run_from(ctx, None)
+    }
 }
 
 /// A solver that takes a given sequence as its first incumbent (an upper bound to prune with)
@@ -137,9 +146,12 @@ impl Built {
     pub fn run(&self, ctx: &mut Context, start: Option<&Sequence>, name: &str) -> Result<Outcome> {
         match (self, start) {
             (Built::Fresh(s), None) => s.solve(ctx),
-            (Built::StartsFrom(s), None) => s.solve(ctx),
+            (Built::StartsFrom(s), None) => s.run_from(ctx, None),
             (Built::WarmStart(s), None) => s.solve(ctx),
-            (Built::StartsFrom(s), Some(q)) => s.start_from(ctx, q),
+            (Built::StartsFrom(s), Some(q)) => {
+                let start = Solution::new(&Costs::open(ctx.model), q);
+                s.run_from(ctx, Some(start))
+            }
             (Built::WarmStart(s), Some(q)) => s.warm_start(ctx, q),
             (Built::Fresh(_), Some(_)) => Err(Error::Solver {
                 solver: name.to_string(),

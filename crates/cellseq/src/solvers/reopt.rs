@@ -30,7 +30,7 @@ use super::Build;
 use super::StartsFrom;
 use super::start::{given_or_polished, outcome};
 use super::{
-    Budget, Caps, Context, Outcome, ParamKind, ParamSpec, Params, Solver, SolverInfo, Sub,
+    Budget, Caps, Context, Outcome, ParamKind, ParamSpec, Params, SolverInfo, Sub,
 };
 use crate::cost::CostModel;
 use crate::engine::{Costs, Slot, Solution};
@@ -117,19 +117,6 @@ pub struct Reopt {
     pub max_window: usize,
     /// Candidate neighbours of the polishing VND.
     pub k: usize,
-}
-
-impl Solver for Reopt {
-    fn solve(&self, ctx: &mut Context) -> Result<Outcome> {
-        self.run(ctx, None)
-    }
-}
-
-impl StartsFrom for Reopt {
-    fn start_from(&self, ctx: &mut Context, start: &Sequence) -> Result<Outcome> {
-        let start = Solution::new(&Costs::open(ctx.model), start);
-        self.run(ctx, Some(start))
-    }
 }
 
 /// The sub-instance of the cells at positions `lo..hi` of `s` between their fixed neighbours
@@ -266,9 +253,12 @@ impl Reopt {
         Ok((true, out.proven_optimal))
     }
 
+}
+
+impl StartsFrom for Reopt {
     /// Runs the sweeps from `start` (evaluated with open-loop costs), or from the greedy
     /// sequence polished by the VND when `start` is `None`.
-    pub fn run(&self, ctx: &mut Context, start: Option<Solution>) -> Result<Outcome> {
+    fn run_from(&self, ctx: &mut Context, start: Option<Solution>) -> Result<Outcome> {
         let m = ctx.model;
         let n = m.n();
         let c = Costs::open(m);
