@@ -37,6 +37,15 @@ impl Solution {
         s.cost = s.evaluate(c);
         s
     }
+    /// The cells of `order` (a permutation of this solution's cells) in that order, each in its
+    /// mode here, evaluated.
+    pub fn reordered(&self, c: &Costs, order: &[u32]) -> Solution {
+        let seq: Sequence = order
+            .iter()
+            .map(|&x| Visit::new(x as usize, self.mode[x as usize] as usize))
+            .collect();
+        Solution::new(c, &seq)
+    }
     /// Number of cells.
     #[inline]
     pub fn n(&self) -> usize {

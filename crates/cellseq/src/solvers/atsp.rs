@@ -228,11 +228,7 @@ impl Atsp {
                 let mut ctx = ctx_cell.borrow_mut();
                 let leaf = value.is_some();
                 leaves += u64::from(leaf);
-                let seq: Vec<Visit> = order
-                    .iter()
-                    .map(|&x| Visit::new(x as usize, best.mode[x as usize] as usize))
-                    .collect();
-                let mut s = Solution::new(c, &seq);
+                let mut s = best.reordered(c, order);
                 if !s.feasible(m) {
                     rejected |= leaf;
                     return best.cost;

@@ -3,12 +3,11 @@
 
 use super::Build;
 use super::StartsFrom;
-use super::start::{given_or_polished, outcome};
+use super::start::{POLISH_K, given_or_polished, outcome};
 use super::{Caps, Context, Outcome, ParamKind, ParamSpec, Params, SolverInfo};
 use crate::engine::corridor::{self, Corridor as Shape, MAX_DIFF, MAX_REACH};
 use crate::engine::{Costs, Solution};
 use crate::error::Result;
-use crate::model::{Sequence, Visit};
 
 /// Registry entry.
 pub static INFO: SolverInfo = SolverInfo {
@@ -48,12 +47,7 @@ makes at once, lie in a corridor of five. Alone it starts from `greedy`.",
             kind: ParamKind::int(1, 1 << 24),
             help: "passes without a gain double the width up to this; a pass at it without a gain ends the run",
         },
-        ParamSpec {
-            name: "k",
-            default: "12",
-            kind: ParamKind::int(1, crate::params::MAX_NEIGHBOURS),
-            help: "candidate neighbours per cell of the VND that polishes a gain",
-        },
+        POLISH_K,
     ],
     caps: Caps {
         improves: true,
@@ -109,11 +103,7 @@ impl StartsFrom for Corridor {
             match corridor::improve(&c, &s, ctx, shape) {
                 Some((order, _)) => {
                     gains += 1;
-                    let seq: Sequence = order
-                        .iter()
-                        .map(|&x| Visit::new(x as usize, s.mode[x as usize] as usize))
-                        .collect();
-                    s = Solution::new(&c, &seq);
+                    s = s.reordered(&c, &order);
                     search.vnd(&mut s, ctx);
                     ctx.report(s.cost + m.constant());
                     if super::trace_enabled() {

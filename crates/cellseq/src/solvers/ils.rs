@@ -35,7 +35,6 @@ use crate::engine::sop3x::{TwoWay, sop3_two_way};
 use crate::engine::vnd::Search;
 use crate::engine::{Costs, Solution, cheaper};
 use crate::error::Result;
-use crate::model::{Sequence, Visit};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -384,11 +383,7 @@ impl Passes {
         match found {
             Some((order, _)) => {
                 self.gains += 1;
-                let seq: Sequence = order
-                    .iter()
-                    .map(|&x| Visit::new(x as usize, best.mode[x as usize] as usize))
-                    .collect();
-                let mut s = Solution::new(c, &seq);
+                let mut s = best.reordered(c, &order);
                 Lk::full_descent(lk, search, &mut s, ctx);
                 if super::trace_enabled() {
                     eprintln!(
@@ -1032,5 +1027,4 @@ mod tests {
             .expect("a feasible sequence");
         assert!((report.cost - a.cost).abs() < 1e-6);
     }
-
 }

@@ -28,7 +28,7 @@
 
 use super::Build;
 use super::StartsFrom;
-use super::start::{given_or_polished, outcome};
+use super::start::{POLISH_K, given_or_polished, outcome};
 use super::{
     Budget, Caps, Context, Outcome, ParamKind, ParamSpec, Params, SolverInfo, Sub,
 };
@@ -80,12 +80,7 @@ the built-in portfolio's `sparse` rule, from the best so far. On rbg323a it turn
             kind: ParamKind::int(2, MAX_WINDOW),
             help: "windows grow up to this many cells; a sweep at this size without a gain ends the run",
         },
-        ParamSpec {
-            name: "k",
-            default: "12",
-            kind: ParamKind::int(1, crate::params::MAX_NEIGHBOURS),
-            help: "candidate neighbours per cell of the VND that polishes a gain",
-        },
+        POLISH_K,
     ],
     caps: Caps {
         improves: true,

@@ -1,6 +1,6 @@
 //! Shared pieces of the improvement solvers: start solutions and result reporting.
 
-use super::{Context, Outcome, outcome_of};
+use super::{Context, Outcome, ParamKind, ParamSpec, outcome_of};
 use crate::clock::Ticker;
 use crate::construct::{edge, greedy, insertion};
 use crate::cost::CostModel;
@@ -29,6 +29,15 @@ pub fn greedy_solution(ctx: &mut Context, c: &Costs) -> Solution {
     ctx.report(s.cost + c.m.constant());
     s
 }
+
+/// The `k` parameter of a solver whose start comes from [`given_or_polished`] and whose gains
+/// the VND polishes.
+pub const POLISH_K: ParamSpec = ParamSpec {
+    name: "k",
+    default: "12",
+    kind: ParamKind::int(1, crate::params::MAX_NEIGHBOURS),
+    help: "candidate neighbours per cell of the VND that polishes a gain",
+};
 
 /// The start of an improvement solver that may be given one: `start`, or else the greedy
 /// sequence polished by the VND with `k` candidates, reported to the observer; with the
