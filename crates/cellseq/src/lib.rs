@@ -102,6 +102,8 @@ pub mod registry {
     pub const PORTFOLIO_MAX_BYTES: u64 = crate::solvers::auto::portfolio::MAX_FILE_BYTES;
     /// Largest `beam.stretch` of a portfolio rule (the least is 1).
     pub const PORTFOLIO_MAX_STRETCH: f64 = crate::solvers::auto::portfolio::MAX_STRETCH;
+    /// Largest `long.min_evals` of a portfolio rule (the least is 0).
+    pub const PORTFOLIO_MAX_LONG_EVALS: f64 = crate::solvers::auto::portfolio::MAX_LONG_EVALS;
 }
 
 /// What most programs need, in one `use cellseq::prelude::*;`.

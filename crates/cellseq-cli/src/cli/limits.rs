@@ -156,11 +156,13 @@ the key); under these limits no cost of any sequence can overflow.\n\n",
     ]);
     rows.push(vec![
         "portfolio file".into(),
-        "size; `share`; `min_seconds`; `beam.stretch`; conditions".into(),
+        "size; `share`; `min_seconds` (beam and `long`); `beam.stretch`; `long.min_evals`; conditions"
+            .into(),
         format!(
-            "at most {} bytes; [0, 1]; at least 0; [1, {}]; finite numbers ([portfolio.md](portfolio.md))",
+            "at most {} bytes; [0, 1]; at least 0; [1, {}]; [0, {:e}]; finite numbers ([portfolio.md](portfolio.md))",
             cellseq::registry::PORTFOLIO_MAX_BYTES,
-            cellseq::registry::PORTFOLIO_MAX_STRETCH
+            cellseq::registry::PORTFOLIO_MAX_STRETCH,
+            cellseq::registry::PORTFOLIO_MAX_LONG_EVALS
         ),
     ]);
     table(out, &["file", "value", "accepts"], &rows);

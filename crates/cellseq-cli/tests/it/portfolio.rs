@@ -14,6 +14,13 @@ fn evals(n: u64) -> Budget {
     }
 }
 
+fn secs(s: f64) -> Budget {
+    Budget {
+        time_limit: Some(std::time::Duration::from_secs_f64(s)),
+        max_evals: None,
+    }
+}
+
 #[test]
 fn plans_parse_and_bad_plans_are_rejected() {
     let p = parse_plan("local-search:0.3, eacs*:0.5,ils*:1").unwrap();
@@ -182,10 +189,10 @@ fn auto_picks_its_rule_by_symmetry_and_precedence_density() {
     assert_eq!(c.rule, "symmetric");
     assert!(c.features.symmetric && !c.features.geometric);
     assert_eq!(
-        plan_text(c.plan(false)),
+        plan_text(c.plan(false, secs(1.0))),
         "local-search:0.1,gls[alpha=3;top=2]*:1"
     );
-    assert_eq!(plan_text(c.plan(true)), "gls[alpha=3;top=2]*:1");
+    assert_eq!(plan_text(c.plan(true, secs(1.0))), "gls[alpha=3;top=2]*:1");
     assert_eq!(c.beam.share, 0.3);
     let c = a.choose(&esc);
     assert_eq!(c.rule, "sparse");
@@ -193,25 +200,54 @@ fn auto_picks_its_rule_by_symmetry_and_precedence_density() {
     assert_eq!(c.beam.share, 0.1);
     for after_beam in [false, true] {
         assert_eq!(
-            plan_text(c.plan(after_beam)),
+            plan_text(c.plan(after_beam, secs(1.0))),
             "local-search:0.1,~eacs:0.2,\
              ils[accept=0.01;kicks=2;perturb=swap;shift-repair=2]*:0.25,\
              ils[accept=0.03;kicks=2;perturb=swap;shift-repair=2]*:0.85,reopt[window=16]*:1"
         );
     }
-    // dense instances: ils with longer kicks; after a beam phase (up to 300 cells) a colony
+    // dense instances with many zero-cost links (crane jobs at stations), up to 400 cells:
+    // ils with longer kicks; after a beam phase (up to 300 cells) a colony; under a long
+    // budget without a beam phase, guided local search, then the walk
     for m in [&rbg, &big] {
         let c = a.choose(m);
         assert_eq!(
             (c.rule, c.beam.share, c.beam.max_cells),
-            ("dense", 0.5, 300)
+            ("dense-ties", 0.5, 300)
         );
-        assert_eq!(
-            plan_text(c.plan(false)),
-            "local-search:0.1,ils[max-seg=45]*:1"
-        );
-        assert_eq!(plan_text(c.plan(true)), "local-search:0.3,eacs:0.5,ils*:1");
+        assert!(c.features.zero_arcs >= 0.01);
+        let walk = "local-search:0.1,ils[max-seg=45]*:1";
+        for short in [secs(1.0), secs(4.9), evals(299_999_999)] {
+            assert_eq!(plan_text(c.plan(false, short)), walk);
+        }
+        for long in [secs(5.0), secs(60.0), evals(300_000_000)] {
+            assert_eq!(plan_text(c.plan(false, long)), "gls:0.7,ils[max-seg=45]*:1");
+            assert_eq!(
+                plan_text(c.plan(true, long)),
+                "local-search:0.3,eacs:0.5,ils*:1"
+            );
+        }
+        // a time limit decides over an evaluation budget given with it
+        let both = Budget {
+            time_limit: Some(std::time::Duration::from_secs(1)),
+            max_evals: Some(1_000_000_000),
+        };
+        assert_eq!(plan_text(c.plan(false, both)), walk);
     }
+    // without those zero-cost links (the generated `time-window` family), the `dense` rule
+    let kv: BTreeMap<String, String> = [("n", "120"), ("w", "10"), ("c", "100")]
+        .iter()
+        .map(|(k, v)| (k.to_string(), v.to_string()))
+        .collect();
+    let tw = cellseq::generate::generate("time-window", &kv, 1).unwrap();
+    let tw = CostModel::new(&tw, tw.default_objective());
+    let c = a.choose(&tw);
+    assert!(c.features.closure_density >= 0.8 && c.features.zero_arcs < 0.01);
+    assert_eq!(c.rule, "dense");
+    assert_eq!(
+        plan_text(c.plan(false, secs(10.0))),
+        "local-search:0.1,ils[max-seg=45]*:1"
+    );
     // the larger one is above the beam's bound: it gets no beam phase
     assert!(rbg.n() <= 300 && big.n() > 300);
     // a plan the user chose replaces the rules, with the catch-all rule's beam share
@@ -221,7 +257,7 @@ fn auto_picks_its_rule_by_symmetry_and_precedence_density() {
         let c = mine.choose(m);
         assert_eq!((c.rule, c.beam.share), (PLAN_RULE, 0.1));
         for after_beam in [false, true] {
-            assert_eq!(plan_text(c.plan(after_beam)), own);
+            assert_eq!(plan_text(c.plan(after_beam, secs(1.0))), own);
         }
     }
     // beam-share replaces the rule's share, and no pass stretches it
@@ -247,14 +283,17 @@ fn auto_picks_its_rule_by_symmetry_and_precedence_density() {
     assert_eq!(c.rule, "geometric-free");
     assert!(c.features.geometric && c.features.symmetric);
     assert_eq!(
-        plan_text(c.plan(true)),
+        plan_text(c.plan(true, secs(1.0))),
         "local-search[three-opt=true;two-level=on;walk-kicks=0.3]:1"
     );
     let ordered = geo(&[("n", "30"), ("preds", "1")]);
     let c = a.choose(&ordered);
     assert_eq!(c.rule, "default");
     assert!(c.features.geometric && c.features.free_density > 0.001);
-    assert_eq!(plan_text(c.plan(true)), "local-search:0.3,eacs:0.5,ils*:1");
+    assert_eq!(
+        plan_text(c.plan(true, secs(1.0))),
+        "local-search:0.3,eacs:0.5,ils*:1"
+    );
     // a symmetric matrix of one mode per cell above the beam's 400 cells: no beam phase;
     // up to 1000 cells guided local search alone, at 400 cells the `symmetric` rule
     for (n, rule) in [("398", "symmetric"), ("399", "symmetric-medium")] {
@@ -264,7 +303,7 @@ fn auto_picks_its_rule_by_symmetry_and_precedence_density() {
     for (n, p) in [("450", "1"), ("450", "30")] {
         let c = a.choose(&generated("symmetric", &[("n", n), ("p", p)], 1));
         assert_eq!((c.rule, c.beam.share), ("symmetric-medium", 0.0));
-        assert_eq!(plan_text(c.plan(false)), "gls[alpha=3;top=2]:1");
+        assert_eq!(plan_text(c.plan(false, secs(1.0))), "gls[alpha=3;top=2]:1");
     }
     for (n, rule) in [("998", "symmetric-medium"), ("999", "symmetric-large")] {
         let c = a.choose(&generated("symmetric", &[("n", n), ("p", "1")], 1));
@@ -275,7 +314,7 @@ fn auto_picks_its_rule_by_symmetry_and_precedence_density() {
     assert_eq!((c.rule, c.beam.share), ("symmetric-large", 0.0));
     assert!(c.features.symmetric && c.features.modes == 1.0);
     assert_eq!(
-        plan_text(c.plan(false)),
+        plan_text(c.plan(false, secs(1.0))),
         "ils[accept=0.01;halve=0.15;max-seg=10;walks=8]:1"
     );
     // `compiler-dag` (closure density 0.8 and above) keeps `ils` at every size above 400
@@ -288,7 +327,7 @@ fn auto_picks_its_rule_by_symmetry_and_precedence_density() {
     assert!(c.features.closure_density >= 0.2);
     assert_eq!((c.rule, c.beam.share), ("symmetric-large-dense", 0.0));
     assert_eq!(
-        plan_text(c.plan(false)),
+        plan_text(c.plan(false, secs(1.0))),
         "ils[accept=0.01;halve=0.15;walks=8]:1"
     );
     let c = a.choose(&generated("symmetric", &[("n", "1050"), ("p", "30")], 1));
@@ -298,10 +337,10 @@ fn auto_picks_its_rule_by_symmetry_and_precedence_density() {
     assert_eq!((c.rule, c.beam.share), ("symmetric-modes", 0.3));
     assert!(c.features.symmetric && c.features.modes > 1.0);
     assert_eq!(
-        plan_text(c.plan(false)),
+        plan_text(c.plan(false, secs(1.0))),
         "local-search:0.2,eacs*:0.3,ils*:1"
     );
-    assert_eq!(plan_text(c.plan(true)), "ils[accept=0.01]*:1");
+    assert_eq!(plan_text(c.plan(true, secs(1.0))), "ils[accept=0.01]*:1");
     // an asymmetric matrix with sparse precedence and several modes per cell (open features
     // cut either way) gets three colony rounds, each polished by `ils`
     let c = a.choose(&generated(
@@ -313,7 +352,7 @@ fn auto_picks_its_rule_by_symmetry_and_precedence_density() {
     assert!(!c.features.symmetric && c.features.modes > 1.0);
     assert!(c.features.closure_density < 0.8);
     assert_eq!(
-        plan_text(c.plan(false)),
+        plan_text(c.plan(false, secs(1.0))),
         "local-search:0.04,~eacs:0.07,ils[accept=0.01;shift-repair=2]+:0.2,eacs:0.09,\
          ils[accept=0.01;shift-repair=2]+:0.25,~eacs:0.12,ils[accept=0.01;shift-repair=2]+:0.33,\
          ils[accept=0.03;shift-repair=2]*:0.8,reopt[window=16]*:1"
@@ -401,12 +440,21 @@ fn the_built_in_portfolio_parses_validates_and_ends_with_a_catch_all() {
             "sparse-modes",
             "sparse",
             "dense-random",
+            "dense-ties",
             "dense",
             "geometric-free",
             "default"
         ]
     );
     assert!(p.catch_all().when.is_empty());
+    // one rule has a plan for long budgets: dense-ties
+    let long: Vec<&str> = p
+        .rules
+        .iter()
+        .filter(|r| r.long.is_some())
+        .map(|r| r.name.as_str())
+        .collect();
+    assert_eq!(long, ["dense-ties"]);
     assert!(
         p.rules[..p.rules.len() - 1]
             .iter()
@@ -432,6 +480,13 @@ fn bad_portfolios_are_refused_naming_the_file_and_the_entry() {
     };
     let ok_phase = "{ solver = \"greedy\", share = 1.0 }";
     let last = rule("rest", "", ok_phase);
+    // a rule with a `[rule.long]` table
+    let long = |table: &str| {
+        format!(
+            "{head}{}[rule.long]\n{table}{last}",
+            rule("a", "when = { cells = { max = 9 } }\n", ok_phase)
+        )
+    };
     let cases: Vec<(String, &str)> = vec![
         (
             format!(
@@ -443,6 +498,32 @@ fn bad_portfolios_are_refused_naming_the_file_and_the_entry() {
                 )
             ),
             "unknown field `clossure_density`",
+        ),
+        (
+            long(&format!(
+                "min_seconds = -1.0\nmin_evals = 0\nphases = [ {ok_phase} ]\n"
+            )),
+            "rule 1 'a': long.min_seconds must be a number >= 0, got -1",
+        ),
+        (
+            long(&format!(
+                "min_seconds = 5.0\nmin_evals = 1e16\nphases = [ {ok_phase} ]\n"
+            )),
+            "rule 1 'a': long.min_evals must be a number in [0, 1e15], got 10000000000000000",
+        ),
+        (
+            long("min_seconds = 5.0\nmin_evals = 0\nphases = []\n"),
+            "rule 1 'a': long.phases: no phases",
+        ),
+        (
+            long(&format!("min_evals = 0\nphases = [ {ok_phase} ]\n")),
+            "missing field `min_seconds`",
+        ),
+        (
+            long(&format!(
+                "min_seconds = 1.0\nmin_evals = 0\nmin_cells = 3\nphases = [ {ok_phase} ]\n"
+            )),
+            "unknown field `min_cells`",
         ),
         (
             format!(

@@ -49,8 +49,9 @@ started at the penalised links. Every sequence whose true cost beats the best is
 the true costs and kept. No random kicks: the result does not depend on the seed. Penalties \
 apply to matrix instances with one mode per cell and at most 4096 nodes; elsewhere it is the \
 descent alone. In `auto` it is the walk of the built-in portfolio's `symmetric` rule, after \
-its short local search or its beam, and the whole plan of its `symmetric-medium` rule \
-(symmetric matrices of 401-1000 cells).",
+its short local search or its beam, the whole plan of its `symmetric-medium` rule \
+(symmetric matrices of 401-1000 cells), and the long-budget plan of its `dense-ties` rule \
+(dense precedence with many zero-cost links).",
     params: &[
         ParamSpec {
             name: "alpha",

@@ -30,7 +30,7 @@ pub mod portfolio;
 
 pub use features::Features;
 pub use phases::{Phase, Start, parse_plan, phase_seed, plan_text};
-pub use portfolio::{Beam, Portfolio};
+pub use portfolio::{Beam, Long, Portfolio};
 
 use super::Build;
 use super::{
@@ -82,9 +82,11 @@ cells **sparse-modes** (three rounds of a fresh colony, each polished by `ils` i
 band, then `ils` in the 3 % band from the best of the three and window re-optimization); \
 **dense** precedence (a short `local-search`, then \
 `ils` with kicks that reorder up to 45 cells; on up to 300 cells, when the beam runs, half the \
-budget for the beam, then the default phases), and with costs spread as random ones \
+budget for the beam, then the default phases), with costs spread as random ones \
 (`cost_spread` 0.5 and above) **dense-random**, whose walk also runs corridor passes when it \
-stalls; **geometric free** instances (geometric, no or \
+stalls, and with many zero-cost links (`zero_arcs` 0.01 and above, crane jobs at stations) on \
+up to 400 cells **dense-ties**, the `dense` plan except under budgets of at least 5 s (or \
+3·10⁸ evaluations), where `gls` takes 70 % of the budget before the walk; **geometric free** instances (geometric, no or \
 very sparse precedence, links that cost the same both ways: `local-search` on the two-level \
 list with local and random-walk double-bridge kicks for the whole budget); and the catch-all \
 **default**, the other geometric instances among them (`local-search`, an `eacs` colony of its \
@@ -155,13 +157,17 @@ pub struct Choice<'a> {
     pub phases: &'a [Phase],
     /// The phases after a beam phase that ran, when they differ.
     pub after_beam: Option<&'a [Phase]>,
+    /// The phases for long budgets, when the rule has them.
+    pub long: Option<&'a Long>,
 }
 
 impl Choice<'_> {
-    /// The phases to run, after a beam phase that ran (`after_beam`) or not.
-    pub fn plan(&self, after_beam: bool) -> &[Phase] {
-        match (after_beam, self.after_beam) {
-            (true, Some(p)) => p,
+    /// The phases to run under `budget`: after a beam phase that ran, its `after_beam`
+    /// phases; otherwise the `long` phases when the budget reaches them; else the phases.
+    pub fn plan(&self, after_beam: bool, budget: Budget) -> &[Phase] {
+        match (after_beam, self.after_beam, self.long) {
+            (true, Some(p), _) => p,
+            (false, _, Some(l)) if l.applies(budget) => &l.phases,
             _ => self.phases,
         }
     }
@@ -188,6 +194,14 @@ impl Choice<'_> {
         ];
         if let Some(p) = self.after_beam {
             out.push(format!("after beam {}", plan_text(p)));
+        }
+        if let Some(l) = self.long {
+            out.push(format!(
+                "long       budgets of at least {} s or {} evaluations: {}",
+                l.min_seconds,
+                l.min_evals,
+                plan_text(&l.phases)
+            ));
         }
         out
     }
@@ -254,10 +268,11 @@ impl Auto {
     /// parameter with the last rule's beam settings), and the beam share in force.
     pub fn choose(&self, m: &CostModel) -> Choice<'_> {
         let features = Features::of(m);
-        let (rule, phases, after_beam, mut beam) = match &self.plan {
+        let (rule, phases, after_beam, long, mut beam) = match &self.plan {
             Some(p) => (
                 PLAN_RULE,
                 p.as_slice(),
+                None,
                 None,
                 self.portfolio.catch_all().beam,
             ),
@@ -267,6 +282,7 @@ impl Auto {
                     r.name.as_str(),
                     r.phases.as_slice(),
                     r.after_beam.as_deref(),
+                    r.long.as_ref(),
                     r.beam,
                 )
             }
@@ -282,6 +298,7 @@ impl Auto {
             beam,
             phases,
             after_beam,
+            long,
         }
     }
 
@@ -385,7 +402,7 @@ impl Solver for Auto {
                 after_beam = true;
             }
         }
-        let plan = choice.plan(after_beam);
+        let plan = choice.plan(after_beam, budget);
         let mut last: Option<Outcome> = None;
         // the instance travelled backwards, built when a phase first needs it (a copy of the
         // matrix: none when the time runs out before)
@@ -462,6 +479,12 @@ pub struct Explanation {
     pub phases: String,
     /// The phases after a beam phase that ran, when they differ.
     pub after_beam: Option<String>,
+    /// The phases for long budgets, when the rule has them (`long` of the portfolio file).
+    pub long: Option<String>,
+    /// Shortest wall-clock budget (seconds) that gets the `long` phases.
+    pub long_min_seconds: Option<f64>,
+    /// Smallest evaluation budget, without a time limit, that gets the `long` phases.
+    pub long_min_evals: Option<u64>,
     /// Wall-clock seconds the features and the rule selection took on their own (the model
     /// built, before any phase; `auto` spends the same at the start of its budget).
     pub features_seconds: f64,
@@ -497,6 +520,9 @@ pub fn explain(
         beam_stretch: c.beam.stretch,
         phases: plan_text(c.phases),
         after_beam: c.after_beam.map(plan_text),
+        long: c.long.map(|l| plan_text(&l.phases)),
+        long_min_seconds: c.long.map(|l| l.min_seconds),
+        long_min_evals: c.long.map(|l| l.min_evals),
         features_seconds,
         lines,
     })

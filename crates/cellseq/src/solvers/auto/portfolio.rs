@@ -4,12 +4,14 @@
 //!
 //! A file has a `[beam]` table (the beam phase's default limits) and an ordered list of
 //! `[[rule]]` tables, each with a `name`, optional `when` conditions on features, the beam
-//! phase's `beam = { share, max_cells?, min_seconds?, stretch? }`, `phases` and optional `after_beam`
-//! phases. The first rule whose conditions all hold applies; the last must have none.
+//! phase's `beam = { share, max_cells?, min_seconds?, stretch? }`, `phases`, optional `after_beam`
+//! phases and an optional `long = { min_seconds, min_evals, phases }` plan for long budgets.
+//! The first rule whose conditions all hold applies; the last must have none.
 //! The format is described for users in `docs/portfolio.md`.
 
 use super::features::Features;
 use super::phases::{Phase, Start, check_phase};
+use crate::context::Budget;
 use crate::error::{Error, Result};
 use serde::Deserialize;
 use std::collections::BTreeMap;
@@ -47,6 +49,34 @@ pub struct Rule {
     pub phases: Vec<Phase>,
     /// The phases after a beam phase that ran and did not prove the optimum, if not `phases`.
     pub after_beam: Option<Vec<Phase>>,
+    /// The phases that replace `phases` under a long budget, if any.
+    pub long: Option<Long>,
+}
+
+/// A rule's plan for long budgets: it replaces the rule's `phases` (not its `after_beam`
+/// phases) when the run's budget reaches `min_seconds` of wall clock, or, with an evaluation
+/// budget and no time limit, `min_evals` evaluations.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Long {
+    /// Shortest wall-clock budget (seconds) that gets these phases.
+    pub min_seconds: f64,
+    /// Smallest evaluation budget, without a time limit, that gets these phases.
+    pub min_evals: u64,
+    /// The phases.
+    pub phases: Vec<Phase>,
+}
+
+impl Long {
+    /// True when a run under `budget` gets these phases: its time limit is at least
+    /// `min_seconds`, or, without one, its evaluation budget at least `min_evals` (a run
+    /// without either has no end the plan could be sized for, and keeps `phases`).
+    pub fn applies(&self, budget: Budget) -> bool {
+        match (budget.time_limit, budget.max_evals) {
+            (Some(t), _) => t.as_secs_f64() >= self.min_seconds,
+            (None, Some(m)) => m >= self.min_evals,
+            (None, None) => false,
+        }
+    }
 }
 
 /// The beam proof attempt of a rule.
@@ -246,6 +276,16 @@ struct RuleText {
     phases: Vec<PhaseText>,
     #[serde(default)]
     after_beam: Option<Vec<PhaseText>>,
+    #[serde(default)]
+    long: Option<LongText>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct LongText {
+    min_seconds: f64,
+    min_evals: f64,
+    phases: Vec<PhaseText>,
 }
 
 #[derive(Deserialize)]
@@ -435,12 +475,42 @@ fn rule_of(r: &RuleText, d: &BeamDefaults) -> std::result::Result<Rule, String> 
     if after_beam.is_some() && beam.share == 0.0 {
         return Err("after_beam is never used: beam.share is 0".into());
     }
+    let long = match &r.long {
+        Some(l) => Some(long_of(l)?),
+        None => None,
+    };
     Ok(Rule {
         name: r.name.clone(),
         when: r.when.clone(),
         beam,
         phases,
         after_beam,
+        long,
+    })
+}
+
+/// Largest `long.min_evals` a portfolio may give.
+pub const MAX_LONG_EVALS: f64 = 1e15;
+
+/// A validated [`Long`] plan from its text.
+fn long_of(l: &LongText) -> std::result::Result<Long, String> {
+    if !(l.min_seconds.is_finite() && l.min_seconds >= 0.0) {
+        return Err(format!(
+            "long.min_seconds must be a number >= 0, got {}",
+            l.min_seconds
+        ));
+    }
+    if !(l.min_evals.is_finite() && (0.0..=MAX_LONG_EVALS).contains(&l.min_evals)) {
+        return Err(format!(
+            "long.min_evals must be a number in [0, {MAX_LONG_EVALS:e}], got {}",
+            l.min_evals
+        ));
+    }
+    let phases = phases_of(&l.phases).map_err(|m| format!("long.phases: {m}"))?;
+    Ok(Long {
+        min_seconds: l.min_seconds,
+        min_evals: l.min_evals as u64,
+        phases,
     })
 }
 
