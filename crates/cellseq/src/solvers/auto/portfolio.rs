@@ -372,9 +372,7 @@ impl Portfolio {
         })?;
         let bad = |m: String| Error::invalid(file, m);
         let d = &raw.beam;
-        if !(d.min_seconds.is_finite() && d.min_seconds >= 0.0) {
-            return Err(bad("[beam] min_seconds must be a number >= 0".into()));
-        }
+        seconds("[beam] min_seconds", d.min_seconds).map_err(bad)?;
         if raw.rule.is_empty() {
             return Err(bad(
                 "no [[rule]]: a portfolio needs at least a catch-all rule".into(),
@@ -451,10 +449,7 @@ fn rule_of(r: &RuleText, d: &BeamDefaults) -> std::result::Result<Rule, String> 
     if !(b.share.is_finite() && (0.0..=1.0).contains(&b.share)) {
         return Err(format!("beam.share must be in [0, 1], got {}", b.share));
     }
-    let min_seconds = b.min_seconds.unwrap_or(d.min_seconds);
-    if !(min_seconds.is_finite() && min_seconds >= 0.0) {
-        return Err("beam.min_seconds must be a number >= 0".into());
-    }
+    let min_seconds = seconds("beam.min_seconds", b.min_seconds.unwrap_or(d.min_seconds))?;
     let stretch = b.stretch.unwrap_or(1.0);
     if !(stretch.is_finite() && (1.0..=MAX_STRETCH).contains(&stretch)) {
         return Err(format!(
@@ -489,17 +484,22 @@ fn rule_of(r: &RuleText, d: &BeamDefaults) -> std::result::Result<Rule, String> 
     })
 }
 
+/// `v` when it is a number of seconds a portfolio may give (finite, at least 0); else the
+/// message naming `key`.
+fn seconds(key: &str, v: f64) -> std::result::Result<f64, String> {
+    if v.is_finite() && v >= 0.0 {
+        Ok(v)
+    } else {
+        Err(format!("{key} must be a number >= 0, got {v}"))
+    }
+}
+
 /// Largest `long.min_evals` a portfolio may give.
 pub const MAX_LONG_EVALS: f64 = 1e15;
 
 /// A validated [`Long`] plan from its text.
 fn long_of(l: &LongText) -> std::result::Result<Long, String> {
-    if !(l.min_seconds.is_finite() && l.min_seconds >= 0.0) {
-        return Err(format!(
-            "long.min_seconds must be a number >= 0, got {}",
-            l.min_seconds
-        ));
-    }
+    let min_seconds = seconds("long.min_seconds", l.min_seconds)?;
     if !(l.min_evals.is_finite() && (0.0..=MAX_LONG_EVALS).contains(&l.min_evals)) {
         return Err(format!(
             "long.min_evals must be a number in [0, {MAX_LONG_EVALS:e}], got {}",
@@ -508,7 +508,7 @@ fn long_of(l: &LongText) -> std::result::Result<Long, String> {
     }
     let phases = phases_of(&l.phases).map_err(|m| format!("long.phases: {m}"))?;
     Ok(Long {
-        min_seconds: l.min_seconds,
+        min_seconds,
         min_evals: l.min_evals as u64,
         phases,
     })
