@@ -194,18 +194,35 @@ fn auto_picks_its_rule_by_symmetry_and_precedence_density() {
     );
     assert_eq!(plan_text(c.plan(true, secs(1.0))), "gls[alpha=3;top=2]*:1");
     assert_eq!(c.beam.share, 0.3);
-    let c = a.choose(&esc);
-    assert_eq!(c.rule, "sparse");
-    assert!((c.features.closure_density - 0.18).abs() < 0.01);
-    assert_eq!(c.beam.share, 0.1);
-    for after_beam in [false, true] {
-        assert_eq!(
-            plan_text(c.plan(after_beam, secs(1.0))),
-            "local-search:0.1,~eacs:0.2,\
-             ils[accept=0.01;kicks=2;perturb=swap;shift-repair=2]*:0.25,\
-             ils[accept=0.03;kicks=2;perturb=swap;shift-repair=2]*:0.85,reopt[window=16]*:1"
-        );
+    // sparse precedence: kro124p.3's costs are travel-like (cost_spread 0.48), ESC25's
+    // spread as random ones (0.61), which under long budgets adds guided local search
+    // between the two walks, also after the beam phase
+    let sparse = "local-search:0.1,~eacs:0.2,\
+                  ils[accept=0.01;kicks=2;perturb=swap;shift-repair=2]*:0.25,\
+                  ils[accept=0.03;kicks=2;perturb=swap;shift-repair=2]*:0.85,reopt[window=16]*:1";
+    let with_gls = "local-search:0.1,~eacs:0.2,\
+                    ils[accept=0.01;kicks=2;perturb=swap;shift-repair=2]*:0.25,gls*:0.6,\
+                    ils[accept=0.03;kicks=2;perturb=swap;shift-repair=2]*:0.85,reopt[window=16]*:1";
+    let kro = model("kro124p.3");
+    for (m, rule) in [(&kro, "sparse"), (&esc, "sparse-random")] {
+        let c = a.choose(m);
+        assert_eq!(c.rule, rule);
+        assert!(c.features.closure_density < 0.2);
+        assert_eq!(c.beam.share, 0.1);
+        for after_beam in [false, true] {
+            for short in [secs(1.0), secs(4.49), evals(149_999_999)] {
+                assert_eq!(plan_text(c.plan(after_beam, short)), sparse);
+            }
+            // 4.5 s: `--time-limit 5` leaves the solver a little less once the file is read
+            for long in [secs(4.5), secs(4.99), secs(10.0), evals(150_000_000)] {
+                let want = if rule == "sparse" { sparse } else { with_gls };
+                assert_eq!(plan_text(c.plan(after_beam, long)), want);
+            }
+        }
     }
+    assert!(
+        a.choose(&kro).features.cost_spread < 0.5 && a.choose(&esc).features.cost_spread >= 0.5
+    );
     // dense instances with many zero-cost links (crane jobs at stations), up to 400 cells:
     // ils with longer kicks; after a beam phase (up to 300 cells) a colony; under a long
     // budget without a beam phase, guided local search, then the walk
@@ -438,6 +455,7 @@ fn the_built_in_portfolio_parses_validates_and_ends_with_a_catch_all() {
             "symmetric-modes",
             "free",
             "sparse-modes",
+            "sparse-random",
             "sparse",
             "dense-random",
             "dense-ties",
@@ -447,14 +465,14 @@ fn the_built_in_portfolio_parses_validates_and_ends_with_a_catch_all() {
         ]
     );
     assert!(p.catch_all().when.is_empty());
-    // one rule has a plan for long budgets: dense-ties
+    // two rules have a plan for long budgets: sparse-random and dense-ties
     let long: Vec<&str> = p
         .rules
         .iter()
         .filter(|r| r.long.is_some())
         .map(|r| r.name.as_str())
         .collect();
-    assert_eq!(long, ["dense-ties"]);
+    assert_eq!(long, ["sparse-random", "dense-ties"]);
     assert!(
         p.rules[..p.rules.len() - 1]
             .iter()
@@ -697,7 +715,7 @@ fn a_custom_portfolio_changes_the_plan_that_runs() {
         .output()
         .unwrap();
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
-    assert_eq!(v["explain"]["rule"], "sparse", "{v}");
+    assert_eq!(v["explain"]["rule"], "sparse-random", "{v}");
     assert_eq!(v["explain"]["portfolio"], "built-in");
     assert!(
         v["explain"]["features"]["closure_density"]

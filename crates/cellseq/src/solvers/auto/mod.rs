@@ -77,7 +77,7 @@ and **symmetric-modes**, several modes per cell (a colony before `ils`); \
 **free** asymmetric matrices with no precedence apart from a fixed start and end (`atsp`); \
 **sparse** precedence (a short `local-search`, a colony run backwards, `ils` in a 1 % then a 3 \
 % acceptance band, its kicks two random segment swaps, with the bounded-shift DP ending every \
-repair, window re-optimization of the best), and with several modes per cell on up to 300 \
+repair, window re-optimization of the best), with costs spread as random ones (`cost_spread` 0.5 and above) on up to 1000 cells **sparse-random**, the `sparse` plan except under budgets of 5 s and more (from 4.5 s, or 1.5·10⁸ evaluations), where `gls` runs between the two `ils` phases, and with several modes per cell on up to 300 \
 cells **sparse-modes** (three rounds of a fresh colony, each polished by `ils` in the 1 % \
 band, then `ils` in the 3 % band from the best of the three and window re-optimization); \
 **dense** precedence (a short `local-search`, then \
@@ -163,11 +163,12 @@ pub struct Choice<'a> {
 
 impl Choice<'_> {
     /// The phases to run under `budget`: after a beam phase that ran, its `after_beam`
-    /// phases; otherwise the `long` phases when the budget reaches them; else the phases.
+    /// phases when the rule has them; otherwise the `long` phases when the budget reaches
+    /// them; else the phases.
     pub fn plan(&self, after_beam: bool, budget: Budget) -> &[Phase] {
         match (after_beam, self.after_beam, self.long) {
             (true, Some(p), _) => p,
-            (false, _, Some(l)) if l.applies(budget) => &l.phases,
+            (_, _, Some(l)) if l.applies(budget) => &l.phases,
             _ => self.phases,
         }
     }

@@ -53,9 +53,10 @@ pub struct Rule {
     pub long: Option<Long>,
 }
 
-/// A rule's plan for long budgets: it replaces the rule's `phases` (not its `after_beam`
-/// phases) when the run's budget reaches `min_seconds` of wall clock, or, with an evaluation
-/// budget and no time limit, `min_evals` evaluations.
+/// A rule's plan for long budgets: it replaces the rule's `phases` wherever they would run
+/// (also after a beam phase that ran, when the rule has no `after_beam` phases, which keep
+/// precedence) when the run's budget reaches `min_seconds` of wall clock, or, with an
+/// evaluation budget and no time limit, `min_evals` evaluations.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Long {
     /// Shortest wall-clock budget (seconds) that gets these phases.
