@@ -69,6 +69,9 @@ pub struct Context<'a> {
     pub budget: Budget,
     observer: &'a mut dyn Observer,
     stop: Option<&'a AtomicBool>,
+    /// The time limit as the caller stated it ([`Context::nominal_limit`]), when it differs
+    /// from the budget's.
+    nominal: Option<Duration>,
     start: Instant,
     evaluations: u64,
     best: f64,
@@ -102,6 +105,7 @@ impl<'a> Context<'a> {
             budget,
             observer,
             stop: None,
+            nominal: None,
             start: Instant::now(),
             evaluations: 0,
             best: f64::INFINITY,
@@ -115,6 +119,20 @@ impl<'a> Context<'a> {
     pub fn with_stop(mut self, stop: Option<&'a AtomicBool>) -> Self {
         self.stop = stop;
         self
+    }
+    /// The same context, its plan sized by `limit` ([`Context::nominal_limit`]); `None` keeps
+    /// the budget's time limit.
+    pub fn with_nominal(mut self, limit: Option<Duration>) -> Self {
+        self.nominal = limit;
+        self
+    }
+    /// The time limit a solver sizes its plan by: the limit its caller stated for the whole
+    /// solve (a command's `--time-limit`, before reading the input and the lower bound's share
+    /// took their part of it), or else the budget's own. A solver that picks its phases by
+    /// budget (`auto`'s beam and long plans) compares this with its thresholds, so that
+    /// `--time-limit 5` means 5 s to it; the budget and the clock still end the run.
+    pub fn nominal_limit(&self) -> Option<Duration> {
+        self.nominal.or(self.budget.time_limit)
     }
     /// The stop flag this context honours, for the contexts of sub-runs.
     pub fn stop_flag(&self) -> Option<&'a AtomicBool> {

@@ -33,7 +33,7 @@ use crate::solvers::{self, SolverKind};
 use std::collections::BTreeMap;
 use std::path::Path;
 use std::sync::atomic::AtomicBool;
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 pub use crate::context::{Budget, NoObserver, Observer, Progress, Trace};
 
@@ -118,6 +118,7 @@ pub struct Solve<'o> {
     lower_bound: bool,
     observer: Option<&'o mut dyn Observer>,
     stop: Option<&'o AtomicBool>,
+    started: Option<Instant>,
 }
 
 impl Default for Solve<'_> {
@@ -138,6 +139,7 @@ impl<'o> Solve<'o> {
             lower_bound: false,
             observer: None,
             stop: None,
+            started: None,
         }
     }
     /// The random seed.
@@ -150,7 +152,8 @@ impl<'o> Solve<'o> {
         self.budget = budget;
         self
     }
-    /// A wall-clock limit on the solver.
+    /// A wall-clock limit on the solve (solver and lower bound), counted from [`Solve::run`] or
+    /// from [`Solve::started`].
     pub fn time_limit(mut self, limit: Duration) -> Self {
         self.budget.time_limit = Some(limit);
         self
@@ -197,6 +200,14 @@ impl<'o> Solve<'o> {
         self.stop = Some(stop);
         self
     }
+    /// Counts the time limit from `at` rather than from [`Solve::run`]: a command that read
+    /// its input since `at` gives its whole `--time-limit` and this start. The run ends at
+    /// `at` + limit; a solver that sizes its plan by the limit (`auto`) sees the whole limit
+    /// (`Context::nominal_limit`), not what reading left of it.
+    pub fn started(mut self, at: Instant) -> Self {
+        self.started = Some(at);
+        self
+    }
     /// The solver chosen.
     pub fn solver(&self) -> SolverKind {
         self.solver
@@ -222,13 +233,21 @@ impl<'o> Solve<'o> {
             trace: &mut trace,
             user: self.observer,
         };
-        // the limit covers the bound too: the solver gets all but the bound's share
-        let deadline = Deadline::after(self.budget.time_limit);
+        // the limit covers the bound too: the solver gets all but the bound's share of what is
+        // left; it sizes its plan by the whole limit
+        let nominal = self.budget.time_limit;
+        let deadline = Deadline::from(self.started.unwrap_or_else(Instant::now), nominal);
         let mut budget = self.budget;
+        // (a limit beyond the clock's range has no deadline: the budget keeps it)
+        budget.time_limit = deadline.remaining().or(nominal);
         if self.lower_bound {
             let share = bound_share(inst);
             budget.time_limit = budget.time_limit.map(|t| t.mul_f64(1.0 - share));
         }
+        let opts = solvers::RunOptions {
+            stop: self.stop,
+            nominal,
+        };
         let r = solvers::run_until(
             info.name,
             inst,
@@ -237,7 +256,7 @@ impl<'o> Solve<'o> {
             self.seed,
             budget,
             &mut tee,
-            self.stop,
+            opts,
         )?;
         let mut solved = Solved {
             solver: self.solver,

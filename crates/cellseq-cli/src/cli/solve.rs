@@ -1,7 +1,6 @@
 //! `info`, `validate`, `solve`, `eval`, `solvers`, `generate`.
 
 use anyhow::{Context as _, Result, bail};
-use cellseq::clock::Deadline;
 use cellseq::formats;
 use cellseq::formats::json;
 use cellseq::model::{Instance, Objective};
@@ -176,7 +175,7 @@ pub fn validate(a: ValidateArgs) -> Result<()> {
 
 pub fn solve(a: SolveArgs) -> Result<()> {
     let clock = Instant::now();
-    // the limit covers the whole command: it is checked, and its deadline set, first
+    // the limit covers the whole command: it is checked, and its clock started, first
     let limit = a
         .time_limit
         .map(|t| {
@@ -188,7 +187,6 @@ pub fn solve(a: SolveArgs) -> Result<()> {
             })
         })
         .transpose()?;
-    let deadline = Deadline::from(clock, limit);
     if let Some(out) = &a.out {
         cellseq::files::ensure_not_input(&a.file, out, a.overwrite_input)?;
     }
@@ -234,9 +232,10 @@ pub fn solve(a: SolveArgs) -> Result<()> {
             say!("{l}");
         }
     }
-    // the solver (and the bound after it) get what reading left
-    if let Some(left) = deadline.remaining() {
-        solve = solve.time_limit(left);
+    // the solver (and the bound after it) get what reading left; the solver sizes its plan
+    // by the whole limit
+    if let Some(limit) = limit {
+        solve = solve.time_limit(limit).started(clock);
     }
     let r = solve.objective(objective).run(&inst)?;
     let bk = best_known(&a.file).map(|b| b.0);

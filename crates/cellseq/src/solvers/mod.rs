@@ -392,10 +392,22 @@ pub fn run(
     budget: Budget,
     observer: &mut dyn Observer,
 ) -> Result<RunResult> {
-    run_until(name, inst, objective, given, seed, budget, observer, None)
+    let opts = RunOptions::default();
+    run_until(name, inst, objective, given, seed, budget, observer, opts)
 }
 
-/// [`run`], also stopped (with the best found so far) as soon as `stop` is set.
+/// What [`run_until`] takes beyond [`run`]'s arguments.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct RunOptions<'a> {
+    /// Stops the run (with the best found so far) as soon as it is set.
+    pub stop: Option<&'a AtomicBool>,
+    /// The time limit the caller stated for the whole solve, when the budget's is what is
+    /// left of it ([`Context::nominal_limit`]).
+    pub nominal: Option<std::time::Duration>,
+}
+
+/// [`run`] with [`RunOptions`]: also stopped as soon as `opts.stop` is set, its plan sized
+/// by `opts.nominal`.
 #[allow(clippy::too_many_arguments)]
 pub fn run_until(
     name: &str,
@@ -405,7 +417,7 @@ pub fn run_until(
     seed: u64,
     budget: Budget,
     observer: &mut dyn Observer,
-    stop: Option<&AtomicBool>,
+    opts: RunOptions<'_>,
 ) -> Result<RunResult> {
     let info = find(name)?;
     let (_, solver) = info.build(given)?;
@@ -417,7 +429,9 @@ pub fn run_until(
         ));
     }
     let objective = model.objective();
-    let mut ctx = Context::new(inst, &model, seed, budget, observer).with_stop(stop);
+    let mut ctx = Context::new(inst, &model, seed, budget, observer)
+        .with_stop(opts.stop)
+        .with_nominal(opts.nominal);
     let outcome = solver.run(&mut ctx, None, name)?;
     let elapsed_s = ctx.elapsed();
     let evaluations = ctx.evaluations();

@@ -64,7 +64,9 @@ hold; the built-in file is `crates/cellseq/src/solvers/auto/portfolio.toml`, `--
 
 1. A `beam` proof attempt gets the rule's beam share of the budget, on instances of at most \
 its `max_cells` cells and, under a wall-clock budget, only when that budget is at least its \
-`min_seconds`; when it proves the optimum, `auto` stops there.
+`min_seconds`; when it proves the optimum, `auto` stops there. Time bounds are compared with \
+the whole limit given (`--time-limit`), not with what reading the file and the lower bound's \
+share leave of it.
 2. Then the rule's phases (or its `after_beam` phases after a beam phase that ran). The \
 built-in rules: **symmetric** cost matrices with one mode per cell (a short `local-search`, \
 then guided local search, `gls`, also after the beam when it ran; on 401–1000 cells with \
@@ -77,7 +79,10 @@ and **symmetric-modes**, several modes per cell (a colony before `ils`); \
 **free** asymmetric matrices with no precedence apart from a fixed start and end (`atsp`); \
 **sparse** precedence (a short `local-search`, a colony run backwards, `ils` in a 1 % then a 3 \
 % acceptance band, its kicks two random segment swaps, with the bounded-shift DP ending every \
-repair, window re-optimization of the best), with costs spread as random ones (`cost_spread` 0.5 and above) on up to 1000 cells **sparse-random**, the `sparse` plan except under budgets of 5 s and more (from 4.5 s, or 1.5·10⁸ evaluations), where `gls` runs between the two `ils` phases, and with several modes per cell on up to 300 \
+repair, window re-optimization of the best), with costs spread as random ones \
+(`cost_spread` 0.5 and above) on up to 1000 cells **sparse-random**, the `sparse` plan except \
+under budgets of 5 s and more (or 1.5·10⁸ evaluations), where `gls` runs between the two \
+`ils` phases, and with several modes per cell on up to 300 \
 cells **sparse-modes** (three rounds of a fresh colony, each polished by `ils` in the 1 % \
 band, then `ils` in the 3 % band from the best of the three and window re-optimization); \
 **dense** precedence (a short `local-search`, then \
@@ -372,8 +377,14 @@ impl Solver for Auto {
                 *best = Some(o);
             }
         };
+        // the beam and the long plan are chosen by the limit the caller stated (a command's
+        // `--time-limit`), not by what reading the input and the bound's share left of it
+        let sized = Budget {
+            time_limit: ctx.nominal_limit(),
+            ..budget
+        };
         let beam_cfg = choice.beam;
-        let short = budget
+        let short = sized
             .time_limit
             .is_some_and(|t| t.as_secs_f64() < beam_cfg.min_seconds);
         let mut after_beam = false;
@@ -403,7 +414,7 @@ impl Solver for Auto {
                 after_beam = true;
             }
         }
-        let plan = choice.plan(after_beam, budget);
+        let plan = choice.plan(after_beam, sized);
         let mut last: Option<Outcome> = None;
         // the instance travelled backwards, built when a phase first needs it (a copy of the
         // matrix: none when the time runs out before)
