@@ -184,6 +184,14 @@ fn auto_picks_its_rule_by_symmetry_and_precedence_density() {
         model("rbg109a"),
         model("rbg323a"),
     );
+    let generated = |kind: &str, pairs: &[(&str, &str)], seed: u64| {
+        let kv: BTreeMap<String, String> = pairs
+            .iter()
+            .map(|(k, v)| (k.to_string(), v.to_string()))
+            .collect();
+        let inst = cellseq::generate::generate(kind, &kv, seed).unwrap();
+        CostModel::new(&inst, inst.default_objective())
+    };
     let a = auto(&[]);
     let c = a.choose(&p42);
     assert_eq!(c.rule, "symmetric");
@@ -203,21 +211,53 @@ fn auto_picks_its_rule_by_symmetry_and_precedence_density() {
     let with_gls = "local-search:0.1,~eacs:0.2,\
                     ils[accept=0.01;kicks=2;perturb=swap;shift-repair=2]*:0.25,gls*:0.6,\
                     ils[accept=0.03;kicks=2;perturb=swap;shift-repair=2]*:0.85,reopt[window=16]*:1";
+    // kro124p.3 (101 cells) takes three colony rounds under budgets from 10 s
+    let rounds = "local-search:0.04,~eacs:0.07,\
+                  ils[accept=0.01;kicks=2;perturb=swap;shift-repair=2]+:0.2,eacs:0.09,\
+                  ils[accept=0.01;kicks=2;perturb=swap;shift-repair=2]+:0.25,~eacs:0.12,\
+                  ils[accept=0.01;kicks=2;perturb=swap;shift-repair=2]+:0.33,\
+                  ils[accept=0.03;kicks=2;perturb=swap;shift-repair=2]*:0.8,reopt[window=16]*:1";
     let kro = model("kro124p.3");
-    for (m, rule, long_plan) in [(&kro, "sparse", sparse), (&esc, "sparse-random", with_gls)] {
+    let cases = [
+        (
+            &kro,
+            "sparse-small",
+            rounds,
+            [secs(1.0), secs(9.99), evals(299_999_999)],
+            [secs(10.0), secs(60.0), evals(300_000_000)],
+        ),
+        (
+            &esc,
+            "sparse-random",
+            with_gls,
+            [secs(1.0), secs(4.99), evals(149_999_999)],
+            [secs(5.0), secs(10.0), evals(150_000_000)],
+        ),
+    ];
+    for (m, rule, long_plan, shorts, longs) in cases {
         let c = a.choose(m);
         assert_eq!(c.rule, rule);
         assert!(c.features.closure_density < 0.2);
         assert_eq!(c.beam.share, 0.1);
         for after_beam in [false, true] {
-            for short in [secs(1.0), secs(4.99), evals(149_999_999)] {
+            for short in shorts {
                 assert_eq!(plan_text(c.plan(after_beam, short)), sparse);
             }
-            for long in [secs(5.0), secs(10.0), evals(150_000_000)] {
+            for long in longs {
                 assert_eq!(plan_text(c.plan(after_beam, long)), long_plan);
             }
         }
     }
+    // above 500 cells the same costs and precedence keep the `sparse` plan at every budget
+    let large = generated(
+        "near-symmetric",
+        &[("n", "600"), ("c", "1000"), ("p", "10"), ("plane", "true")],
+        1,
+    );
+    let c = a.choose(&large);
+    assert_eq!(c.rule, "sparse");
+    assert!(c.features.cells > 500 && c.features.cost_spread < 0.5);
+    assert_eq!(plan_text(c.plan(true, secs(60.0))), sparse);
     assert!(
         a.choose(&kro).features.cost_spread < 0.5 && a.choose(&esc).features.cost_spread >= 0.5
     );
@@ -284,14 +324,6 @@ fn auto_picks_its_rule_by_symmetry_and_precedence_density() {
     );
     // geometric instances: without precedence and with links that cost the same both ways,
     // the two-level local search; with precedence, the catch-all rule
-    let generated = |kind: &str, pairs: &[(&str, &str)], seed: u64| {
-        let kv: BTreeMap<String, String> = pairs
-            .iter()
-            .map(|(k, v)| (k.to_string(), v.to_string()))
-            .collect();
-        let inst = cellseq::generate::generate(kind, &kv, seed).unwrap();
-        CostModel::new(&inst, inst.default_objective())
-    };
     let geo = |pairs: &[(&str, &str)]| generated("uniform", pairs, 3);
     let free = geo(&[("n", "30"), ("modes", "2"), ("reversible", "true")]);
     let c = a.choose(&free);
@@ -454,6 +486,7 @@ fn the_built_in_portfolio_parses_validates_and_ends_with_a_catch_all() {
             "free",
             "sparse-modes",
             "sparse-random",
+            "sparse-small",
             "sparse",
             "dense-random",
             "dense-ties",
@@ -463,14 +496,14 @@ fn the_built_in_portfolio_parses_validates_and_ends_with_a_catch_all() {
         ]
     );
     assert!(p.catch_all().when.is_empty());
-    // two rules have a plan for long budgets: sparse-random and dense-ties
+    // three rules have a plan for long budgets: sparse-random, sparse-small and dense-ties
     let long: Vec<&str> = p
         .rules
         .iter()
         .filter(|r| r.long.is_some())
         .map(|r| r.name.as_str())
         .collect();
-    assert_eq!(long, ["sparse-random", "dense-ties"]);
+    assert_eq!(long, ["sparse-random", "sparse-small", "dense-ties"]);
     assert!(
         p.rules[..p.rules.len() - 1]
             .iter()
