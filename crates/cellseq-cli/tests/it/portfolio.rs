@@ -211,7 +211,7 @@ fn auto_picks_its_rule_by_symmetry_and_precedence_density() {
     let with_gls = "local-search:0.1,~eacs:0.2,\
                     ils[accept=0.01;kicks=2;perturb=swap;shift-repair=2]*:0.25,gls*:0.6,\
                     ils[accept=0.03;kicks=2;perturb=swap;shift-repair=2]*:0.85,reopt[window=16]*:1";
-    // kro124p.3 (101 cells) takes three colony rounds under budgets from 10 s
+    // kro124p.3 (101 cells) takes three colony rounds under budgets from 7.5 s
     let rounds = "local-search:0.04,~eacs:0.07,\
                   ils[accept=0.01;kicks=2;perturb=swap;shift-repair=2]+:0.2,eacs:0.09,\
                   ils[accept=0.01;kicks=2;perturb=swap;shift-repair=2]+:0.25,~eacs:0.12,\
@@ -223,8 +223,8 @@ fn auto_picks_its_rule_by_symmetry_and_precedence_density() {
             &kro,
             "sparse-small",
             rounds,
-            [secs(1.0), secs(9.99), evals(299_999_999)],
-            [secs(10.0), secs(60.0), evals(300_000_000)],
+            [secs(1.0), secs(7.49), evals(249_999_999)],
+            [secs(7.5), secs(60.0), evals(250_000_000)],
         ),
         (
             &esc,
