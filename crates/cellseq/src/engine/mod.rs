@@ -9,6 +9,7 @@
 //! layered shortest-path mode DP, [`vnd`] the variable neighbourhood descent.
 
 pub mod atsp;
+pub mod carry;
 pub mod corridor;
 pub mod crossover;
 pub mod large;

@@ -26,6 +26,7 @@ use super::StartsFrom;
 use super::start::{greedy_solution, outcome};
 use super::{Caps, Context, Outcome, ParamKind, ParamSpec, Params, SolverInfo};
 use crate::engine::corridor::{self, Corridor as Shape};
+use crate::engine::carry::Carry;
 use crate::engine::crossover::Crossover;
 use crate::engine::lk::Lk;
 use crate::engine::moves::sop3_delta;
@@ -182,6 +183,12 @@ are re-chosen); `window-repair=true` runs them in every repair as well.",
             help: "every kick's repair ends with the bounded-shift DP (engine::shift, Balas-Simonetti: the best reorder of the kicked span, with modes, in which no cell passes one that lay this many places or more after it) over the kicked span and this many cells either side (0: off)",
         },
         ParamSpec {
+            name: "carry",
+            default: "false",
+            kind: ParamKind::Bool,
+            help: "the polish of the start and of every new record ends with carry moves (engine::carry: a cell moved past a precedence successor or predecessor in its way, which a segment of at most 3 cells carries behind or before it), alternating with the full descent until neither improves",
+        },
+        ParamSpec {
             name: "walks",
             default: "1",
             kind: ParamKind::int(1, MAX_WALKS),
@@ -275,6 +282,7 @@ pub fn from_params(p: &Params) -> Ils {
         cross: p.bool("cross"),
         window_repair: p.bool("window-repair"),
         shift_repair: p.int("shift-repair") as usize,
+        carry: p.bool("carry"),
         walks: p.int("walks") as usize,
         halve: p.float("halve"),
         corridor: Shape {
@@ -327,6 +335,8 @@ pub struct Ils {
     pub window_repair: bool,
     /// Largest shift of the bounded-shift DP in every kick's repair (0: off).
     pub shift_repair: usize,
+    /// Carry moves in the polish of the start and of every new record.
+    pub carry: bool,
     /// Record-to-record walks kicked in turn.
     pub walks: usize,
     /// Share of the budget after which the worse half of the walks is dropped (0: never).
@@ -573,6 +583,8 @@ impl StartsFrom for Ils {
             return Ok(outcome(m, &cur));
         }
         let (mut search, mut lk) = self.descend(ctx, c, &mut cur);
+        let mut carry = Carry::default();
+        self.carry_moves((&mut search, lk.as_mut()), &mut carry, &mut cur, ctx);
         let mut best = cur.clone();
         ctx.report(best.cost + m.constant());
         let max_seg = if self.max_seg > 0 {
@@ -675,7 +687,7 @@ impl StartsFrom for Ils {
             }
             if crossed || cheaper(trial.cost, walk.record.cost) {
                 // polish a new record with the full descent before keeping it
-                Lk::full_descent(lk.as_mut(), &mut search, &mut trial, ctx);
+                self.polish((&mut search, lk.as_mut()), &mut carry, &mut trial, ctx);
                 walk.record.clone_from(&trial);
                 walk.since = 0;
                 if crossed || cheaper(trial.cost, best.cost) {
@@ -702,8 +714,8 @@ impl StartsFrom for Ils {
         }
         if trace {
             eprintln!(
-                "ils: {kicks_done} kicks, {crosses} crossovers gave a new best, {shift_gains} repairs improved by the shift DP, {} corridor passes gave {} new bests",
-                passes.runs, passes.gains
+                "ils: {kicks_done} kicks, {crosses} crossovers gave a new best, {shift_gains} repairs improved by the shift DP, {} corridor passes gave {} new bests, {} carry moves",
+                passes.runs, passes.gains, carry.applied
             );
         }
         Ok(outcome(m, &best))
@@ -793,6 +805,33 @@ impl Ils {
             lk.max_viol = self.lk_max_viol;
         }
         (search, lk)
+    }
+
+    /// The polish of a new record: the full descent (with Lin–Kernighan when it runs), then
+    /// [`Ils::carry_moves`].
+    fn polish(
+        &self,
+        (search, mut lk): (&mut Search, Option<&mut Lk>),
+        carry: &mut Carry,
+        s: &mut Solution,
+        ctx: &mut Context,
+    ) {
+        Lk::full_descent(lk.as_deref_mut(), search, s, ctx);
+        self.carry_moves((search, lk), carry, s, ctx);
+    }
+
+    /// With `carry`: carry moves on `s` (a local optimum of the full descent), each round
+    /// that improves followed by the full descent again, until a round finds none.
+    fn carry_moves(
+        &self,
+        (search, mut lk): (&mut Search, Option<&mut Lk>),
+        carry: &mut Carry,
+        s: &mut Solution,
+        ctx: &mut Context,
+    ) {
+        while self.carry && !ctx.exhausted() && carry.improve(&search.c, &search.nb, s, ctx) {
+            Lk::full_descent(lk.as_deref_mut(), search, s, ctx);
+        }
     }
 
     /// Starts another walk: `s` (a local optimum) gets random feasible reorders of windows
