@@ -211,17 +211,24 @@ fn auto_picks_its_rule_by_symmetry_and_precedence_density() {
     let with_gls = "local-search:0.1,~eacs:0.2,\
                     ils[accept=0.01;kicks=2;perturb=swap;shift-repair=2]*:0.25,gls*:0.6,\
                     ils[accept=0.03;kicks=2;perturb=swap;shift-repair=2]*:0.85,reopt[window=16]*:1";
-    // kro124p.3 (101 cells) takes three colony rounds under budgets from 7.5 s
+    // kro124p.3 (101 cells) takes the sparse plan with carry moves, and three colony rounds
+    // under budgets from 7.5 s
+    let carry = "local-search:0.1,~eacs:0.2,\
+                 ils[accept=0.01;carry=true;kicks=2;perturb=swap;shift-repair=2]*:0.25,\
+                 ils[accept=0.03;carry=true;kicks=2;perturb=swap;shift-repair=2]*:0.85,\
+                 reopt[window=16]*:1";
     let rounds = "local-search:0.04,~eacs:0.07,\
-                  ils[accept=0.01;kicks=2;perturb=swap;shift-repair=2]+:0.2,eacs:0.09,\
-                  ils[accept=0.01;kicks=2;perturb=swap;shift-repair=2]+:0.25,~eacs:0.12,\
-                  ils[accept=0.01;kicks=2;perturb=swap;shift-repair=2]+:0.33,\
-                  ils[accept=0.03;kicks=2;perturb=swap;shift-repair=2]*:0.8,reopt[window=16]*:1";
+                  ils[accept=0.01;carry=true;kicks=2;perturb=swap;shift-repair=2]+:0.2,eacs:0.09,\
+                  ils[accept=0.01;carry=true;kicks=2;perturb=swap;shift-repair=2]+:0.25,~eacs:0.12,\
+                  ils[accept=0.01;carry=true;kicks=2;perturb=swap;shift-repair=2]+:0.33,\
+                  ils[accept=0.03;carry=true;kicks=2;perturb=swap;shift-repair=2]*:0.8,\
+                  reopt[window=16]*:1";
     let kro = model("kro124p.3");
     let cases = [
         (
             &kro,
             "sparse-small",
+            carry,
             rounds,
             [secs(1.0), secs(7.49), evals(249_999_999)],
             [secs(7.5), secs(60.0), evals(250_000_000)],
@@ -229,19 +236,20 @@ fn auto_picks_its_rule_by_symmetry_and_precedence_density() {
         (
             &esc,
             "sparse-random",
+            sparse,
             with_gls,
             [secs(1.0), secs(4.99), evals(149_999_999)],
             [secs(5.0), secs(10.0), evals(150_000_000)],
         ),
     ];
-    for (m, rule, long_plan, shorts, longs) in cases {
+    for (m, rule, short_plan, long_plan, shorts, longs) in cases {
         let c = a.choose(m);
         assert_eq!(c.rule, rule);
         assert!(c.features.closure_density < 0.2);
         assert_eq!(c.beam.share, 0.1);
         for after_beam in [false, true] {
             for short in shorts {
-                assert_eq!(plan_text(c.plan(after_beam, short)), sparse);
+                assert_eq!(plan_text(c.plan(after_beam, short)), short_plan);
             }
             for long in longs {
                 assert_eq!(plan_text(c.plan(after_beam, long)), long_plan);

@@ -83,7 +83,9 @@ repair, window re-optimization of the best), with costs spread as random ones \
 (`cost_spread` 0.5 and above) on up to 1000 cells **sparse-random**, the `sparse` plan except \
 under budgets of 5 s and more (or 1.5·10⁸ evaluations), where `gls` runs between the two \
 `ils` phases, with one mode per cell on up to 500 cells **sparse-small**, the `sparse` plan \
-except under budgets of 7.5 s and more (or 2.5·10⁸ evaluations), where three rounds of a fresh \
+with carry moves (a cell moved past a precedence neighbour in its way, which a short segment \
+carried along lets through) in the polish of every walk's records, except under budgets of \
+7.5 s and more (or 2.5·10⁸ evaluations), where three rounds of a fresh \
 colony, each polished by `ils` in the 1 % band, come before the walk in the 3 % band, and \
 with several modes per cell on up to 300 \
 cells **sparse-modes** (three rounds of a fresh colony, each polished by `ils` in the 1 % \
