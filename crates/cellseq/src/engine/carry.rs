@@ -151,13 +151,16 @@ impl Carry {
         self.places.clear();
         self.places.extend(nb.inn[x as usize].iter().map(|&v| s.pos[v as usize] as isize));
         self.places.extend(nb.out[x as usize].iter().map(|&w| s.pos[w as usize] as isize - 1));
-        let mut evals = 0;
+        let mut evals = succ.len() as u64;
         for bi in 0..self.places.len() {
             let b = self.places[bi];
             if b < first || b >= n {
                 continue;
             }
             // the successors of x in its way, a..=b
+            // every precedence link read counts as an evaluation, so that an evaluation
+            // budget bounds the work under dense precedence too
+            evals += succ.len() as u64;
             let last = succ
                 .iter()
                 .map(|&y| s.pos[y as usize] as isize)
@@ -174,6 +177,9 @@ impl Carry {
                         continue;
                     }
                     // the segment may not pass a successor of its own
+                    evals += (st..=en)
+                        .map(|p| m.dag.succs[s.order[p as usize] as usize].len() as u64)
+                        .sum::<u64>();
                     let limit = (st..=en)
                         .flat_map(|p| m.dag.succs[s.order[p as usize] as usize].iter())
                         .map(|&y| s.pos[y as usize] as isize)
@@ -211,13 +217,15 @@ impl Carry {
         self.places.clear();
         self.places.extend(nb.out[x as usize].iter().map(|&w| s.pos[w as usize] as isize));
         self.places.extend(nb.inn[x as usize].iter().map(|&v| s.pos[v as usize] as isize + 1));
-        let mut evals = 0;
+        let mut evals = pred.len() as u64;
         for bi in 0..self.places.len() {
             let b = self.places[bi];
             if b > first || b < 0 {
                 continue;
             }
             // the predecessors of x in its way, b..a
+            // precedence links read count as evaluations (as in `forward`)
+            evals += pred.len() as u64;
             let last = pred
                 .iter()
                 .map(|&y| s.pos[y as usize] as isize)
@@ -234,6 +242,9 @@ impl Carry {
                         continue;
                     }
                     // the segment may not pass a predecessor of its own
+                    evals += (st..=en)
+                        .map(|p| m.dag.preds[s.order[p as usize] as usize].len() as u64)
+                        .sum::<u64>();
                     let limit = (st..=en)
                         .flat_map(|p| m.dag.preds[s.order[p as usize] as usize].iter())
                         .map(|&y| s.pos[y as usize] as isize)
