@@ -16,6 +16,7 @@
 //! neighbours. Each candidate's delta is O(1): the new order of the span is five runs of the
 //! old one, and only the links at their ends change.
 
+use super::moves::window;
 use super::vnd::improves;
 use super::{Costs, Neighbours, Solution};
 use crate::context::Context;
@@ -144,9 +145,10 @@ impl Carry {
         let n = s.n() as isize;
         let a = s.pos[x as usize] as isize;
         let succ = &m.dag.succs[x as usize];
-        let Some(first) = succ.iter().map(|&y| s.pos[y as usize] as isize).min() else {
+        let first = s.first_succ(m, x as usize);
+        if first == n {
             return 0;
-        };
+        }
         // x lands after position b: next to one of its candidate neighbours, past `first`
         self.places.clear();
         self.places.extend(nb.inn[x as usize].iter().map(|&v| s.pos[v as usize] as isize));
@@ -154,7 +156,7 @@ impl Carry {
         let mut evals = succ.len() as u64;
         for bi in 0..self.places.len() {
             let b = self.places[bi];
-            if b < first || b >= n {
+            if b < first {
                 continue;
             }
             // the successors of x in its way, a..=b
@@ -180,12 +182,7 @@ impl Carry {
                     evals += (st..=en)
                         .map(|p| m.dag.succs[s.order[p as usize] as usize].len() as u64)
                         .sum::<u64>();
-                    let limit = (st..=en)
-                        .flat_map(|p| m.dag.succs[s.order[p as usize] as usize].iter())
-                        .map(|&y| s.pos[y as usize] as isize)
-                        .filter(|&p| p > en)
-                        .min()
-                        .unwrap_or(n);
+                    let (_, limit) = window(m, s, st as usize, len as usize);
                     self.targets.clear();
                     self.targets.push(b);
                     let (f, l) = (s.order[st as usize], s.order[en as usize]);
@@ -210,9 +207,10 @@ impl Carry {
         let m = c.m;
         let a = s.pos[x as usize] as isize;
         let pred = &m.dag.preds[x as usize];
-        let Some(first) = pred.iter().map(|&y| s.pos[y as usize] as isize).max() else {
+        let first = s.last_pred(m, x as usize);
+        if first < 0 {
             return 0;
-        };
+        }
         // x lands before position b: next to one of its candidate neighbours, before `first`
         self.places.clear();
         self.places.extend(nb.out[x as usize].iter().map(|&w| s.pos[w as usize] as isize));
@@ -220,7 +218,7 @@ impl Carry {
         let mut evals = pred.len() as u64;
         for bi in 0..self.places.len() {
             let b = self.places[bi];
-            if b > first || b < 0 {
+            if b > first {
                 continue;
             }
             // the predecessors of x in its way, b..a
@@ -245,12 +243,7 @@ impl Carry {
                     evals += (st..=en)
                         .map(|p| m.dag.preds[s.order[p as usize] as usize].len() as u64)
                         .sum::<u64>();
-                    let limit = (st..=en)
-                        .flat_map(|p| m.dag.preds[s.order[p as usize] as usize].iter())
-                        .map(|&y| s.pos[y as usize] as isize)
-                        .filter(|&p| p < st)
-                        .max()
-                        .unwrap_or(-1);
+                    let (limit, _) = window(m, s, st as usize, len as usize);
                     self.targets.clear();
                     self.targets.push(b);
                     let (f, l) = (s.order[st as usize], s.order[en as usize]);

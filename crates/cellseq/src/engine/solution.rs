@@ -97,7 +97,6 @@ impl Solution {
     }
     /// Position of the earliest successor of `cell` (n if none).
     #[inline]
-    #[cfg(any(test, feature = "internals"))]
     pub fn first_succ(&self, m: &CostModel, cell: usize) -> isize {
         m.dag.succs[cell]
             .iter()
