@@ -13,7 +13,7 @@ of the two variants' runs with that seed, run side by side), in sections that st
   discordant pairs): whether one variant reaches the best seen more often, the quantity a
   target "at the best known in the median of three seeds" depends on.
 
-    python3 scripts/paired_runs.py notes/lab/carry-runs.txt [--section t1n.txt ...]
+    python3 scripts/paired_runs.py notes/lab/carry-runs.txt [--section t1n.txt]...   (repeatable)
 """
 import argparse
 import math
