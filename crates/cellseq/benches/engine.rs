@@ -1,11 +1,11 @@
 //! Engine benchmarks: delta evaluations per second, one local-search pass on 10k cells, the
 //! two-level descent on 10k points (with and without 3-opt), the Lin–Kernighan descent on a
 //! symmetric matrix with precedence, the two-way SOP-3-exchange descent on a symmetric matrix
-//! with sparse precedence, one SA chain, one tabu iteration, one ant construction; `atsp` to
-//! its branch-and-bound proof on a 300-cell random matrix with costs 0–100; 50 subgradient steps
-//! of the position-indexed path bound on a 100-cell symmetric matrix, and the beam to widths 256
-//! and 4096 there; `ils` for 10^7 evaluations on a dense 340-cell `time-window` instance.
-
+//! with sparse precedence and its pass at a local optimum without precedence, one SA chain,
+//! one tabu iteration, one ant construction; `atsp` to its branch-and-bound proof on a
+//! 300-cell random matrix with costs 0–100; 50 subgradient steps of the position-indexed path
+//! bound on a 100-cell symmetric matrix, and the beam to widths 256 and 4096 there; `ils` for
+//! 10^7 evaluations on a dense 340-cell `time-window` instance.
 use cellseq::bound::cells::CellGraph;
 use cellseq::bound::qpath::QPath;
 use cellseq::bound::sec::sec_bound;
@@ -203,6 +203,39 @@ fn benches(cr: &mut Criterion) {
                 let mut ctx = Context::new(&sop, &om, 1, Budget::default(), &mut obs);
                 let mut s = os.clone();
                 while sop3_two_way(&osearch, &mut two_way, &mut s, &mut ctx, &every) {}
+                black_box(s.cost)
+            })
+        },
+    );
+
+    // the same pass at a local optimum of a `random-sop` instance without precedence, 300
+    // cells, costs 0-100 (blocks of 64; every scan runs to its block's end): the work after a
+    // kick, when no move is left
+    let free = generated("random-sop", &[("n", "300"), ("p", "0"), ("c", "100")]);
+    let fm = CostModel::new(&free, free.default_objective());
+    let fc = Costs::open(&fm);
+    let fsearch = Search::new(fc, 12);
+    let mut fs = Solution::new(&fc, &greedy::matrix(&fm, &mut |_| {}));
+    let all: Vec<u32> = (0..fs.n() as u32).collect();
+    {
+        let mut obs = NoObserver;
+        let mut ctx = Context::new(&free, &fm, 1, Budget::default(), &mut obs);
+        while sop3_two_way(&fsearch, &mut two_way, &mut fs, &mut ctx, &all) {}
+    }
+    g.bench_function(
+        "SOP-3-exchange pass at a local optimum, two-way (random-sop, 300 cells, p = 0)",
+        |b| {
+            b.iter(|| {
+                let mut obs = NoObserver;
+                let mut ctx = Context::new(&free, &fm, 1, Budget::default(), &mut obs);
+                let mut s = fs.clone();
+                assert!(!sop3_two_way(
+                    &fsearch,
+                    &mut two_way,
+                    &mut s,
+                    &mut ctx,
+                    &all
+                ));
                 black_box(s.cost)
             })
         },

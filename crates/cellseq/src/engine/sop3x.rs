@@ -30,6 +30,19 @@
 //! skipped: `ils` makes about 40 % more kicks a second on a symmetric 100-cell instance with
 //! sparse precedence, and as many as before on dense precedence, where blocks are short.
 //!
+//! Two more exact savings, measured in the `engine` benches:
+//! - the free range a scan may use (forward: the positions after i up to the first stamped
+//!   cell) is kept along the scan rather than searched again for every block: a new stamp
+//!   inside it cuts it, and its end only grows past the last cell looked at. A block then
+//!   costs O(1) amortised instead of O(block), which is what a scan without precedence paid
+//!   (the pass at a local optimum of a 300-cell instance without precedence takes 2.4 times
+//!   less time);
+//! - the bound's scan part is a prefix minimum from the scan's start, so it also holds the
+//!   positions of the growing left block, where no right block can end. When it does not
+//!   settle a block, the minimum over the block's own range is taken in one sequential pass
+//!   and may still settle it (about half the blocks the prefix bound leaves, on sparse
+//!   precedence), before the range's link lookups.
+//!
 //! [`CostModel::closure`]: crate::cost::CostModel::closure
 
 use super::moves::sop3_sum;
@@ -118,6 +131,17 @@ impl Labels {
         self.least.push(before.min(end - link));
     }
 
+    /// Minimum of `ends[k] - links[k]` over `lo..=hi`: the bound's scan part for the blocks
+    /// that can be exchanged (a sequential pass, run only when the prefix minimum does not
+    /// settle the block, and cheaper than the block's link lookups it may save).
+    #[inline]
+    fn range_min(&self, lo: usize, hi: usize) -> f64 {
+        self.ends[lo..=hi]
+            .iter()
+            .zip(&self.links[lo..=hi])
+            .fold(f64::INFINITY, |m, (e, l)| m.min(e - l))
+    }
+
     /// Starts a scan: empties the scan's links.
     fn start_scan(&mut self) {
         self.links.clear();
@@ -176,10 +200,18 @@ pub(crate) fn forward(
             w.reach.clear();
             w.reach.resize(cl.words(), 0);
         }
+        // positions (i, clear] hold no stamped cell: R may end anywhere up to clear. Kept
+        // along the scan (a new stamp inside the range cuts it, the end grows past clear
+        // only), so the scan costs O(1) a block, amortised, instead of O(block)
+        let mut clear = h;
         for i in (h + 1)..=imax {
             w.steps += 1;
             for &q in &m.dag.succs[s.order[i as usize] as usize] {
                 w.stamp[q as usize] = label;
+                let pq = s.pos[q as usize] as isize;
+                if pq > i && pq <= clear {
+                    clear = pq - 1;
+                }
             }
             if let Some(cl) = cl {
                 union(&mut w.reach, cl.desc_row(s.order[i as usize] as usize));
@@ -192,10 +224,11 @@ pub(crate) fn forward(
             let old_i = s.link(c, i, i + 1);
             let last_l = s.at(i);
             // R = [i+1..=j] may end anywhere before the first cell that follows a cell of L
-            let mut jend = i;
-            while jend < jmax && w.stamp[s.order[(jend + 1) as usize] as usize] != label {
-                jend += 1;
+            clear = clear.max(i);
+            while clear < jmax && w.stamp[s.order[(clear + 1) as usize] as usize] != label {
+                clear += 1;
             }
+            let jend = clear;
             // exact bound: the exchange adds a link out of the left block's last cell, and
             // for every j in range the right block's links add at least `least`
             if jend > i {
@@ -208,7 +241,11 @@ pub(crate) fn forward(
                     let (a, ma) = last_l.expect("a cell of the path");
                     // j + 1 may be the path's end
                     let out = cheapest.out[m.node(a, ma)].min(c.link(last_l, None));
-                    new_h - old_h - old_i + w.least[kmax] + out >= 0.0
+                    let fixed = new_h - old_h - old_i + out;
+                    // the prefix minimum also holds the positions of L (k < i−1−h); when it
+                    // does not settle the block, the minimum over the j in range may
+                    fixed + w.least[kmax] >= 0.0
+                        || fixed + w.range_min((i - 1 - h) as usize, kmax) >= 0.0
                 });
             if !hopeless {
                 let mut best = (0.0, 0isize);
@@ -273,10 +310,17 @@ fn backward(
         }
         // R = [i+1..=j] grows leftwards
         let mut i = j - 1;
+        // positions (low, i] hold no stamped cell: L may start anywhere after low. Kept
+        // along the scan as in `forward`
+        let mut low = i;
         while i >= imin {
             w.steps += 1;
             for &q in &m.dag.preds[s.order[(i + 1) as usize] as usize] {
                 w.stamp[q as usize] = label;
+                let pq = s.pos[q as usize] as isize;
+                if pq <= i && pq > low {
+                    low = pq;
+                }
             }
             if let Some(cl) = cl {
                 union(&mut w.reach, cl.anc_row(s.order[(i + 1) as usize] as usize));
@@ -290,10 +334,11 @@ fn backward(
             let old_i = s.link(c, i, i + 1);
             let first_r = s.at(i + 1);
             // L = [h+1..=i] may start anywhere after the last cell that precedes a cell of R
-            let mut hlow = i;
-            while hlow > hmin && w.stamp[s.order[hlow as usize] as usize] != label {
-                hlow -= 1;
+            low = low.min(i);
+            while low > hmin && w.stamp[s.order[low as usize] as usize] != label {
+                low -= 1;
             }
+            let hlow = low;
             // exact bound: the exchange adds a link into the right block's first cell, and
             // for every h in range the left block's links add at least `least`
             if hlow < i {
@@ -306,7 +351,10 @@ fn backward(
                     let (a, ma) = first_r.expect("a cell of the path");
                     // h may be the path's start
                     let inn = cheapest.inn[m.node(a, ma)].min(c.link(None, first_r));
-                    new_i - old_i - old_j + w.least[kmax] + inn >= 0.0
+                    let fixed = new_i - old_i - old_j + inn;
+                    // as in `forward`: k < j−1−i are the positions of R
+                    fixed + w.least[kmax] >= 0.0
+                        || fixed + w.range_min((j - 1 - i) as usize, kmax) >= 0.0
                 });
             // L = [h+1..=i] grows leftwards
             let mut h = if hopeless { hlow - 1 } else { i - 1 };
@@ -436,6 +484,134 @@ mod tests {
         Labels {
             unbounded: true,
             ..Labels::default()
+        }
+    }
+
+    /// `forward` by enumeration: every (h, i, j) in the scan's order, an exchange feasible
+    /// when no direct successor of a cell of L lies in R.
+    fn forward_naive(c: &Costs, s: &Solution, x: u32, max_block: usize) -> Option<Move> {
+        let succs = &c.m.dag.succs;
+        let n = s.n() as isize;
+        let px = s.pos[x as usize] as isize;
+        for h in [px - 1, px] {
+            if h + 2 >= n {
+                continue;
+            }
+            for i in (h + 1)..=(h + max_block as isize).min(n - 2) {
+                let mut best = (0.0, 0isize);
+                for j in (i + 1)..=(i + max_block as isize).min(n - 1) {
+                    let blocked = ((h + 1)..=i).any(|a| {
+                        succs[s.order[a as usize] as usize].iter().any(|&q| {
+                            let pq = s.pos[q as usize] as isize;
+                            pq > i && pq <= j
+                        })
+                    });
+                    if blocked {
+                        continue;
+                    }
+                    let d = sop3_sum(
+                        s.link(c, h, i + 1),
+                        c.link(s.at(j), s.at(h + 1)),
+                        c.link(s.at(i), s.at(j + 1)),
+                        s.link(c, h, h + 1),
+                        s.link(c, i, i + 1),
+                        s.link(c, j, j + 1),
+                    );
+                    if d < best.0 {
+                        best = (d, j);
+                    }
+                }
+                if improves(best.0, s.cost) {
+                    return Some((best.0, h, i, best.1));
+                }
+            }
+        }
+        None
+    }
+
+    /// `backward` by enumeration: every (j, i, h) in the scan's order, an exchange feasible
+    /// when no direct predecessor of a cell of R lies in L.
+    fn backward_naive(c: &Costs, s: &Solution, x: u32, max_block: usize) -> Option<Move> {
+        let preds = &c.m.dag.preds;
+        let n = s.n() as isize;
+        let px = s.pos[x as usize] as isize;
+        for j in [px, px - 1] {
+            if j < 1 || j >= n {
+                continue;
+            }
+            let mut i = j - 1;
+            while i >= (j - max_block as isize).max(0) {
+                let mut best = (0.0, 0isize);
+                let mut h = i - 1;
+                while h >= (i - max_block as isize).max(-1) {
+                    let blocked = ((i + 1)..=j).any(|b| {
+                        preds[s.order[b as usize] as usize].iter().any(|&q| {
+                            let pq = s.pos[q as usize] as isize;
+                            pq > h && pq <= i
+                        })
+                    });
+                    if !blocked {
+                        let d = sop3_sum(
+                            c.link(s.at(h), s.at(i + 1)),
+                            c.link(s.at(j), s.at(h + 1)),
+                            s.link(c, i, j + 1),
+                            s.link(c, h, h + 1),
+                            s.link(c, i, i + 1),
+                            s.link(c, j, j + 1),
+                        );
+                        if d < best.0 {
+                            best = (d, h);
+                        }
+                    }
+                    h -= 1;
+                }
+                if improves(best.0, s.cost) {
+                    return Some((best.0, best.1, i, j));
+                }
+                i -= 1;
+            }
+        }
+        None
+    }
+
+    type Move = (f64, isize, isize, isize);
+
+    /// The scans (labelling, the kept range of free positions, the bound, the closure's
+    /// early end) find the move the enumeration finds, from random feasible orders and their
+    /// local optima, sparse to dense precedence, short and whole-path blocks.
+    #[test]
+    fn scans_match_the_enumeration() {
+        for (seed, p) in [(11, 0.0), (12, 0.03), (13, 0.1), (14, 0.3), (15, 0.8)] {
+            let n = 45;
+            let inst = instance_with(n, seed, p);
+            let m = CostModel::new(&inst, Objective::Matrix);
+            let c = Costs::open(&m);
+            let mut obs = NoObserver;
+            let mut ctx = Context::new(&inst, &m, 1, Budget::default(), &mut obs);
+            let mut rng = ChaCha8Rng::seed_from_u64(seed);
+            let mut w = Labels::default();
+            let mut found = 0;
+            for round in 0..6 {
+                let mut s = random_order(&m, &c, &mut rng);
+                if round % 2 == 1 {
+                    let search = Search::new(c, 8);
+                    let all: Vec<u32> = (0..n as u32).collect();
+                    while sop3_two_way(&search, &mut TwoWay::default(), &mut s, &mut ctx, &all) {}
+                }
+                for x in 0..n as u32 {
+                    for block in [1, 5, n] {
+                        let mut e = 0;
+                        for cl in [None, m.closure()] {
+                            let a = forward(&c, cl, &s, &mut w, x, block, &mut e);
+                            assert_eq!(a, forward_naive(&c, &s, x, block), "forward {seed} {x}");
+                            let b = backward(&c, cl, &s, &mut w, x, block, &mut e);
+                            assert_eq!(b, backward_naive(&c, &s, x, block), "backward {seed} {x}");
+                            found += usize::from(a.is_some()) + usize::from(b.is_some());
+                        }
+                    }
+                }
+            }
+            assert!(found > 0, "no move found at density {p}");
         }
     }
 
