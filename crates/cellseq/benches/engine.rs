@@ -1,7 +1,8 @@
 //! Engine benchmarks: delta evaluations per second, one local-search pass on 10k cells, the
 //! two-level descent on 10k points (with and without 3-opt), the Lin–Kernighan descent on a
 //! symmetric matrix with precedence, the two-way SOP-3-exchange descent on a symmetric matrix
-//! with sparse precedence and its pass at a local optimum without precedence, one SA chain,
+//! with sparse precedence and its pass at a local optimum (without, sparse and time-window
+//! precedence), one SA chain,
 //! one tabu iteration, one ant construction; `atsp` to its branch-and-bound proof on a
 //! 300-cell random matrix with costs 0–100; 50 subgradient steps of the position-indexed path
 //! bound on a 100-cell symmetric matrix, and the beam to widths 256 and 4096 there; `ils` for
@@ -28,6 +29,9 @@ use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::collections::BTreeMap;
 use std::hint::black_box;
+
+/// Generator parameters as key–value pairs.
+type Params<'a> = &'a [(&'a str, &'a str)];
 
 /// Key–value pairs as the owned map that generators and solvers take.
 fn strings(kv: &[(&str, &str)]) -> BTreeMap<String, String> {
@@ -208,38 +212,52 @@ fn benches(cr: &mut Criterion) {
         },
     );
 
-    // the same pass at a local optimum of a `random-sop` instance without precedence, 300
-    // cells, costs 0-100 (blocks of 64; every scan runs to its block's end): the work after a
-    // kick, when no move is left
-    let free = generated("random-sop", &[("n", "300"), ("p", "0"), ("c", "100")]);
-    let fm = CostModel::new(&free, free.default_objective());
-    let fc = Costs::open(&fm);
-    let fsearch = Search::new(fc, 12);
-    let mut fs = Solution::new(&fc, &greedy::matrix(&fm, &mut |_| {}));
-    let all: Vec<u32> = (0..fs.n() as u32).collect();
-    {
-        let mut obs = NoObserver;
-        let mut ctx = Context::new(&free, &fm, 1, Budget::default(), &mut obs);
-        while sop3_two_way(&fsearch, &mut two_way, &mut fs, &mut ctx, &all) {}
-    }
-    g.bench_function(
-        "SOP-3-exchange pass at a local optimum, two-way (random-sop, 300 cells, p = 0)",
-        |b| {
+    // the same pass at a local optimum (the work after a kick, when no move is left) of a
+    // `random-sop` instance without precedence, 300 cells, costs 0-100 (blocks of 64; every
+    // scan runs to its block's end), and of the precedence regimes the walks meet:
+    // `near-symmetric` with 10 % precedence in the plane (100 cells, blocks up to the path)
+    // and `time-window` (350 cells, dense)
+    let passes: [(&str, &str, Params); 3] = [
+        (
+            "random-sop, 300 cells, p = 0",
+            "random-sop",
+            &[("n", "300"), ("p", "0"), ("c", "100")],
+        ),
+        (
+            "near-symmetric, 100 cells, p = 10 %",
+            "near-symmetric",
+            &[("n", "100"), ("c", "1000"), ("p", "10"), ("plane", "true")],
+        ),
+        (
+            "time-window, 350 cells, w = 20",
+            "time-window",
+            &[("n", "350"), ("w", "20")],
+        ),
+    ];
+    for (name, kind, params) in passes {
+        let inst = generated(kind, params);
+        let fm = CostModel::new(&inst, inst.default_objective());
+        let fc = Costs::open(&fm);
+        let fsearch = Search::new(fc, 12);
+        let mut fs = Solution::new(&fc, &greedy::matrix(&fm, &mut |_| {}));
+        let all: Vec<u32> = (0..fs.n() as u32).collect();
+        {
+            let mut obs = NoObserver;
+            let mut ctx = Context::new(&inst, &fm, 1, Budget::default(), &mut obs);
+            while sop3_two_way(&fsearch, &mut two_way, &mut fs, &mut ctx, &all) {}
+        }
+        let id = format!("SOP-3-exchange pass at a local optimum, two-way ({name})");
+        g.bench_function(id, |b| {
             b.iter(|| {
                 let mut obs = NoObserver;
-                let mut ctx = Context::new(&free, &fm, 1, Budget::default(), &mut obs);
+                let mut ctx = Context::new(&inst, &fm, 1, Budget::default(), &mut obs);
                 let mut s = fs.clone();
-                assert!(!sop3_two_way(
-                    &fsearch,
-                    &mut two_way,
-                    &mut s,
-                    &mut ctx,
-                    &all
-                ));
+                let moved = sop3_two_way(&fsearch, &mut two_way, &mut s, &mut ctx, &all);
+                assert!(!moved);
                 black_box(s.cost)
             })
-        },
-    );
+        });
+    }
 
     let anneal = Anneal {
         chain: 1.0,

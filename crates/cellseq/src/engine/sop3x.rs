@@ -208,9 +208,11 @@ pub(crate) fn forward(
             w.steps += 1;
             for &q in &m.dag.succs[s.order[i as usize] as usize] {
                 w.stamp[q as usize] = label;
-                let pq = s.pos[q as usize] as isize;
-                if pq > i && pq <= clear {
-                    clear = pq - 1;
+                if clear > i {
+                    let pq = s.pos[q as usize] as isize;
+                    if pq > i && pq <= clear {
+                        clear = pq - 1;
+                    }
                 }
             }
             if let Some(cl) = cl {
@@ -317,9 +319,11 @@ fn backward(
             w.steps += 1;
             for &q in &m.dag.preds[s.order[(i + 1) as usize] as usize] {
                 w.stamp[q as usize] = label;
-                let pq = s.pos[q as usize] as isize;
-                if pq <= i && pq > low {
-                    low = pq;
+                if low < i {
+                    let pq = s.pos[q as usize] as isize;
+                    if pq <= i && pq > low {
+                        low = pq;
+                    }
                 }
             }
             if let Some(cl) = cl {
