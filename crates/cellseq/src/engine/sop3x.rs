@@ -483,6 +483,17 @@ mod tests {
         Solution::new(c, &seq)
     }
 
+    /// A random feasible order, on odd rounds taken to a SOP-3-exchange local optimum.
+    fn start(c: &Costs, ctx: &mut Context, rng: &mut ChaCha8Rng, round: usize) -> Solution {
+        let mut s = random_order(c.m, c, rng);
+        if round % 2 == 1 {
+            let search = Search::new(*c, 8);
+            let all: Vec<u32> = (0..s.n() as u32).collect();
+            while sop3_two_way(&search, &mut TwoWay::default(), &mut s, ctx, &all) {}
+        }
+        s
+    }
+
     /// Scratch space whose scans evaluate every block.
     fn unbounded() -> Labels {
         Labels {
@@ -596,12 +607,7 @@ mod tests {
             let mut w = Labels::default();
             let mut found = 0;
             for round in 0..6 {
-                let mut s = random_order(&m, &c, &mut rng);
-                if round % 2 == 1 {
-                    let search = Search::new(c, 8);
-                    let all: Vec<u32> = (0..n as u32).collect();
-                    while sop3_two_way(&search, &mut TwoWay::default(), &mut s, &mut ctx, &all) {}
-                }
+                let s = start(&c, &mut ctx, &mut rng, round);
                 for x in 0..n as u32 {
                     for block in [1, 5, n] {
                         let mut e = 0;
@@ -669,12 +675,7 @@ mod tests {
             let mut plain = unbounded();
             let mut bounded = Labels::default();
             for round in 0..8 {
-                let mut s = random_order(&m, &c, &mut rng);
-                if round % 2 == 1 {
-                    let search = Search::new(c, 8);
-                    let all: Vec<u32> = (0..n as u32).collect();
-                    while sop3_two_way(&search, &mut TwoWay::default(), &mut s, &mut ctx, &all) {}
-                }
+                let s = start(&c, &mut ctx, &mut rng, round);
                 for x in 0..n as u32 {
                     for block in [6, n] {
                         let (mut e1, mut e2) = (0, 0);
