@@ -2,11 +2,11 @@
 //! two-level descent on 10k points (with and without 3-opt), the Lin–Kernighan descent on a
 //! symmetric matrix with precedence, the two-way SOP-3-exchange descent on a symmetric matrix
 //! with sparse precedence and its pass at a local optimum (without, sparse and time-window
-//! precedence), one SA chain,
-//! one tabu iteration, one ant construction; `atsp` to its branch-and-bound proof on a
-//! 300-cell random matrix with costs 0–100; 50 subgradient steps of the position-indexed path
-//! bound on a 100-cell symmetric matrix, and the beam to widths 256 and 4096 there; `ils` for
-//! 10^7 evaluations on a dense 340-cell `time-window` instance.
+//! precedence), one SA chain, one tabu iteration, one ant construction; `atsp` to its
+//! branch-and-bound proof on a 300-cell random matrix with costs 0–100; 50 subgradient steps
+//! of the position-indexed path bound on a 100-cell symmetric matrix, and the beam to widths
+//! 256 and 4096 there; `ils` for 10^7 evaluations on a dense 340-cell `time-window` instance.
+
 use cellseq::bound::cells::CellGraph;
 use cellseq::bound::qpath::QPath;
 use cellseq::bound::sec::sec_bound;
