@@ -1,7 +1,7 @@
 //! The default portfolio (`auto`) and the enhanced ant colony (`eacs`): plans, determinism
 //! under an evaluation budget, and solution quality on a small TSPLIB SOP instance.
 
-use cellseq::solvers::auto::{Start, parse_plan};
+use cellseq::solvers::auto::{Start, parse_plan, plan_text};
 use cellseq::solvers::{Budget, NoObserver, run};
 use std::collections::BTreeMap;
 
@@ -56,6 +56,43 @@ fn plans_parse_and_bad_plans_are_rejected() {
         "~:1",
     ] {
         assert!(parse_plan(bad).is_err(), "plan '{bad}' accepted");
+    }
+}
+
+/// `@until` after a phase's share: parsed, printed back, checked, and the phase is skipped
+/// once more than that share of the budget is used (an evaluation budget: deterministic).
+#[test]
+fn a_phase_with_until_runs_only_while_the_budget_lasts() {
+    let p = parse_plan("ils:0.9,ils[accept=0.01]*:1@0.5").unwrap();
+    assert_eq!((p[0].until, p[1].until), (None, Some(0.5)));
+    assert_eq!(parse_plan(&plan_text(&p)).unwrap(), p);
+    for bad in ["ils:1@0", "ils:1@1.5", "ils:1@x", "ils:1@", "ils:@0.5"] {
+        assert!(parse_plan(bad).is_err(), "plan '{bad}' accepted");
+    }
+    let inst = sop("ry48p.1");
+    let budget = 1_000_000u64;
+    let used = |plan: &str| {
+        let given = BTreeMap::from([("plan".to_string(), plan.to_string())]);
+        run(
+            "auto",
+            &inst,
+            inst.default_objective(),
+            &given,
+            1,
+            evals(budget),
+            &mut NoObserver,
+        )
+        .unwrap()
+        .evaluations
+    };
+    // the first phase uses 90 % of the budget: a second phase with until = 0.5 is skipped,
+    // one with until = 0.95 or none runs and spends the rest
+    let skipped = used("ils:0.9,ils*:1@0.5");
+    assert!(skipped < budget * 92 / 100, "{skipped}");
+    assert!(skipped > budget * 85 / 100, "{skipped}");
+    for plan in ["ils:0.9,ils*:1@0.95", "ils:0.9,ils*:1"] {
+        let all = used(plan);
+        assert!(all >= budget * 99 / 100, "{plan}: {all}");
     }
 }
 
@@ -217,19 +254,28 @@ fn auto_picks_its_rule_by_symmetry_and_precedence_density() {
                  ils[accept=0.01;carry=true;kicks=2;perturb=swap;shift-repair=2]*:0.25,\
                  ils[accept=0.03;carry=true;kicks=2;perturb=swap;shift-repair=2]*:0.85,\
                  reopt[window=16]*:1";
-    let rounds = "local-search:0.04,~eacs:0.07,\
-                  ils[accept=0.01;carry=true;kicks=2;perturb=swap;shift-repair=2]+:0.2,eacs:0.09,\
-                  ils[accept=0.01;carry=true;kicks=2;perturb=swap;shift-repair=2]+:0.25,~eacs:0.12,\
-                  ils[accept=0.01;carry=true;kicks=2;perturb=swap;shift-repair=2]+:0.33,\
-                  ils[accept=0.03;carry=true;kicks=2;perturb=swap;shift-repair=2]*:0.8,\
-                  reopt[window=16]*:1";
+    // (three rounds whose walks end when they stall, then up to five more while less than
+    // 70 % of the budget is used)
+    let walk = "ils[accept=0.01;carry=true;end-stall=2000;kicks=2;perturb=swap;shift-repair=2]+";
+    let extra: Vec<String> = (3..8)
+        .map(|i| {
+            let back = if i % 2 == 0 { "~" } else { "" };
+            format!("{back}eacs:0.08@0.7,{walk}:0.25@0.7")
+        })
+        .collect();
+    let rounds = format!(
+        "local-search:0.04,~eacs:0.07,{walk}:0.2,eacs:0.09,{walk}:0.25,~eacs:0.12,{walk}:0.33,\
+         {},ils[accept=0.03;carry=true;kicks=2;perturb=swap;shift-repair=2]*:0.8,\
+         reopt[window=16]*:1",
+        extra.join(",")
+    );
     let kro = model("kro124p.3");
     let cases = [
         (
             &kro,
             "sparse-small",
             carry,
-            rounds,
+            rounds.as_str(),
             [secs(1.0), secs(7.49), evals(249_999_999)],
             [secs(7.5), secs(60.0), evals(250_000_000)],
         ),
@@ -673,6 +719,13 @@ fn bad_portfolios_are_refused_naming_the_file_and_the_entry() {
                 rule("a", "", "{ solver = \"auto\", share = 1.0 }")
             ),
             "a plan cannot contain auto itself",
+        ),
+        (
+            format!(
+                "{head}{}{last}",
+                rule("a", "", "{ solver = \"ils\", share = 1.0, until = 1.5 }")
+            ),
+            "until must be in (0, 1], got 1.5",
         ),
         (
             format!(

@@ -11,7 +11,9 @@
 //! whose costs read the same backwards (`lk=auto`; TSPLIB's prob.100) the repair and the
 //! polish of a new best also run Lin–Kernighan chains of feasible reversals
 //! ([`crate::engine::lk`]). Without a budget it stops after `stall` kicks without a new
-//! best. With `walks` > 1 several such walks take kicks in turn, each in the band above its
+//! best; with `end-stall` it stops after that many under a budget too, so that a plan's next
+//! phases get the rest of its share (the `sparse-small` rule's rounds,
+//! notes/lab/stall-rounds.md). With `walks` > 1 several such walks take kicks in turn, each in the band above its
 //! own record, and every repaired kick is crossed with the best of all walks
 //! (notes/lab/ils-walks.md). With `halve` the worse half of the walks is dropped each time
 //! that share of the budget is used, down to one: the `symmetric` rule's plan without a beam
@@ -60,6 +62,8 @@ crossover: the two sequences are cut wherever their prefixes hold the same cells
 cheapest feasible mix of segments is kept, in O(n).
 - **Acceptance**: record-to-record, within `accept` above the best; a restart from the best \
 after `restart` kicks without a gain.
+- **End**: the budget; without one, `stall` kicks without a new best; with `end-stall` > 0, \
+that many kicks without a new best under a budget too (a plan's later phases get the rest).
 - **Corridor passes** (`corridor` > 0): once the walk has spent as many evaluations since its \
 last record as the last pass took, the corridor search (engine::corridor) reorders the best \
 within prefixes that differ from its own by at most `corridor-diff` cells; a gain is \
@@ -224,6 +228,12 @@ are re-chosen); `window-repair=true` runs them in every repair as well.",
             kind: ParamKind::int(1, crate::params::MAX_ITERATIONS),
             help: "stop after this many kicks without a new best when no budget is set",
         },
+        ParamSpec {
+            name: "end-stall",
+            default: "0",
+            kind: ParamKind::int(0, crate::params::MAX_ITERATIONS),
+            help: "end the walk after this many kicks without a new best under a budget too, leaving the rest of its share to the phases after it in a plan (0: off, the walk runs to its budget)",
+        },
     ],
     caps: Caps {
         improves: true,
@@ -271,6 +281,7 @@ pub fn from_params(p: &Params) -> Ils {
         accept: p.float("accept"),
         restart: p.int("restart"),
         stall: p.int("stall"),
+        end_stall: p.int("end-stall"),
         two_way: p.bool("two-way"),
         lk: p.switch("lk"),
         lk_depth: p.int("lk-depth") as usize,
@@ -313,6 +324,8 @@ pub struct Ils {
     pub restart: u64,
     /// Kicks without improvement before stopping (no budget).
     pub stall: u64,
+    /// Kicks without improvement before stopping under a budget too (0: off).
+    pub end_stall: u64,
     /// Backward as well as forward SOP-3-exchange in the repair.
     pub two_way: bool,
     /// Lin-Kernighan chains in the repair (`None`: when the costs are symmetric).
@@ -617,7 +630,7 @@ impl StartsFrom for Ils {
         let trace = super::trace_enabled();
         let mut passes = Passes::new(self.corridor, n, ctx.evaluations());
         while !ctx.exhausted() {
-            if !bounded && since_best >= self.stall {
+            if self.stalled(bounded, since_best) {
                 break;
             }
             if kicks_done.is_multiple_of(HALVE_EVERY) {
@@ -723,6 +736,12 @@ impl StartsFrom for Ils {
 }
 
 impl Ils {
+    /// True when the walk ends after `since_best` kicks without a new best: `stall` of them
+    /// without a budget (`bounded` false), `end-stall` (when set) under any.
+    fn stalled(&self, bounded: bool, since_best: u64) -> bool {
+        !bounded && since_best >= self.stall || self.end_stall > 0 && since_best >= self.end_stall
+    }
+
     /// The walks: the first from `first`, the others (`walks` > 1) from its local optimum
     /// scattered by random feasible reorders, while [`Ils::may_start_walk`] allows; `best`
     /// follows their records.
@@ -1024,6 +1043,38 @@ mod tests {
         assert!(ils(0.0).may_start_walk(&ctx, 7));
         ctx.count(1);
         assert!(!ils(0.0).may_start_walk(&ctx, 1), "half the budget is used");
+    }
+
+    /// `end-stall`: under an evaluation budget the walk ends after that many kicks without a
+    /// new best, well inside the budget, with the same result on every run; without it the
+    /// walk spends the whole budget.
+    #[test]
+    fn end_stall_ends_a_walk_inside_its_budget() {
+        let inst = random_matrix_instance(30, 4, 100, &[(2, 9), (5, 20), (11, 12)]);
+        let m = CostModel::new(&inst, Objective::Matrix);
+        let budget = Budget {
+            time_limit: None,
+            max_evals: Some(3_000_000),
+        };
+        let run = |end_stall: u64| {
+            let ils = Ils {
+                end_stall,
+                ..from_params(&INFO.check_params(&Default::default()).unwrap())
+            };
+            let mut obs = NoObserver;
+            let mut ctx = Context::new(&inst, &m, 5, budget, &mut obs);
+            let out = ils.run_from(&mut ctx, None).unwrap();
+            (out, ctx.evaluations())
+        };
+        let (a, used_a) = run(20);
+        let (b, used_b) = run(20);
+        assert_eq!(a.sequence, b.sequence);
+        assert_eq!(used_a, used_b);
+        assert!(used_a < 1_000_000, "20 kicks without a gain end the walk: {used_a}");
+        let (c, used_c) = run(0);
+        assert!(used_c >= 3_000_000, "without end-stall the walk runs to its budget");
+        assert!(c.cost <= a.cost + 1e-9, "the longer walk is no worse");
+        crate::checker::check(&inst, &a.sequence, Objective::Matrix).expect("feasible");
     }
 
     /// Corridor passes are due once the walk has spent, since the mark, as many evaluations

@@ -19,6 +19,7 @@
 //! instance travelled backwards ([`crate::model::Instance::reversed_matrix`]; matrix
 //! instances only, elsewhere the phase runs forwards). A solver named twice in a plan gets a
 //! new seed each time ([`phase_seed`]), so `eacs:0.4,~eacs:0.5` runs two independent colonies.
+//! `@U` after a share (`eacs:0.08@0.7`) skips the phase once more than U of the budget is used.
 //!
 //! The best sequence wins. Budgets are split by fraction, evaluations as well as time, so a
 //! run with an evaluation budget stays deterministic. Without any budget `auto` gives itself
@@ -85,8 +86,9 @@ under budgets of 5 s and more (or 1.5·10⁸ evaluations), where `gls` runs betw
 `ils` phases, with one mode per cell on up to 500 cells **sparse-small**, the `sparse` plan \
 with carry moves (a cell moved past a precedence neighbour in its way, which a short segment \
 carried along lets through) in the polish of every walk's records, except under budgets of \
-7.5 s and more (or 2.5·10⁸ evaluations), where three rounds of a fresh \
-colony, each polished by `ils` in the 1 % band, come before the walk in the 3 % band, and \
+7.5 s and more (or 2.5·10⁸ evaluations), where rounds of a fresh \
+colony, each polished by `ils` in the 1 % band until it stalls (three, and up to five more \
+while less than 70 % of the budget is used), come before the walk in the 3 % band, and \
 with several modes per cell on up to 300 \
 cells **sparse-modes** (three rounds of a fresh colony, each polished by `ils` in the 1 % \
 band, then `ils` in the 3 % band from the best of the three and window re-optimization); \
@@ -108,7 +110,8 @@ rules: its phases run with the beam settings of the portfolio's last rule. Plan 
 `solver[key=value;...]:share,...`, where the share is a fraction of what is left. After the \
 name, `*` starts the phase from the best sequence so far and `+` from the previous phase's \
 sequence; `~` before the name runs the phase on the instance travelled backwards (matrix \
-instances; elsewhere the phase runs forwards). A solver named twice gets a new seed each time. \
+instances; elsewhere the phase runs forwards). `@U` after the share skips the phase once more \
+than U (in (0, 1]) of the whole budget is used. A solver named twice gets a new seed each time. \
 Example: `cellseq solve F --param plan=local-search:0.3,eacs:0.5,ils*:1`. How the built-in \
 rules were chosen: [notes/portfolio.md](../notes/portfolio.md).",
     params: &[
@@ -128,7 +131,7 @@ rules were chosen: [notes/portfolio.md](../notes/portfolio.md).",
             name: "plan",
             default: FROM_RULE,
             kind: ParamKind::Text,
-            help: "phases that replace the rule selection, with the beam settings of the portfolio's last rule: solver[key=value;...]:share,... (share of what is left; a '*' after the name starts ils, eacs or reopt from the best so far, a '+' from the sequence of the phase before; a '~' before the name runs the phase on the matrix instance travelled backwards; a solver named twice gets a new seed each time); rule: the chosen rule's phases",
+            help: "phases that replace the rule selection, with the beam settings of the portfolio's last rule: solver[key=value;...]:share,... (share of what is left; a '*' after the name starts ils, eacs or reopt from the best so far, a '+' from the sequence of the phase before; a '~' before the name runs the phase on the matrix instance travelled backwards; '@U' after the share skips the phase once more than U of the budget is used; a solver named twice gets a new seed each time); rule: the chosen rule's phases",
         },
         ParamSpec {
             name: "beam-share",
@@ -227,6 +230,16 @@ fn share(b: Budget, used_evals: u64, used_s: f64, frac: f64) -> Budget {
         max_evals: b.max_evals.map(|m| m.saturating_sub(used_evals)),
     }
     .scaled(frac)
+}
+
+/// The share of `b` used so far: of its evaluation budget when it has one (deterministic),
+/// else of its time limit, else none.
+fn used(b: Budget, ctx: &Context) -> f64 {
+    match (b.max_evals, b.time_limit) {
+        (Some(m), _) if m > 0 => ctx.evaluations() as f64 / m as f64,
+        (_, Some(t)) if !t.is_zero() => ctx.elapsed() / t.as_secs_f64(),
+        _ => 0.0,
+    }
 }
 
 /// One phase as it runs: what [`Phase`] says, resolved against the run so far.
@@ -433,6 +446,10 @@ impl Solver for Auto {
             // a best that meets the model's floor is optimal: nothing is left to do
             if (late || ctx.solved()) && best.is_some() {
                 break;
+            }
+            // an extra round (`until`) runs only while the rounds before it left the time
+            if ph.until.is_some_and(|u| used(budget, ctx) > u) {
+                continue;
             }
             let b = share(budget, ctx.evaluations(), ctx.elapsed(), ph.share);
             let start = match ph.start {

@@ -33,6 +33,10 @@ pub struct Phase {
     pub reversed: bool,
     /// The phase's own solver parameters (`solver[key=value;...]`), validated.
     pub params: BTreeMap<String, String>,
+    /// The phase is skipped once more than this share of the plan's budget is used (`@U`
+    /// after the share; `None`: it always runs). Extra rounds of a plan so run only when the
+    /// rounds before them ended early, and never take the time of the phases after them.
+    pub until: Option<f64>,
 }
 
 impl Phase {
@@ -53,8 +57,9 @@ impl Phase {
             Start::Best => "*",
             Start::Previous => "+",
         };
+        let until = self.until.map(|u| format!("@{u}")).unwrap_or_default();
         format!(
-            "{}{}{params}{start}:{}",
+            "{}{}{params}{start}:{}{until}",
             if self.reversed { "~" } else { "" },
             self.solver,
             self.share
@@ -74,6 +79,11 @@ pub fn check_phase(ph: &Phase, index: usize) -> std::result::Result<(), String> 
     if !(ph.share.is_finite() && ph.share > 0.0 && ph.share <= 1.0) {
         return Err(format!("share must be in (0, 1], got {}", ph.share));
     }
+    if let Some(u) = ph.until
+        && !(u.is_finite() && u > 0.0 && u <= 1.0)
+    {
+        return Err(format!("until must be in (0, 1], got {u}"));
+    }
     if ph.solver == "auto" {
         return Err("a plan cannot contain auto itself".to_string());
     }
@@ -91,8 +101,8 @@ pub fn check_phase(ph: &Phase, index: usize) -> std::result::Result<(), String> 
     Ok(())
 }
 
-/// Parses a plan `[~]solver[key=value;...][*|+]:share,...` (parameters in brackets are optional and
-/// checked against the solver's declared parameters).
+/// Parses a plan `[~]solver[key=value;...][*|+]:share[@until],...` (parameters in brackets
+/// and `@until` are optional; parameters are checked against the solver's declared ones).
 pub fn parse_plan(plan: &str) -> Result<Vec<Phase>> {
     let bad = |msg: String| Error::Solver {
         solver: "auto".to_string(),
@@ -103,6 +113,17 @@ pub fn parse_plan(plan: &str) -> Result<Vec<Phase>> {
         let (name, share) = part
             .split_once(':')
             .ok_or_else(|| bad(format!("plan phase '{part}' is not solver:share")))?;
+        let (share, until) = match share.split_once('@') {
+            Some((s, u)) => {
+                let u: f64 = u.trim().parse().map_err(|_| {
+                    bad(format!(
+                        "plan phase '{part}': until (after @) must be a number in (0, 1]"
+                    ))
+                })?;
+                (s, Some(u))
+            }
+            None => (share, None),
+        };
         let share: f64 = share
             .trim()
             .parse()
@@ -143,6 +164,7 @@ pub fn parse_plan(plan: &str) -> Result<Vec<Phase>> {
             start,
             reversed,
             params,
+            until,
         };
         check_phase(&phase, out.len()).map_err(|e| bad(format!("plan phase '{part}': {e}")))?;
         out.push(phase);

@@ -309,6 +309,8 @@ struct PhaseText {
     backwards: bool,
     #[serde(default)]
     params: BTreeMap<String, toml::Value>,
+    #[serde(default)]
+    until: Option<f64>,
 }
 
 /// 1-based line of byte offset `at` in `text`.
@@ -539,6 +541,7 @@ fn phases_of(list: &[PhaseText]) -> std::result::Result<Vec<Phase>, String> {
             start: p.start,
             reversed: p.backwards,
             params,
+            until: p.until,
         };
         check_phase(&ph, i).map_err(|m| format!("phase {} ({}): {m}", i + 1, p.solver))?;
         out.push(ph);
