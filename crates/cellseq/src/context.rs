@@ -151,6 +151,17 @@ impl<'a> Context<'a> {
     pub fn elapsed(&self) -> f64 {
         self.start.elapsed().as_secs_f64()
     }
+    /// The share of the budget used: of the evaluation budget when one is set (so that a run
+    /// under an evaluation budget stays deterministic), else of the time limit, else none.
+    pub fn used_share(&self) -> f64 {
+        if let Some(m) = self.budget.max_evals {
+            self.evaluations as f64 / m.max(1) as f64
+        } else if let Some(t) = self.budget.time_limit {
+            self.elapsed() / t.as_secs_f64().max(1e-9)
+        } else {
+            0.0
+        }
+    }
     /// The end of the wall-clock budget (none without a time limit): what long computations
     /// below the solvers (bounds, tables, constructions) check.
     pub fn deadline(&self) -> Deadline {

@@ -13,9 +13,9 @@
 //! ([`crate::engine::lk`]). Without a budget it stops after `stall` kicks without a new
 //! best; with `end-stall` it stops after that many under a budget too, so that a plan's next
 //! phases get the rest of its share (the `sparse-small` rule's rounds,
-//! notes/lab/stall-rounds.md). With `walks` > 1 several such walks take kicks in turn, each in the band above its
-//! own record, and every repaired kick is crossed with the best of all walks
-//! (notes/lab/ils-walks.md). With `halve` the worse half of the walks is dropped each time
+//! notes/lab/stall-rounds.md). With `walks` > 1 several such walks take kicks in turn, each
+//! in the band above its own record, and every repaired kick is crossed with the best of all
+//! walks (notes/lab/ils-walks.md). With `halve` the worse half of the walks is dropped each time
 //! that share of the budget is used, down to one: the `symmetric` rule's plan without a beam
 //! runs eight walks so (notes/lab/halved-walks.md). Walks then start only within the first
 //! such share: on 1500 cells eight starts took a whole 10 s budget
@@ -244,18 +244,6 @@ are re-chosen); `window-repair=true` runs them in every repair as well.",
 
 /// Kicks between two looks at whether walks are to be dropped (`halve`).
 const HALVE_EVERY: u64 = 16;
-
-/// The share of the budget used: of the evaluation budget when one is set (so that a run
-/// under an evaluation budget stays deterministic), else of the time limit, else none.
-fn used_share(ctx: &Context) -> f64 {
-    if let Some(m) = ctx.budget.max_evals {
-        ctx.evaluations() as f64 / m.max(1) as f64
-    } else if let Some(t) = ctx.budget.time_limit {
-        ctx.elapsed() / t.as_secs_f64().max(1e-9)
-    } else {
-        0.0
-    }
-}
 
 /// Without `halve`, walks after the first start only within this share of the budget: on
 /// large instances a start (a scatter and a full descent) takes seconds, and the walks need
@@ -786,16 +774,16 @@ impl Ils {
         } else {
             START_SHARE
         };
-        started < self.walks && !ctx.exhausted() && used_share(ctx) < share
+        started < self.walks && !ctx.exhausted() && ctx.used_share() < share
     }
 
     /// With `halve` > 0, keeps the `walks >> stage` walks of the best records, where `stage`
-    /// counts the shares of `halve` of the budget used so far ([`used_share`]).
+    /// counts the shares of `halve` of the budget used so far ([`Context::used_share`]).
     fn drop_walks(&self, ctx: &Context, walks: &mut Vec<Walk>) {
         if self.halve <= 0.0 || walks.len() <= 1 {
             return;
         }
-        let stage = (used_share(ctx) / self.halve).floor().min(63.0) as u32;
+        let stage = (ctx.used_share() / self.halve).floor().min(63.0) as u32;
         let keep = (self.walks >> stage).max(1);
         if keep < walks.len() {
             // stable: among equal records the walk started first stays

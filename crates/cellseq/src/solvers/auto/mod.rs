@@ -232,16 +232,6 @@ fn share(b: Budget, used_evals: u64, used_s: f64, frac: f64) -> Budget {
     .scaled(frac)
 }
 
-/// The share of `b` used so far: of its evaluation budget when it has one (deterministic),
-/// else of its time limit, else none.
-fn used(b: Budget, ctx: &Context) -> f64 {
-    match (b.max_evals, b.time_limit) {
-        (Some(m), _) if m > 0 => ctx.evaluations() as f64 / m as f64,
-        (_, Some(t)) if !t.is_zero() => ctx.elapsed() / t.as_secs_f64(),
-        _ => 0.0,
-    }
-}
-
 /// One phase as it runs: what [`Phase`] says, resolved against the run so far.
 struct Run<'p> {
     /// Solver name.
@@ -448,7 +438,8 @@ impl Solver for Auto {
                 break;
             }
             // an extra round (`until`) runs only while the rounds before it left the time
-            if ph.until.is_some_and(|u| used(budget, ctx) > u) {
+            // (`budget` is the context's own: without one, the default limit was set on both)
+            if ph.until.is_some_and(|u| ctx.used_share() > u) {
                 continue;
             }
             let b = share(budget, ctx.evaluations(), ctx.elapsed(), ph.share);
