@@ -156,10 +156,11 @@ the key); under these limits no cost of any sequence can overflow.\n\n",
     ]);
     rows.push(vec![
         "portfolio file".into(),
-        "size; `share`; `min_seconds` (beam and `long`); `beam.stretch`; `long.min_evals`; conditions"
+        "size; `share`; a phase's `until`; `min_seconds` (beam and `long`); `beam.stretch`; \
+         `long.min_evals`; conditions"
             .into(),
         format!(
-            "at most {} bytes; [0, 1]; at least 0; [1, {}]; [0, {:e}]; finite numbers ([portfolio.md](portfolio.md))",
+            "at most {} bytes; [0, 1]; (0, 1]; at least 0; [1, {}]; [0, {:e}]; finite numbers ([portfolio.md](portfolio.md))",
             cellseq::registry::PORTFOLIO_MAX_BYTES,
             cellseq::registry::PORTFOLIO_MAX_STRETCH,
             cellseq::registry::PORTFOLIO_MAX_LONG_EVALS
